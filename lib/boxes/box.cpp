@@ -1,0 +1,118 @@
+#include "cellmap/boxes/box.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+namespace {
+
+using nlohmann::json;
+
+json vector_json(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& where, const std::string& reason) const {
+    throw Error(source_ + ": " + where + ": " + reason);
+  }
+
+  const json& field(const json& object, const char* key, const std::string& where) const {
+    if (!object.is_object()) fail(where, "must be an object");
+    const auto it = object.find(key);
+    if (it == object.end()) fail(where + "." + key, "is missing");
+    return *it;
+  }
+
+  double finite(const json& value, const std::string& where) const {
+    if (!value.is_number()) fail(where, "must be a number");
+    const double x = value.get<double>();
+    if (!std::isfinite(x)) fail(where, "must be finite");
+    return x;
+  }
+
+  std::uint64_t count(const json& value, const std::string& where) const {
+    if (!value.is_number_unsigned() && !(value.is_number_integer() && value.get<std::int64_t>() >= 0)) {
+      fail(where, "must be a non-negative integer");
+    }
+    return value.get<std::uint64_t>();
+  }
+
+  template <int N>
+  Eigen::Matrix<double, N, 1> numbers(const json& value, const std::string& where) const {
+    if (!value.is_array() || value.size() != N) fail(where, "must be an array of " + std::to_string(N) + " numbers");
+    Eigen::Matrix<double, N, 1> out;
+    for (int i = 0; i < N; ++i) out[i] = finite(value[i], where + "[" + std::to_string(i) + "]");
+    return out;
+  }
+
+ private:
+  std::string source_;
+};
+
+}  // namespace
+
+bool Box::contains(const Eigen::Vector3d& p_C, double tolerance) const {
+  const Eigen::Vector3d p_B = rotation.conjugate() * (p_C - center);
+  return (p_B.cwiseAbs() - half_extents).maxCoeff() <= tolerance;
+}
+
+bool Box::is_axis_aligned() const { return rotation.angularDistance(Eigen::Quaterniond::Identity()) == 0.0; }
+
+std::string to_json(const BoxSet& set) {
+  json boxes = json::array();
+  for (const Box& box : set.boxes) {
+    const Eigen::Quaterniond& q = box.rotation;
+    boxes.push_back({{"id", box.id},
+                     {"center", vector_json(box.center)},
+                     {"half_extents", vector_json(box.half_extents)},
+                     {"rotation", json::array({q.w(), q.x(), q.y(), q.z()})},
+                     {"points", box.points}});
+  }
+  json doc = {{"version", set.version}, {"frame", set.frame}, {"boxes", boxes}};
+  return doc.dump(1) + "\n";
+}
+
+BoxSet box_set_from_json(const std::string& text, const std::string& source) {
+  const Reader reader(source);
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw Error(source + ": not valid JSON (" + e.what() + ")");
+  }
+  BoxSet set;
+  set.version = reader.count(reader.field(doc, "version", "document"), "version");
+  const json& frame = reader.field(doc, "frame", "document");
+  if (!frame.is_string()) reader.fail("frame", "must be a string");
+  set.frame = frame.get<std::string>();
+  const json& boxes = reader.field(doc, "boxes", "document");
+  if (!boxes.is_array()) reader.fail("boxes", "must be an array");
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const std::string where = "boxes[" + std::to_string(i) + "]";
+    const json& item = boxes[i];
+    Box box;
+    box.id = reader.count(reader.field(item, "id", where), where + ".id");
+    box.center = reader.numbers<3>(reader.field(item, "center", where), where + ".center");
+    box.half_extents = reader.numbers<3>(reader.field(item, "half_extents", where), where + ".half_extents");
+    if (box.half_extents.minCoeff() < 0) reader.fail(where + ".half_extents", "must not be negative");
+    const Eigen::Vector4d q = reader.numbers<4>(reader.field(item, "rotation", where), where + ".rotation");
+    if (std::abs(q.norm() - 1.0) > 1e-6) reader.fail(where + ".rotation", "must be a unit quaternion [w, x, y, z]");
+    box.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+    box.points = reader.count(reader.field(item, "points", where), where + ".points");
+    set.boxes.push_back(box);
+  }
+  return set;
+}
+
+void write_box_file(const std::filesystem::path& path, const BoxSet& set) {
+  write_file_atomically(path, to_json(set));
+}
+
+BoxSet read_box_file(const std::filesystem::path& path) { return box_set_from_json(read_file(path), path.string()); }
+
+}  // namespace cellmap

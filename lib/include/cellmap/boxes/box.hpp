@@ -1,0 +1,49 @@
+#pragma once
+// The collision box: what segmentation produces, environments version and planners check against.
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cellmap {
+
+/// An oriented box in the cell frame C (metres). `rotation` is R_CB, the box axes expressed in C; an
+/// axis-aligned box has the identity rotation. Plain value type; a default Box is a degenerate point at the
+/// origin with id 0.
+struct Box final {
+  std::uint64_t id = 0;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();        ///< p_CB, metres
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< along the box's own x, y, z axes, metres, >= 0
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  ///< R_CB, unit quaternion
+  std::uint64_t points = 0;  ///< how many input points the box was fitted to
+
+  /// True when p_C lies inside the box grown by `tolerance` on every side.
+  [[nodiscard]] bool contains(const Eigen::Vector3d& p_C, double tolerance = 0.0) const;
+  [[nodiscard]] double volume() const { return 8.0 * half_extents.prod(); }
+  [[nodiscard]] bool is_axis_aligned() const;
+};
+
+/// A set of boxes with the version and frame they belong to: the boxes file of ARCHITECTURE.md.
+struct BoxSet final {
+  std::uint64_t version = 0;
+  std::string frame = "cell";
+  std::vector<Box> boxes;
+};
+
+/// Serialises to the boxes JSON contract: {"version", "frame", "boxes": [{"id", "center", "half_extents",
+/// "rotation" [w,x,y,z], "points"}]}. Numbers keep full double precision.
+[[nodiscard]] std::string to_json(const BoxSet& set);
+
+/// Parses the boxes JSON contract. @throws Error naming `source` and the offending field on malformed input,
+/// non-finite numbers, negative half extents or a non-unit quaternion.
+[[nodiscard]] BoxSet box_set_from_json(const std::string& text, const std::string& source = "boxes");
+
+/// Writes the boxes file atomically (see write_file_atomically). @throws Error on I/O failure.
+void write_box_file(const std::filesystem::path& path, const BoxSet& set);
+/// Reads a boxes file. @throws Error on I/O failure or malformed content.
+[[nodiscard]] BoxSet read_box_file(const std::filesystem::path& path);
+
+}  // namespace cellmap

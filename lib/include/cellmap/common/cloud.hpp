@@ -1,0 +1,13 @@
+#pragma once
+// The point cloud type every stage exchanges.
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+namespace cellmap {
+
+/// Points in metres. Which frame they are in is part of each variable's name (`points_C` cell, `points_S`
+/// sensor). Unorganized unless a function says otherwise.
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+}  // namespace cellmap

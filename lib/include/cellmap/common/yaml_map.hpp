@@ -1,0 +1,84 @@
+#pragma once
+// Strict reading of YAML configuration maps: every key is either read or reported as unknown.
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <set>
+#include <string>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+
+/// A view of one YAML mapping that remembers which keys were read, so that `expect_all_read()` can reject
+/// misspelt or unsupported keys. Errors name the full key path ("segment.region_growing.gap") and, when the
+/// map came from a file, the file. Copyable; not thread-safe.
+class YamlMap {
+ public:
+  /// @param node  a YAML mapping, or a null node (treated as an empty map: every key takes its default).
+  /// @param path  dotted key path of this map inside its document ("" for the root), used in messages.
+  /// @param source  file name or other origin, used as the message prefix ("" for none).
+  /// @throws Error if `node` is neither null nor a mapping.
+  YamlMap(YAML::Node node, std::string path, std::string source = "");
+
+  /// Parses a whole YAML document. @throws Error with the parser's line and column on a syntax error.
+  [[nodiscard]] static YamlMap parse(const std::string& text, const std::string& source);
+  /// Reads and parses a YAML file. @throws Error if it cannot be read or parsed.
+  [[nodiscard]] static YamlMap load(const std::string& file);
+
+  [[nodiscard]] bool has(const std::string& key) const;
+
+  /// The value of `key` converted to T, or `fallback` when absent.
+  /// @throws Error naming the key if the value does not convert to T.
+  template <typename T>
+  [[nodiscard]] T get(const std::string& key, const T& fallback) {
+    if (!has(key)) {
+      read_.insert(key);
+      return fallback;
+    }
+    return require<T>(key);
+  }
+
+  /// The value of `key` converted to T. @throws Error naming the key if absent or not convertible.
+  template <typename T>
+  [[nodiscard]] T require(const std::string& key) {
+    read_.insert(key);
+    const YAML::Node value = node_[key];
+    if (!value) fail(key, "is required");
+    try {
+      return value.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(key, "has the wrong type");
+    }
+  }
+
+  /// A number in [min, max]. @throws Error naming the key and the allowed range otherwise.
+  [[nodiscard]] double number(const std::string& key, double fallback, double min, double max);
+  /// An integer in [min, max]. @throws Error naming the key and the allowed range otherwise.
+  [[nodiscard]] long integer(const std::string& key, long fallback, long min, long max);
+
+  /// The nested map under `key` (an empty map when absent). @throws Error if present but not a map.
+  [[nodiscard]] YamlMap child(const std::string& key);
+  /// The raw node under `key` (for sequences), marked as read; null when absent.
+  [[nodiscard]] YAML::Node node(const std::string& key);
+  /// The underlying node of this map.
+  [[nodiscard]] const YAML::Node& node() const { return node_; }
+
+  /// @throws Error naming the first key of this map that was never read ("unknown key").
+  void expect_all_read() const;
+
+  /// @throws Error "<source>: <path>.<key>: <reason>".
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const;
+
+  [[nodiscard]] std::string key_path(const std::string& key) const;
+  [[nodiscard]] const std::string& source() const { return source_; }
+
+ private:
+  YAML::Node node_;
+  std::string path_;
+  std::string source_;
+  std::set<std::string> read_;
+};
+
+}  // namespace cellmap

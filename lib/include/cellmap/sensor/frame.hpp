@@ -1,0 +1,50 @@
+#pragma once
+// One sensor frame and the depth-image → points conversion every camera source shares.
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cellmap/common/cloud.hpp"
+
+namespace cellmap {
+
+/// Pinhole camera model of a depth image. Sensor frame S: x right, y down, z forward (optical axis), metres.
+struct PinholeIntrinsics final {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0;  ///< focal lengths, pixels
+  double cx = 0, cy = 0;  ///< principal point, pixels
+  double depth_scale = 0.001;  ///< metres per raw depth unit (1 mm for Kinect-class and RealSense Z16)
+  double min_range = 0.0;      ///< depths below this (metres along z) are treated as no return
+  double max_range = 10.0;     ///< depths above this are treated as no return
+
+  /// @throws Error if a size or focal length is not positive, or the range is empty.
+  void validate() const;
+};
+
+/// A raw 16-bit depth image, row-major, `depth.size() == width * height`; 0 means no return.
+struct DepthImage final {
+  PinholeIntrinsics intrinsics;
+  std::vector<std::uint16_t> depth;
+};
+
+/// Back-projects a depth image into the sensor frame: p_S = ((u - cx) z / fx, (v - cy) z / fy, z).
+/// With `organized`, the cloud keeps width × height with NaN for pixels without a valid return (matches PCL's
+/// grabbers); otherwise only valid points are returned. @throws Error if the image size disagrees with the
+/// intrinsics or the intrinsics are invalid.
+[[nodiscard]] Cloud depth_to_points(const DepthImage& image, bool organized = false);
+
+/// One frame of one sensor, with the pose it was taken from.
+struct Frame final {
+  std::string sensor;  ///< sensor name from the configuration
+  double stamp = 0.0;  ///< seconds (sensor clock or simulated time)
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< sensor pose in the cell frame at `stamp`
+  std::optional<DepthImage> depth;  ///< cameras only
+  Cloud points_S;                   ///< valid points in the sensor frame (from `depth`, or a scanner's scan)
+};
+
+}  // namespace cellmap

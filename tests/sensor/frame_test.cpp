@@ -1,0 +1,57 @@
+#include "cellmap/sensor/frame.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+namespace {
+
+DepthImage small_image() {
+  DepthImage image;
+  image.intrinsics.width = 4;
+  image.intrinsics.height = 2;
+  image.intrinsics.fx = 2.0;
+  image.intrinsics.fy = 4.0;
+  image.intrinsics.cx = 1.5;
+  image.intrinsics.cy = 0.5;
+  image.depth = {1000, 0, 2000, 3000, 500, 20000, 1500, 1000};
+  return image;
+}
+
+TEST(DepthToPointsTest, BackProjectsThePinholeModel) {
+  const Cloud cloud = depth_to_points(small_image());
+  // Pixel (1,0) has no return and (1,1) is beyond the default 10 m range: 6 valid points.
+  ASSERT_EQ(cloud.size(), 6u);
+  // Pixel (u=0, v=0), z = 1 m: x = (0 - 1.5) * 1 / 2, y = (0 - 0.5) * 1 / 4.
+  EXPECT_FLOAT_EQ(cloud[0].x, -0.75f);
+  EXPECT_FLOAT_EQ(cloud[0].y, -0.125f);
+  EXPECT_FLOAT_EQ(cloud[0].z, 1.0f);
+  // Pixel (u=3, v=1), z = 1 m.
+  EXPECT_FLOAT_EQ(cloud[5].x, 0.75f);
+  EXPECT_FLOAT_EQ(cloud[5].y, 0.125f);
+  EXPECT_FLOAT_EQ(cloud[5].z, 1.0f);
+}
+
+TEST(DepthToPointsTest, OrganizedKeepsTheGridWithNaN) {
+  const Cloud cloud = depth_to_points(small_image(), true);
+  EXPECT_EQ(cloud.width, 4u);
+  EXPECT_EQ(cloud.height, 2u);
+  EXPECT_TRUE(std::isnan(cloud.at(1, 0).z));
+  EXPECT_TRUE(std::isnan(cloud.at(1, 1).z));
+  EXPECT_FLOAT_EQ(cloud.at(2, 0).z, 2.0f);
+}
+
+TEST(DepthToPointsTest, RejectsSizeMismatchAndBadIntrinsics) {
+  DepthImage image = small_image();
+  image.depth.pop_back();
+  EXPECT_THROW((void)depth_to_points(image), Error);
+  image = small_image();
+  image.intrinsics.fx = 0;
+  EXPECT_THROW((void)depth_to_points(image), Error);
+}
+
+}  // namespace
+}  // namespace cellmap

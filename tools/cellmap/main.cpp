@@ -1,0 +1,24 @@
+// cellmap: the command-line tool over the cellmap library.
+#include <iostream>
+
+#include "cellmap/common/error.hpp"
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"cellmap: keeps a robot cell's collision environment up to date (tools over the library)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "cellmap 0.1.0");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const cellmap::Error& e) {
+    std::cerr << "cellmap: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "cellmap: unexpected failure: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
