@@ -1,9 +1,12 @@
 #pragma once
-// Each subcommand of the `cellmap` tool registers itself on the app; main.cpp lists them.
-// A subcommand reports failure by throwing cellmap::Error (main prints its one-line reason, exits 1).
+// Each subcommand of the `cellmap` tool lives in its own file and registers itself on the app through one
+// function declared here; main.cpp calls them all. A subcommand reports failure by throwing cellmap::Error
+// (main prints "cellmap: <reason>" and exits 1); it prints its results to stdout.
 
 #include <CLI/CLI.hpp>
 
 namespace cellmap::cli {
+
+// void add_<name>_command(CLI::App& app);  -- one line per subcommand, in the order of `cellmap --help`.
 
 }  // namespace cellmap::cli
