@@ -1,0 +1,81 @@
+#pragma once
+// Robot kinematics: joint vector q → pose of every link and of the tool in the cell frame.
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace cellmap {
+
+/// Range of one joint: metres for prismatic joints, radians for revolute ones.
+struct JointLimits final {
+  double lower = 0.0;
+  double upper = 0.0;
+};
+
+/// A serial kinematic chain placed in the cell frame C: a linear/gantry robot (built in) or a serial arm read
+/// from URDF. Links are listed base first, tool last; each moving joint drives the link after it.
+/// Immutable after construction, so it can be shared between threads. An object that exists is valid.
+class Robot final {
+ public:
+  /// A gantry with three prismatic axes along the cell's x, y and z: the bridge (x), the carriage (y) and the
+  /// ram (z). q = (x, y, z) in metres; the tool pose is X_CE(q) = Translation(q) * X_CE_zero, so `X_CE_zero`
+  /// is the tool pose at q = 0 (its rotation fixes how the tool, and a sensor on it, looks down).
+  /// Links: "base", "bridge", "carriage", "ram"; the tool frame is the ram's.
+  /// @throws Error if a lower limit exceeds its upper limit or a value is not finite.
+  [[nodiscard]] static Robot gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                                    const Eigen::Isometry3d& X_CE_zero = Eigen::Isometry3d::Identity());
+
+  /// The chain from the URDF's root link to `tool_link`, with the root placed at X_C_root. Fixed joints are
+  /// folded into their child link's pose; revolute, continuous and prismatic joints become moving joints.
+  /// @throws Error naming the file and the reason when the URDF does not parse, `tool_link` is missing, or a
+  /// joint type is not supported (floating, planar).
+  [[nodiscard]] static Robot from_urdf_file(const std::string& path, const std::string& tool_link,
+                                            const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity());
+  /// As from_urdf_file, on URDF XML text; `source` names it in error messages.
+  [[nodiscard]] static Robot from_urdf_string(const std::string& xml, const std::string& tool_link,
+                                              const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity(),
+                                              const std::string& source = "urdf");
+
+  /// Number of moving joints (the size of q).
+  [[nodiscard]] int dof() const { return static_cast<int>(joint_names_.size()); }
+  [[nodiscard]] const std::vector<std::string>& joint_names() const { return joint_names_; }
+  [[nodiscard]] const std::vector<JointLimits>& limits() const { return limits_; }
+  /// Names of the links along the chain, base first, tool link last.
+  [[nodiscard]] const std::vector<std::string>& link_names() const { return link_names_; }
+
+  /// True if q has dof() finite entries, each within its limits (inclusive).
+  [[nodiscard]] bool within_limits(const Eigen::VectorXd& q) const;
+
+  /// X_CL for every link, in link_names() order. Costs one transform product per joint.
+  /// @throws Error if q has the wrong size or a non-finite entry (limits are not enforced here).
+  [[nodiscard]] std::vector<Eigen::Isometry3d> link_poses(const Eigen::VectorXd& q) const;
+  /// X_CE: the pose of the tool (last) link. @throws Error as link_poses.
+  [[nodiscard]] Eigen::Isometry3d tool_pose(const Eigen::VectorXd& q) const;
+
+  enum class JointType { kFixed, kPrismatic, kRevolute };
+  /// One step of the chain: link i is placed at X_parent_link(i) = origin * motion(q_i) (motion is identity for
+  /// fixed steps). Public so that tests and tools can inspect the chain.
+  struct Step {
+    std::string link;
+    Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< joint frame in the parent link frame
+    JointType type = JointType::kFixed;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< unit, in the joint frame
+    int joint_index = -1;                             ///< index into q, -1 for fixed steps
+  };
+  [[nodiscard]] const std::vector<Step>& steps() const { return steps_; }
+
+ private:
+  Robot() = default;
+  void add_step(Step step, const std::string& joint_name, const JointLimits& limits);
+  void validate() const;
+
+  Eigen::Isometry3d X_C_root_ = Eigen::Isometry3d::Identity();
+  std::vector<Step> steps_;  // steps_[0] is the root link (fixed, origin identity)
+  std::vector<std::string> joint_names_;
+  std::vector<JointLimits> limits_;
+  std::vector<std::string> link_names_;
+};
+
+}  // namespace cellmap
