@@ -446,18 +446,61 @@ SignedDistance epa_penetration(const Obb& a, const Obb& b) {
   const GjkResult g = gjk_relative(a.half_extents, b.half_extents, rel, &simplex);
   Vector3d sat_axis;
   const double sat_gap = sat_relative(a.half_extents, b.half_extents, rel, &sat_axis);
-  if (!g.intersecting || simplex.n < 4) {
-    // Separated, or touching within rounding (GJK stopped on a lower-dimensional simplex at the origin):
-    // report the GJK distance (0 when touching) with the separating axis as normal.
+  if (!g.intersecting) {
     SignedDistance out;
     out.distance = g.distance;
     out.point_a = a.rotation * g.point_a + a.center;
     out.point_b = a.rotation * g.point_b + a.center;
-    out.normal = a.rotation * (g.distance > 0.0 ? Vector3d((g.point_b - g.point_a).normalized()) : sat_axis);
+    out.normal = a.rotation * (g.point_b - g.point_a).normalized();
     return out;
   }
   const Support support{a.half_extents, b.half_extents, rel};
   const double scale = a.half_extents.norm() + b.half_extents.norm() + rel.t.norm();
+  // GJK may stop on a segment or triangle through the origin (inside D): grow it to a tetrahedron by support
+  // points in directions that leave its span. If D itself is flat the depth is 0.
+  const double flat = 1e-12 * scale;
+  for (int attempt = 0; simplex.n < 4 && attempt < 3; ++attempt) {
+    std::vector<Vector3d> directions;
+    if (simplex.n == 1) {
+      for (int k = 0; k < 3; ++k)
+        directions.insert(directions.end(), {Vector3d::Unit(k), -Vector3d::Unit(k)});
+    } else if (simplex.n == 2) {
+      const Vector3d d = (simplex.v[1].w - simplex.v[0].w).normalized();
+      int k = 0;
+      d.cwiseAbs().minCoeff(&k);
+      const Vector3d e1 = d.cross(Vector3d::Unit(k)).normalized();
+      const Vector3d e2 = d.cross(e1);
+      directions = {e1, -e1, e2, -e2};
+    } else {
+      const Vector3d n =
+          (simplex.v[1].w - simplex.v[0].w).cross(simplex.v[2].w - simplex.v[0].w).normalized();
+      const double side = n.dot(simplex.v[0].w) > 0.0 ? -1.0 : 1.0;  // towards the origin first
+      directions = {side * n, -side * n};
+    }
+    bool grown = false;
+    for (const Vector3d& direction : directions) {
+      const Vertex w = support(direction);
+      double off = 0.0;  // distance of w from the current simplex's affine span
+      if (simplex.n == 1) {
+        off = (w.w - simplex.v[0].w).norm();
+      } else if (simplex.n == 2) {
+        const Vector3d d = (simplex.v[1].w - simplex.v[0].w).normalized();
+        const Vector3d r = w.w - simplex.v[0].w;
+        off = (r - r.dot(d) * d).norm();
+      } else {
+        const Vector3d n =
+            (simplex.v[1].w - simplex.v[0].w).cross(simplex.v[2].w - simplex.v[0].w).normalized();
+        off = std::abs(n.dot(w.w - simplex.v[0].w));
+      }
+      if (off > flat) {
+        simplex.v[simplex.n++] = w;
+        grown = true;
+        break;
+      }
+    }
+    if (!grown) break;
+  }
+  if (simplex.n < 4) return penetration_witnesses(a, b, rel, std::max(-sat_gap, 0.0), sat_axis);
   std::vector<Vertex> vertices(simplex.v.begin(), simplex.v.end());
   std::vector<Face> faces;
   const Vector3d centroid = 0.25 * (vertices[0].w + vertices[1].w + vertices[2].w + vertices[3].w);

@@ -133,6 +133,9 @@ TEST(BoxDistanceTest, EdgeEdgeCrossed) {
 TEST(BoxDistanceTest, IdenticalBoxesPenetrateByTheirSmallestWidth) {
   const Obb a(Vector3d(1, 2, 3), Vector3d(0.3, 0.1, 0.7), rotation(0.4, Vector3d(1, 2, 3)));
   expect_in_all_frames(a, a, {-0.2, {}, {}, false});
+  EXPECT_NEAR(epa_penetration(a, a).distance, -0.2, kExact);
+  EXPECT_NEAR(epa_penetration(unit_cube(Vector3d::Zero()), unit_cube(Vector3d::Zero())).distance, -1.0,
+              kExact);
 }
 
 TEST(BoxDistanceTest, DegenerateBoxesStayFinite) {
