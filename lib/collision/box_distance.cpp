@@ -29,10 +29,13 @@ Relative relative(const Obb& a, const Obb& b) {
 // repeated support vertex is recognised exactly.
 struct Vertex {
   Vector3d w;
-  Vector3d a;
-  Vector3d b;
   int id = -1;
 };
+
+// A's vertex of a support vertex, from the sign bits; B's vertex is then a - w.
+Vector3d vertex_a(int id, const Vector3d& ha) {
+  return Vector3d((id & 1) ? ha[0] : -ha[0], (id & 2) ? ha[1] : -ha[1], (id & 4) ? ha[2] : -ha[2]);
+}
 
 struct Support {
   const Vector3d& ha;
@@ -42,9 +45,10 @@ struct Support {
   Vertex operator()(const Vector3d& d) const {
     Vertex v;
     int id = 0;
+    Vector3d a;
     for (int k = 0; k < 3; ++k) {
       const bool positive = d[k] >= 0.0;
-      v.a[k] = positive ? ha[k] : -ha[k];
+      a[k] = positive ? ha[k] : -ha[k];
       id |= positive ? (1 << k) : 0;
     }
     const Vector3d d_b = -(rel.R.transpose() * d);
@@ -54,8 +58,7 @@ struct Support {
       s_b[k] = positive ? hb[k] : -hb[k];
       id |= positive ? (8 << k) : 0;
     }
-    v.b = rel.R * s_b + rel.t;
-    v.w = v.a - v.b;
+    v.w = a - (rel.R * s_b + rel.t);
     v.id = id;
     return v;
   }
@@ -106,6 +109,11 @@ SubResult closest_segment(const std::array<Vertex, 4>& s, int i0, int i1) {
   return r;
 }
 
+// Edge of a triangle, vertex indices in increasing order (the GJK loop compacts the simplex in place).
+SubResult closest_edge(const std::array<Vertex, 4>& s, int i, int j) {
+  return i < j ? closest_segment(s, i, j) : closest_segment(s, j, i);
+}
+
 double cross2(double ax, double ay, double bx, double by) {
   return ax * by - ay * bx;
 }
@@ -148,14 +156,14 @@ SubResult closest_triangle(const std::array<Vertex, 4>& s, int i0, int i1, int i
     }
     for (int j = 0; j < 3; ++j) {
       if (c[j] * mu > 0.0) continue;  // the origin's projection is on the inner side of the edge opposite j
-      const SubResult edge = closest_segment(s, idx[(j + 1) % 3], idx[(j + 2) % 3]);
+      const SubResult edge = closest_edge(s, idx[(j + 1) % 3], idx[(j + 2) % 3]);
       if (edge.distance2 < best.distance2) best = edge;
     }
     return best;
   }
   // Degenerate (collinear) triangle: the closest point lies on one of its edges.
   for (int j = 0; j < 3; ++j) {
-    const SubResult edge = closest_segment(s, idx[(j + 1) % 3], idx[(j + 2) % 3]);
+    const SubResult edge = closest_edge(s, idx[(j + 1) % 3], idx[(j + 2) % 3]);
     if (edge.distance2 < best.distance2) best = edge;
   }
   return best;
@@ -173,10 +181,10 @@ SubResult closest_tetrahedron(const std::array<Vertex, 4>& s) {
   const Vector3d& p3 = s[3].w;
   const Vector3d zero = Vector3d::Zero();
   const double total = volume(p0, p1, p2, p3);
-  const double scale = (p1 - p0).norm() * (p2 - p0).norm() * (p3 - p0).norm();
+  const double scale2 = (p1 - p0).squaredNorm() * (p2 - p0).squaredNorm() * (p3 - p0).squaredNorm();
   const std::array<double, 4> c{volume(zero, p1, p2, p3), volume(p0, zero, p2, p3), volume(p0, p1, zero, p3),
                                 volume(p0, p1, p2, zero)};
-  const bool degenerate = !(std::abs(total) > 1e-14 * scale);
+  const bool degenerate = !(total * total > 1e-28 * scale2);
   SubResult best;
   if (!degenerate && c[0] * total > 0.0 && c[1] * total > 0.0 && c[2] * total > 0.0 && c[3] * total > 0.0) {
     best.n = 4;
@@ -200,15 +208,16 @@ SubResult closest_tetrahedron(const std::array<Vertex, 4>& s) {
 GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
                        Simplex* simplex_out = nullptr) {
   const Support support{ha, hb, rel};
-  const double scale = ha.norm() + hb.norm() + rel.t.norm();
-  const double tiny2 = std::max(1e-24 * scale * scale, std::numeric_limits<double>::min());
+  // (|ha| + |hb| + |t|)^2 <= 3 (|ha|^2 + |hb|^2 + |t|^2): a scene size without square roots.
+  const double scale2 = 3.0 * (ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm());
+  const double tiny2 = std::max(1e-24 * scale2, std::numeric_limits<double>::min());
   constexpr double kRelative = 1e-14;
   constexpr int kMaxIterations = 64;
 
   Simplex simplex;
   // Start from D's centre (-t): the first support point is then in the direction of the origin.
   Vector3d v = -rel.t;
-  if (!(v.squaredNorm() > tiny2)) v = Vector3d(1.0, 0.0, 0.0) * std::max(scale, 1.0);
+  if (!(v.squaredNorm() > tiny2)) v = Vector3d(1.0, 0.0, 0.0) * std::max(std::sqrt(scale2), 1.0);
   double vv = std::numeric_limits<double>::infinity();
   GjkResult result;
   bool intersecting = false;
@@ -220,41 +229,41 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
     if (repeated) break;
     if (simplex.n > 0 && vv - v.dot(w.w) <= kRelative * vv) break;
 
-    Simplex next = simplex;
-    next.v[next.n++] = w;
+    // Tentatively append w (slot n); the simplex is only changed for good when the distance decreases.
+    const int n = simplex.n;
+    simplex.v[n] = w;
     SubResult sub;
-    switch (next.n) {
+    switch (n + 1) {
       case 1:
-        sub = closest_vertex(next.v, 0);
+        sub = closest_vertex(simplex.v, 0);
         break;
       case 2:
-        sub = closest_segment(next.v, 0, 1);
+        sub = closest_segment(simplex.v, 0, 1);
         break;
       case 3:
-        sub = closest_triangle(next.v, 0, 1, 2);
+        sub = closest_triangle(simplex.v, 0, 1, 2);
         break;
       default:
-        sub = closest_tetrahedron(next.v);
+        sub = closest_tetrahedron(simplex.v);
         break;
     }
-    Simplex reduced;
-    reduced.n = sub.n;
-    Vector3d v_next = Vector3d::Zero();
-    for (int i = 0; i < sub.n; ++i) {
-      reduced.v[i] = next.v[sub.index[i]];
-      reduced.lambda[i] = sub.lambda[i];
-      v_next += sub.lambda[i] * reduced.v[i].w;
-    }
     if (sub.n == 4) {
-      simplex = reduced;
+      simplex.n = 4;
+      for (int i = 0; i < 4; ++i) simplex.lambda[i] = sub.lambda[i];
       intersecting = true;
       v = Vector3d::Zero();
       break;
     }
+    Vector3d v_next = sub.lambda[0] * simplex.v[sub.index[0]].w;
+    for (int i = 1; i < sub.n; ++i) v_next += sub.lambda[i] * simplex.v[sub.index[i]].w;
     const double vv_next = v_next.squaredNorm();
-    if (simplex.n > 0 && !(vv_next < vv))
-      break;  // no progress: rounding floor reached, keep the last simplex
-    simplex = reduced;
+    if (n > 0 && !(vv_next < vv)) break;  // no progress: rounding floor reached, keep the last simplex
+    // Indices come in increasing order, so compacting in place is safe.
+    for (int i = 0; i < sub.n; ++i) {
+      if (sub.index[i] != i) simplex.v[i] = simplex.v[sub.index[i]];
+      simplex.lambda[i] = sub.lambda[i];
+    }
+    simplex.n = sub.n;
     v = v_next;
     vv = vv_next;
     if (vv <= tiny2) {
@@ -267,8 +276,9 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
   Vector3d pa = Vector3d::Zero();
   Vector3d pb = Vector3d::Zero();
   for (int i = 0; i < simplex.n; ++i) {
-    pa += simplex.lambda[i] * simplex.v[i].a;
-    pb += simplex.lambda[i] * simplex.v[i].b;
+    const Vector3d a = vertex_a(simplex.v[i].id, ha);
+    pa += simplex.lambda[i] * a;
+    pb += simplex.lambda[i] * (a - simplex.v[i].w);
   }
   result.point_a = pa;
   result.point_b = pb;
@@ -570,8 +580,10 @@ SignedDistance epa_penetration(const Obb& a, const Obb& b) {
   Vector3d pa = Vector3d::Zero();
   Vector3d pb = Vector3d::Zero();
   for (int i = 0; i < 3; ++i) {
-    pa += lambda[i] * vertices[closest->v[i]].a;
-    pb += lambda[i] * vertices[closest->v[i]].b;
+    const Vertex& v = vertices[closest->v[i]];
+    const Vector3d va = vertex_a(v.id, a.half_extents);
+    pa += lambda[i] * va;
+    pb += lambda[i] * (va - v.w);
   }
   SignedDistance out;
   out.distance = -std::max(closest->distance, 0.0);
