@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 
+#include "cellmap/robot/robot.hpp"
 #include "cellmap/sensor/frame.hpp"
 
 namespace cellmap {
@@ -46,6 +47,11 @@ class PoseBuffer final {
   /// 1e-6).
   void push(double stamp, const Eigen::Isometry3d& X_CE);
   void push(const StampedPose& sample) { push(sample.stamp, sample.X_CE); }
+  /// Adds the tool pose of joint vector `q` at `stamp`: X_CE = robot.tool_pose(q).
+  /// @throws Error as push(), or as Robot::tool_pose for a q of the wrong size or with non-finite entries.
+  void push_joints(double stamp, const Robot& robot, const Eigen::VectorXd& q) {
+    push(stamp, robot.tool_pose(q));
+  }
 
   struct Result {
     PoseLookup status = PoseLookup::kMissing;
