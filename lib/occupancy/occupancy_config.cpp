@@ -51,6 +51,18 @@ int OccupancyConfig::sweeps_to_clear() const {
   return sweeps;
 }
 
+int OccupancyConfig::sweeps_to_occupy() const {
+  const float hit_log = static_cast<float>(logodds(hit));
+  const float threshold = static_cast<float>(logodds(occupied_threshold));
+  float value = static_cast<float>(logodds(clamp_min));
+  int sweeps = 0;
+  while (value < threshold) {
+    value += hit_log;
+    ++sweeps;
+  }
+  return sweeps;
+}
+
 OccupancyConfig OccupancyConfig::from_yaml(YamlMap section) {
   OccupancyConfig c;
   // Coarse ranges here so the message names the key; validate() then checks the relations between fields.

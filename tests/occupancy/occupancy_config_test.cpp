@@ -32,6 +32,8 @@ TEST(OccupancyConfigTest, DefaultsAreOctomapsAndValid) {
   EXPECT_DOUBLE_EQ(c.miss, 0.4);
   // logodds(0.971) = 3.51, logodds(0.4) = -0.405: 8 misses leave 0.27 (occupied), the 9th -0.13 (free).
   EXPECT_EQ(c.sweeps_to_clear(), 9);
+  // logodds(0.1192) = -2.0, logodds(0.7) = 0.847: 3 hits reach 0.54 >= 0.
+  EXPECT_EQ(c.sweeps_to_occupy(), 3);
   const OccupancyConfig absent = from_text("other: 1\n");
   EXPECT_DOUBLE_EQ(absent.resolution, 0.02);
   EXPECT_DOUBLE_EQ(absent.max_range, 5.0);

@@ -32,6 +32,12 @@ struct OccupancyConfig final {
   /// removed object has vanished from the map after this many sweeps that see through where it was.
   [[nodiscard]] int sweeps_to_clear() const;
 
+  /// Sweeps of hits that turn a voxel at the lower clamp (well-observed free space) into an occupied one: the
+  /// smallest n with logodds(clamp_min) + n · logodds(hit) >= logodds(occupied_threshold). With the
+  /// defaults, 3. An object put into observed free space is in the map after this many sweeps (in unknown
+  /// space after 1).
+  [[nodiscard]] int sweeps_to_occupy() const;
+
   /// Reads the `occupancy` section (the map passed is that section; absent keys keep their defaults).
   /// Keys: resolution, hit, miss, clamp_min, clamp_max, occupied_threshold, max_range, threads.
   /// @throws Error naming the key ("occupancy.hit: ...") for unknown keys, wrong types or bad ranges.
