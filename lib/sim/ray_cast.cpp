@@ -85,13 +85,14 @@ SceneCaster::SceneCaster(const std::vector<Obstacle>& obstacles) {
   entries_.reserve(obstacles.size());
   for (const Obstacle& o : obstacles) {
     entries_.push_back(
-        Entry{o.shape, o.X_CO.linear().transpose(), o.X_CO.translation(), o.bounding_radius()});
+        Entry{o, o.shape, o.X_CO.linear().transpose(), o.X_CO.translation(), o.bounding_radius()});
   }
 }
 
-std::vector<int> SceneCaster::candidates(const Eigen::Vector3d& apex_C, const Eigen::Vector3d& axis_C,
-                                         double half_angle) const {
-  std::vector<int> out;
+std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3d& apex_C,
+                                                            const Eigen::Vector3d& axis_C,
+                                                            double half_angle) const {
+  std::vector<Candidate> out;
   for (int i = 0; i < size(); ++i) {
     const Entry& e = entries_[static_cast<std::size_t>(i)];
     const Eigen::Vector3d v = e.p_CO - apex_C;
@@ -102,8 +103,12 @@ std::vector<int> SceneCaster::candidates(const Eigen::Vector3d& apex_C, const Ei
       const double angle = std::acos(std::clamp(v.dot(axis_C) / distance, -1.0, 1.0));
       keep = angle - std::asin(e.bounding_radius / distance) <= half_angle;
     }
-    if (keep) out.push_back(i);
+    if (keep) out.push_back(Candidate{i, std::max(0.0, e.obstacle.signed_distance(apex_C))});
   }
+  // Nearest first: once a hit is found, farther obstacles (e.g. the floor under the table) are never tested.
+  std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
+    return a.min_t < b.min_t || (a.min_t == b.min_t && a.obstacle < b.obstacle);
+  });
   return out;
 }
 
@@ -115,7 +120,7 @@ std::optional<double> SceneCaster::hit(const Entry& e, const Eigen::Vector3d& o_
 }
 
 RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C, double t_max,
-                         const std::vector<int>* candidates) const {
+                         const std::vector<Candidate>* candidates) const {
   RayHit best{t_max, -1};
   auto consider = [&](int i) {
     const Entry& e = entries_[static_cast<std::size_t>(i)];
@@ -129,7 +134,10 @@ RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C,
     if (t && *t <= best.t) best = RayHit{*t, i};
   };
   if (candidates) {
-    for (int i : *candidates) consider(i);
+    for (const Candidate& c : *candidates) {
+      if (c.min_t > best.t) break;
+      consider(c.obstacle);
+    }
   } else {
     for (int i = 0; i < size(); ++i) consider(i);
   }

@@ -101,7 +101,8 @@ SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3
     for (const Eigen::Vector3d& c : corners) {
       half_angle = std::max(half_angle, std::acos(std::clamp(axis_S.dot(c), -1.0, 1.0)));
     }
-    const std::vector<int> candidates = caster_.candidates(p_CS, R_CS * axis_S, half_angle + 1e-9);
+    const std::vector<SceneCaster::Candidate> candidates =
+        caster_.candidates(p_CS, R_CS * axis_S, half_angle + 1e-9);
     for (int v = v0; v <= v1; ++v) {
       for (int u = u0; u <= u1; ++u) {
         const Eigen::Vector3d r_S = ray_S(u, v);

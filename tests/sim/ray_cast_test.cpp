@@ -77,7 +77,7 @@ TEST(SceneCasterTest, ConeCullingNeverDropsAHit) {
   const Eigen::Vector3d apex = Eigen::Vector3d::Zero();
   const Eigen::Vector3d axis = Eigen::Vector3d(0.1, -0.2, 1).normalized();
   const double half_angle = 0.3;
-  const std::vector<int> candidates = caster.candidates(apex, axis, half_angle);
+  const std::vector<SceneCaster::Candidate> candidates = caster.candidates(apex, axis, half_angle);
   EXPECT_LT(candidates.size(), obstacles.size());  // the cone does cull
   int hits = 0;
   for (int i = 0; i < 2000; ++i) {

@@ -35,20 +35,29 @@ class SceneCaster final {
  public:
   explicit SceneCaster(const std::vector<Obstacle>& obstacles);
 
-  /// Indices of the obstacles whose bounding sphere meets the cone with apex `apex_C`, unit axis `axis_C` and
-  /// half angle `half_angle` (radians, < π/2 for culling; larger keeps every obstacle). A ray bundle inside
-  /// that cone can only hit these; passing them to cast() skips the rest.
-  [[nodiscard]] std::vector<int> candidates(const Eigen::Vector3d& apex_C, const Eigen::Vector3d& axis_C,
-                                            double half_angle) const;
+  /// An obstacle a ray bundle may hit, with a lower bound on the distance to it from the bundle's apex.
+  struct Candidate {
+    int obstacle;
+    double min_t;  ///< the obstacle's distance from the apex (no ray from the apex hits it sooner)
+  };
 
-  /// The nearest hit with t ≤ t_max among `candidates` (all obstacles when null). `d_C` must be unit.
+  /// The obstacles whose bounding sphere meets the cone with apex `apex_C`, unit axis `axis_C` and half angle
+  /// `half_angle` (radians, < π/2 for culling; larger keeps every obstacle), nearest first. A ray from the
+  /// apex inside the cone can only hit these. Costs one distance evaluation per obstacle.
+  [[nodiscard]] std::vector<Candidate> candidates(const Eigen::Vector3d& apex_C,
+                                                  const Eigen::Vector3d& axis_C, double half_angle) const;
+
+  /// The nearest hit with t ≤ t_max. `d_C` must be unit. With `candidates` (from candidates() for the apex
+  /// o_C), only those are tested, nearest first, stopping once the next one cannot be nearer than the best
+  /// hit; without, every obstacle is tested.
   [[nodiscard]] RayHit cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C, double t_max,
-                            const std::vector<int>* candidates = nullptr) const;
+                            const std::vector<Candidate>* candidates = nullptr) const;
 
   [[nodiscard]] int size() const { return static_cast<int>(entries_.size()); }
 
  private:
   struct Entry {
+    Obstacle obstacle;
     Shape shape;
     Eigen::Matrix3d R_OC;  // rotates cell-frame vectors into the obstacle frame
     Eigen::Vector3d p_CO;  // obstacle frame origin in the cell
