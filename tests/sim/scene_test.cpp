@@ -191,3 +191,23 @@ TEST(SceneEditTest, AddRemoveMoveByName) {
 
 }  // namespace
 }  // namespace cellmap::sim
+
+namespace cellmap::sim {
+namespace {
+
+TEST(SceneTest, UrdfArmSceneLoadsWithItsPathRelativeToTheFile) {
+  const Scene scene = load_scene(std::string(CELLMAP_SOURCE_DIR) + "/config/scenes/scara_cell.yaml");
+  EXPECT_EQ(scene.robot.dof(), 3);
+  EXPECT_EQ(scene.robot.joint_names(), (std::vector<std::string>{"shoulder", "elbow", "lift"}));
+  ASSERT_EQ(scene.sweep.stops.size(), 5u);
+  // Shoulder 0, elbow 0.8: flange at base + 0.6 x + 0.5 (cos 0.8, sin 0.8), looking down; camera 5 cm below.
+  const Eigen::Isometry3d X_CS = scene.sensor_pose(0, scene.sweep.stops[2]);
+  const Eigen::Vector3d expected(1.5 + 0.6 + 0.5 * std::cos(0.8), 1.0 + 0.5 * std::sin(0.8), 2.35);
+  EXPECT_TRUE(X_CS.translation().isApprox(expected, 1e-12));
+  EXPECT_TRUE((X_CS.linear() * Eigen::Vector3d::UnitZ()).isApprox(-Eigen::Vector3d::UnitZ(), 1e-12));
+  EXPECT_EQ(error_of([] { (void)load_scene("/nonexistent/scene.yaml"); }).find("/nonexistent/scene.yaml"),
+            0u);
+}
+
+}  // namespace
+}  // namespace cellmap::sim
