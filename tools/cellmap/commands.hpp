@@ -11,5 +11,6 @@ namespace cellmap::cli {
 void add_bench_command(CLI::App& app);
 void add_distance_command(CLI::App& app);
 void add_sensors_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 }  // namespace cellmap::cli

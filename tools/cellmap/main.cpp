@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   cellmap::cli::add_bench_command(app);
   cellmap::cli::add_distance_command(app);
   cellmap::cli::add_sensors_command(app);
+  cellmap::cli::add_simulate_command(app);
 
   try {
     app.parse(argc, argv);
