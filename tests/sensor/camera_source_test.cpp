@@ -105,12 +105,37 @@ TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
     EXPECT_GE(far, 320);
     EXPECT_GT(frame.points_S.size(), 320u);  // plus the disc near 1 m
   }
-  // Device stamps (33 ms apart) mapped to the host's realtime clock.
-  EXPECT_NEAR(frames[2].stamp - frames[1].stamp, 0.033, 0.0005);
+  // Device stamps (33 ms apart) mapped to the host's realtime clock; the mapping's offset only shrinks, by as
+  // much as the delivery delay improves between frames (a few ms under load).
+  EXPECT_LE(frames[2].stamp - frames[1].stamp, 0.033 + 1e-6);
+  EXPECT_GE(frames[2].stamp - frames[1].stamp, 0.023);
   EXPECT_NEAR(frames[0].stamp, realtime_seconds(), 5.0);
   EXPECT_EQ(source.status().frames, 3u);
   source.close();
   EXPECT_EQ(source.status().state, SourceState::kClosed);
+}
+
+TEST(OpenNI2SourceTest, SilentDeviceTurnsDisconnectedAndIsReopened) {
+  // The Dummy device sends a frame every 33 ms; a 10 ms frame timeout makes each gap look like an unplugged
+  // camera, so the real driver goes through disconnect → back-off → reopen → frames again.
+  OpenNI2Config config = dummy_device();
+  config.reconnect.frame_timeout = 0.010;
+  config.reconnect.initial_backoff = 0.005;
+  config.reconnect.max_backoff = 0.010;
+  OpenNI2Source source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
+  bool saw_disconnect = false;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (std::chrono::steady_clock::now() < until && (!saw_disconnect || source.status().frames < 2)) {
+    (void)source.next(milliseconds(5));
+    if (source.status().state == SourceState::kDisconnected) {
+      saw_disconnect = true;
+      EXPECT_EQ(source.status().reason, "no frames for 0.01 s");
+    }
+  }
+  EXPECT_TRUE(saw_disconnect);
+  EXPECT_GE(source.status().attempts, 2u);
+  EXPECT_GE(source.status().frames, 2u);
 }
 
 TEST(OpenNI2SourceTest, ModeTheDeviceDoesNotOfferIsAnErrorListingWhatItOffers) {
@@ -190,3 +215,10 @@ TEST(SensorsCommandTest, ListsAndExitsZero) {
 
 }  // namespace
 }  // namespace cellmap
+
+// LeakSanitizer (the unit tests also run under ASan): OpenNI2's driver libraries keep a few small allocations
+// for the life of the process (PS1080, PSLink, DummyDevice; ~400 bytes, allocated inside the drivers when
+// OpenNI2 loads them). They are not ours to free; everything allocated by cellmap is still checked.
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libPS1080.so\nleak:libPSLink.so\nleak:libDummyDevice.so\nleak:libOniFile.so\n";
+}
