@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "cellmap 0.1.0");
   cellmap::cli::add_bench_command(app);
   cellmap::cli::add_distance_command(app);
+  cellmap::cli::add_paper_figure_command(app);
 
   try {
     app.parse(argc, argv);
