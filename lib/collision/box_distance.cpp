@@ -206,7 +206,7 @@ SubResult closest_tetrahedron(const std::array<Vertex, 4>& s) {
 
 // Runs GJK in A's frame; returns points in A's frame. `simplex_out` receives the final simplex (for EPA).
 GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
-                       Simplex* simplex_out = nullptr) {
+                       Simplex* simplex_out = nullptr, const Vector3d* towards_b = nullptr) {
   const Support support{ha, hb, rel};
   // (|ha| + |hb| + |t|)^2 <= 3 (|ha|^2 + |hb|^2 + |t|^2): a scene size without square roots.
   const double scale2 = 3.0 * (ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm());
@@ -215,8 +215,9 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
   constexpr int kMaxIterations = 64;
 
   Simplex simplex;
-  // Start from D's centre (-t): the first support point is then in the direction of the origin.
-  Vector3d v = -rel.t;
+  // Start from D's centre (-t), or from a known direction A → B (a separating axis): the first support point
+  // is then in the direction of the origin.
+  Vector3d v = towards_b != nullptr ? Vector3d(-*towards_b) : Vector3d(-rel.t);
   if (!(v.squaredNorm() > tiny2)) v = Vector3d(1.0, 0.0, 0.0) * std::max(std::sqrt(scale2), 1.0);
   double vv = std::numeric_limits<double>::infinity();
   GjkResult result;
@@ -287,28 +288,29 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
   return result;
 }
 
-// The largest separation along the 15 axes (negative: minus the smallest overlap), exact rotation terms.
-// Returns the gap and the unit axis in A's frame pointing from A to B.
-double sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, Vector3d* axis) {
+// The largest separation along the 15 axes (negative: minus the smallest overlap), exact rotation terms, with
+// the unit axis in A's frame pointing from A to B and which axis it is.
+struct SatResult {
+  double gap = -std::numeric_limits<double>::infinity();
+  Vector3d axis = Vector3d::UnitX();
+  enum Kind { kFaceA, kFaceB, kEdges } kind = kFaceA;
+  int i = 0;  // face of A, or A's edge direction
+  int j = 0;  // face of B, or B's edge direction
+};
+
+SatResult sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   const Matrix3d absR = R.cwiseAbs();
-  double best = -std::numeric_limits<double>::infinity();
-  Vector3d best_axis = Vector3d::UnitX();
-  const auto consider = [&](double gap, const Vector3d& unit_axis) {
-    if (gap > best) {
-      best = gap;
-      best_axis = unit_axis;
-    }
-  };
+  SatResult best;
   for (int i = 0; i < 3; ++i) {
     const double gap = std::abs(t[i]) - ha[i] - hb.dot(absR.row(i));
-    consider(gap, Vector3d::Unit(i) * (t[i] >= 0.0 ? 1.0 : -1.0));
+    if (gap > best.gap) best = {gap, Vector3d::Unit(i) * (t[i] >= 0.0 ? 1.0 : -1.0), SatResult::kFaceA, i, 0};
   }
   for (int j = 0; j < 3; ++j) {
     const double tj = t.dot(R.col(j));
     const double gap = std::abs(tj) - ha.dot(absR.col(j)) - hb[j];
-    consider(gap, R.col(j) * (tj >= 0.0 ? 1.0 : -1.0));
+    if (gap > best.gap) best = {gap, R.col(j) * (tj >= 0.0 ? 1.0 : -1.0), SatResult::kFaceB, 0, j};
   }
   // Edge axes: L = e_i x R.col(j); near-parallel edges (|L| < 1e-8) are skipped, their facets of the
   // Minkowski difference degenerate and the neighbouring axes bound the same overlap.
@@ -318,18 +320,94 @@ double sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
     for (int j = 0; j < 3; ++j) {
       const int j1 = (j + 1) % 3;
       const int j2 = (j + 2) % 3;
-      const Vector3d L = Vector3d::Unit(i).cross(R.col(j));
-      const double length2 = L.squaredNorm();
+      const double length2 = R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j);  // |e_i x R.col(j)|^2
       if (length2 < 1e-16) continue;
       const double ra = ha[i1] * absR(i2, j) + ha[i2] * absR(i1, j);
       const double rb = hb[j1] * absR(i, j2) + hb[j2] * absR(i, j1);
       const double tl = t[i2] * R(i1, j) - t[i1] * R(i2, j);
+      const double numerator = std::abs(tl) - ra - rb;
+      // gap = numerator / |L|; when a positive gap is already known, decide without a square root.
+      if (best.gap > 0.0 && (numerator <= 0.0 || numerator * numerator <= best.gap * best.gap * length2)) continue;
       const double length = std::sqrt(length2);
-      consider((std::abs(tl) - ra - rb) / length, L * ((tl >= 0.0 ? 1.0 : -1.0) / length));
+      const double gap = numerator / length;
+      if (gap > best.gap) {
+        const Vector3d L = Vector3d::Unit(i).cross(R.col(j));
+        best = {gap, L * ((tl >= 0.0 ? 1.0 : -1.0) / L.norm()), SatResult::kEdges, i, j};
+      }
     }
   }
-  *axis = best_axis;
   return best;
+}
+
+double sign_of(double x) { return x >= 0.0 ? 1.0 : -1.0; }
+
+// Exact distance certificate: the separating axis gives a lower bound `gap` on the distance; if the support
+// features along it hold a pair of points exactly `gap` apart (a vertex projecting into the facing face, or
+// two edges whose common perpendicular meets both), that pair is a closest pair. Returns false otherwise.
+bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat, Vector3d* pa,
+             Vector3d* pb) {
+  const Matrix3d& R = rel.R;
+  const Vector3d& t = rel.t;
+  if (sat.kind == SatResult::kFaceA) {
+    // B's vertex deepest towards A's face i.
+    const int i = sat.i;
+    const double s = sat.axis[i];
+    const Vector3d sigma(sign_of(-s * R(i, 0)), sign_of(-s * R(i, 1)), sign_of(-s * R(i, 2)));
+    const Vector3d v = t + R * sigma.cwiseProduct(hb);
+    const int k1 = (i + 1) % 3, k2 = (i + 2) % 3;
+    if (std::abs(v[k1]) > ha[k1] || std::abs(v[k2]) > ha[k2]) return false;
+    *pb = v;
+    *pa = v;
+    (*pa)[i] = s * ha[i];
+    return true;
+  }
+  if (sat.kind == SatResult::kFaceB) {
+    // A's vertex deepest towards B's face j, tested in B's frame.
+    const int j = sat.j;
+    const double s = sign_of(sat.axis.dot(R.col(j)));
+    const Vector3d u = Vector3d(sign_of(s * R(0, j)), sign_of(s * R(1, j)), sign_of(s * R(2, j))).cwiseProduct(ha);
+    Vector3d u_B = R.transpose() * (u - t);
+    const int k1 = (j + 1) % 3, k2 = (j + 2) % 3;
+    if (std::abs(u_B[k1]) > hb[k1] || std::abs(u_B[k2]) > hb[k2]) return false;
+    *pa = u;
+    u_B[j] = -s * hb[j];
+    *pb = t + R * u_B;
+    return true;
+  }
+  // Edge-edge: A's edge along e_i and B's edge along R.col(j), the ones extreme along the axis.
+  const int i = sat.i;
+  const int j = sat.j;
+  const Vector3d& L = sat.axis;
+  Vector3d a0(sign_of(L[0]) * ha[0], sign_of(L[1]) * ha[1], sign_of(L[2]) * ha[2]);
+  a0[i] = 0.0;
+  const Vector3d L_B = R.transpose() * L;
+  Vector3d b_local(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
+  b_local[j] = 0.0;
+  const Vector3d b0 = t + R * b_local;
+  const Vector3d d2 = R.col(j);
+  const Vector3d r = a0 - b0;
+  const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+  const double a12 = R(i, j);
+  const double c1 = r[i];
+  const double c2 = d2.dot(r);
+  const double alpha = (a12 * c2 - c1) / (R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j));  // = 1 - a12^2 > 1e-16
+  const double beta = c2 + alpha * a12;
+  if (std::abs(alpha) > ha[i] || std::abs(beta) > hb[j]) return false;
+  *pa = a0;
+  (*pa)[i] += alpha;
+  *pb = b0 + beta * d2;
+  return true;
+}
+
+// Distance of separated boxes (sat.gap > 0) in A's frame: the certificate when it applies, else GJK started
+// along the separating axis.
+GjkResult separated_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat) {
+  GjkResult result;
+  if (certify(ha, hb, rel, sat, &result.point_a, &result.point_b)) {
+    result.distance = (result.point_b - result.point_a).norm();
+    return result;
+  }
+  return gjk_relative(ha, hb, rel, nullptr, &sat.axis);
 }
 
 }  // namespace
@@ -366,11 +444,10 @@ bool overlap(const Obb& a, const Obb& b, double margin) {
 }
 
 SignedDistance separating_axis_depth(const Obb& a, const Obb& b) {
-  const Relative rel = relative(a, b);
-  Vector3d axis;
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, relative(a, b));
   SignedDistance out;
-  out.distance = sat_relative(a.half_extents, b.half_extents, rel, &axis);
-  out.normal = a.rotation * axis;
+  out.distance = sat.gap;
+  out.normal = a.rotation * sat.axis;
   return out;
 }
 
@@ -392,7 +469,9 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const Relative&
   const double shift = depth + clearance;
   Relative moved = rel;
   moved.t += shift * axis_a;
-  const GjkResult g = gjk_relative(a.half_extents, b.half_extents, moved);
+  SatResult sat = sat_relative(a.half_extents, b.half_extents, moved);
+  if (!(sat.gap > 0.0)) sat = {clearance, axis_a, SatResult::kFaceA, 0, 0};  // rounding; GJK decides below
+  const GjkResult g = separated_relative(a.half_extents, b.half_extents, moved, sat);
   Vector3d pa = g.point_a;
   Vector3d pb = g.point_b - shift * axis_a;
   if (g.intersecting) {  // cannot happen for a true separating direction; stay finite regardless
@@ -411,20 +490,23 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const Relative&
 
 SignedDistance signed_distance(const Obb& a, const Obb& b) {
   const Relative rel = relative(a, b);
-  const GjkResult g = gjk_relative(a.half_extents, b.half_extents, rel);
-  if (!g.intersecting) {
-    SignedDistance out;
-    out.distance = g.distance;
-    out.point_a = a.rotation * g.point_a + a.center;
-    out.point_b = a.rotation * g.point_b + a.center;
-    // Not intersecting means the gap exceeds the rounding floor, so the direction is well defined.
-    out.normal = a.rotation * (g.point_b - g.point_a).normalized();
-    return out;
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, rel);
+  if (sat.gap > 0.0) {
+    const GjkResult g = separated_relative(a.half_extents, b.half_extents, rel, sat);
+    if (!g.intersecting) {
+      SignedDistance out;
+      out.distance = g.distance;
+      out.point_a = a.rotation * g.point_a + a.center;
+      out.point_b = a.rotation * g.point_b + a.center;
+      // A positive separation exceeds the rounding floor, so the direction is well defined; a certified pair
+      // lies along the axis itself.
+      const Vector3d gap = g.point_b - g.point_a;
+      out.normal = a.rotation * (gap.squaredNorm() > 0.0 ? Vector3d(gap.normalized()) : sat.axis);
+      return out;
+    }
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
-  Vector3d axis;
-  const double gap = sat_relative(a.half_extents, b.half_extents, rel, &axis);
-  return penetration_witnesses(a, b, rel, std::max(-gap, 0.0), axis);
+  return penetration_witnesses(a, b, rel, std::max(-sat.gap, 0.0), sat.axis);
 }
 
 namespace {
@@ -454,8 +536,9 @@ SignedDistance epa_penetration(const Obb& a, const Obb& b) {
   const Relative rel = relative(a, b);
   Simplex simplex;
   const GjkResult g = gjk_relative(a.half_extents, b.half_extents, rel, &simplex);
-  Vector3d sat_axis;
-  const double sat_gap = sat_relative(a.half_extents, b.half_extents, rel, &sat_axis);
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, rel);
+  const double sat_gap = sat.gap;
+  const Vector3d& sat_axis = sat.axis;
   if (!g.intersecting) {
     SignedDistance out;
     out.distance = g.distance;
