@@ -298,54 +298,96 @@ struct SatResult {
   int j = 0;  // face of B, or B's edge direction
 };
 
-SatResult sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel) {
+// With faces_only, just the 6 face axes: a valid lower bound when positive, and cheap.
+SatResult sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool faces_only = false) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   const Matrix3d absR = R.cwiseAbs();
-  SatResult best;
-  for (int i = 0; i < 3; ++i) {
-    const double gap = std::abs(t[i]) - ha[i] - hb.dot(absR.row(i));
-    if (gap > best.gap) best = {gap, Vector3d::Unit(i) * (t[i] >= 0.0 ? 1.0 : -1.0), SatResult::kFaceA, i, 0};
-  }
+  double gap[15];
+  double tb[3];
+  for (int i = 0; i < 3; ++i) gap[i] = std::abs(t[i]) - ha[i] - hb.dot(absR.row(i));
   for (int j = 0; j < 3; ++j) {
-    const double tj = t.dot(R.col(j));
-    const double gap = std::abs(tj) - ha.dot(absR.col(j)) - hb[j];
-    if (gap > best.gap) best = {gap, R.col(j) * (tj >= 0.0 ? 1.0 : -1.0), SatResult::kFaceB, 0, j};
+    tb[j] = t.dot(R.col(j));
+    gap[3 + j] = std::abs(tb[j]) - ha.dot(absR.col(j)) - hb[j];
   }
-  // Edge axes: L = e_i x R.col(j); near-parallel edges (|L| < 1e-8) are skipped, their facets of the
-  // Minkowski difference degenerate and the neighbouring axes bound the same overlap.
+  // Edge axes: L = e_i x R.col(j), |L|^2 = R(i1, j)^2 + R(i2, j)^2. Near-parallel edges (|L| < 1e-8) are
+  // skipped: their facets of the Minkowski difference degenerate and the neighbouring axes bound the same
+  // overlap.
+  if (faces_only) {
+    int k = 0;
+    for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
+    SatResult best;
+    best.gap = gap[k];
+    if (k < 3) {
+      best.kind = SatResult::kFaceA;
+      best.i = k;
+      best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
+    } else {
+      best.kind = SatResult::kFaceB;
+      best.j = k - 3;
+      best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
+    }
+    return best;
+  }
+  double tl[9];
+  double numerator[9];
+  double length2[9];
   for (int i = 0; i < 3; ++i) {
     const int i1 = (i + 1) % 3;
     const int i2 = (i + 2) % 3;
     for (int j = 0; j < 3; ++j) {
       const int j1 = (j + 1) % 3;
       const int j2 = (j + 2) % 3;
-      const double length2 = R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j);  // |e_i x R.col(j)|^2
-      if (length2 < 1e-16) continue;
+      const int m = 3 * i + j;
+      length2[m] = R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j);
       const double ra = ha[i1] * absR(i2, j) + ha[i2] * absR(i1, j);
       const double rb = hb[j1] * absR(i, j2) + hb[j2] * absR(i, j1);
-      const double tl = t[i2] * R(i1, j) - t[i1] * R(i2, j);
-      const double numerator = std::abs(tl) - ra - rb;
-      // gap = numerator / |L|; when a positive gap is already known, decide without a square root.
-      if (best.gap > 0.0 && (numerator <= 0.0 || numerator * numerator <= best.gap * best.gap * length2)) continue;
-      const double length = std::sqrt(length2);
-      const double gap = numerator / length;
-      if (gap > best.gap) {
-        const Vector3d L = Vector3d::Unit(i).cross(R.col(j));
-        best = {gap, L * ((tl >= 0.0 ? 1.0 : -1.0) / L.norm()), SatResult::kEdges, i, j};
-      }
+      tl[m] = t[i2] * R(i1, j) - t[i1] * R(i2, j);
+      numerator[m] = std::abs(tl[m]) - ra - rb;
     }
+  }
+  int k = 0;
+  for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
+  for (int m = 0; m < 9; ++m) {
+    gap[6 + m] = -std::numeric_limits<double>::infinity();
+    if (length2[m] < 1e-16) continue;
+    // With a positive gap known, an edge axis can only win with a positive numerator and then the comparison
+    // needs no square root; most edge axes are discarded here.
+    const double best = gap[k];
+    if (best > 0.0 && (numerator[m] <= 0.0 || numerator[m] * numerator[m] <= best * best * length2[m]))
+      continue;
+    gap[6 + m] = numerator[m] / std::sqrt(length2[m]);
+    if (gap[6 + m] > best) k = 6 + m;
+  }
+  SatResult best;
+  best.gap = gap[k];
+  if (k < 3) {
+    best.kind = SatResult::kFaceA;
+    best.i = k;
+    best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
+  } else if (k < 6) {
+    best.kind = SatResult::kFaceB;
+    best.j = k - 3;
+    best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
+  } else {
+    best.kind = SatResult::kEdges;
+    best.i = (k - 6) / 3;
+    best.j = (k - 6) % 3;
+    const Vector3d L = Vector3d::Unit(best.i).cross(R.col(best.j));
+    best.axis = L * ((tl[k - 6] >= 0.0 ? 1.0 : -1.0) / L.norm());
   }
   return best;
 }
 
-double sign_of(double x) { return x >= 0.0 ? 1.0 : -1.0; }
+double sign_of(double x) {
+  return x >= 0.0 ? 1.0 : -1.0;
+}
 
 // Exact distance certificate: the separating axis gives a lower bound `gap` on the distance; if the support
 // features along it hold a pair of points exactly `gap` apart (a vertex projecting into the facing face, or
 // two edges whose common perpendicular meets both), that pair is a closest pair. Returns false otherwise.
-bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat, Vector3d* pa,
-             Vector3d* pb) {
+bool certify_axis(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat,
+                  Vector3d* pa, Vector3d* pb) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   if (sat.kind == SatResult::kFaceA) {
@@ -365,7 +407,8 @@ bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const 
     // A's vertex deepest towards B's face j, tested in B's frame.
     const int j = sat.j;
     const double s = sign_of(sat.axis.dot(R.col(j)));
-    const Vector3d u = Vector3d(sign_of(s * R(0, j)), sign_of(s * R(1, j)), sign_of(s * R(2, j))).cwiseProduct(ha);
+    const Vector3d u =
+        Vector3d(sign_of(s * R(0, j)), sign_of(s * R(1, j)), sign_of(s * R(2, j))).cwiseProduct(ha);
     Vector3d u_B = R.transpose() * (u - t);
     const int k1 = (j + 1) % 3, k2 = (j + 2) % 3;
     if (std::abs(u_B[k1]) > hb[k1] || std::abs(u_B[k2]) > hb[k2]) return false;
@@ -399,9 +442,47 @@ bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const 
   return true;
 }
 
+// Second certificate: a vertex extreme along the axis and the closest point of the other box to it, when
+// each is the other's closest point (mutually closest points of two convex sets are a closest pair: the
+// direction between them lies in both normal cones). Covers vertex-vertex and vertex-edge contacts.
+bool certify_vertex(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat,
+                    Vector3d* pa, Vector3d* pb) {
+  const Matrix3d& R = rel.R;
+  const Vector3d& t = rel.t;
+  const double tolerance2 = 1e-26 * (ha.squaredNorm() + hb.squaredNorm() + t.squaredNorm());
+  // B's vertex extreme towards A, A's closest point to it, B's closest point to that.
+  const Vector3d L_B = R.transpose() * sat.axis;
+  const Vector3d v_B(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
+  const Vector3d v = t + R * v_B;
+  const Vector3d p = v.cwiseMax(-ha).cwiseMin(ha);
+  const Vector3d p_B = R.transpose() * (p - t);
+  if ((p_B.cwiseMax(-hb).cwiseMin(hb) - v_B).squaredNorm() <= tolerance2) {
+    *pa = p;
+    *pb = v;
+    return true;
+  }
+  // A's vertex extreme towards B, symmetric.
+  const Vector3d u(sign_of(sat.axis[0]) * ha[0], sign_of(sat.axis[1]) * ha[1], sign_of(sat.axis[2]) * ha[2]);
+  const Vector3d u_B = R.transpose() * (u - t);
+  const Vector3d q_B = u_B.cwiseMax(-hb).cwiseMin(hb);
+  const Vector3d q = t + R * q_B;
+  if ((q.cwiseMax(-ha).cwiseMin(ha) - u).squaredNorm() <= tolerance2) {
+    *pa = u;
+    *pb = q;
+    return true;
+  }
+  return false;
+}
+
+bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat, Vector3d* pa,
+             Vector3d* pb) {
+  return certify_axis(ha, hb, rel, sat, pa, pb) || certify_vertex(ha, hb, rel, sat, pa, pb);
+}
+
 // Distance of separated boxes (sat.gap > 0) in A's frame: the certificate when it applies, else GJK started
 // along the separating axis.
-GjkResult separated_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat) {
+GjkResult separated_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
+                             const SatResult& sat) {
   GjkResult result;
   if (certify(ha, hb, rel, sat, &result.point_a, &result.point_b)) {
     result.distance = (result.point_b - result.point_a).norm();
@@ -490,20 +571,30 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const Relative&
 
 SignedDistance signed_distance(const Obb& a, const Obb& b) {
   const Relative rel = relative(a, b);
+  const auto separated = [&](const GjkResult& g, const Vector3d& axis) {
+    SignedDistance out;
+    out.distance = g.distance;
+    out.point_a = a.rotation * g.point_a + a.center;
+    out.point_b = a.rotation * g.point_b + a.center;
+    // A positive separation exceeds the rounding floor, so the direction is well defined; a certified pair
+    // at zero distance cannot occur (the axis gap is positive), the fallback only guards against rounding.
+    const Vector3d gap = g.point_b - g.point_a;
+    out.normal = a.rotation * (gap.squaredNorm() > 0.0 ? Vector3d(gap.normalized()) : axis);
+    return out;
+  };
+  // Fast path: a face axis already separates and a certificate holds (most separated pairs).
+  const SatResult faces = sat_relative(a.half_extents, b.half_extents, rel, true);
+  if (faces.gap > 0.0) {
+    GjkResult g;
+    if (certify(a.half_extents, b.half_extents, rel, faces, &g.point_a, &g.point_b)) {
+      g.distance = (g.point_b - g.point_a).norm();
+      return separated(g, faces.axis);
+    }
+  }
   const SatResult sat = sat_relative(a.half_extents, b.half_extents, rel);
   if (sat.gap > 0.0) {
     const GjkResult g = separated_relative(a.half_extents, b.half_extents, rel, sat);
-    if (!g.intersecting) {
-      SignedDistance out;
-      out.distance = g.distance;
-      out.point_a = a.rotation * g.point_a + a.center;
-      out.point_b = a.rotation * g.point_b + a.center;
-      // A positive separation exceeds the rounding floor, so the direction is well defined; a certified pair
-      // lies along the axis itself.
-      const Vector3d gap = g.point_b - g.point_a;
-      out.normal = a.rotation * (gap.squaredNorm() > 0.0 ? Vector3d(gap.normalized()) : sat.axis);
-      return out;
-    }
+    if (!g.intersecting) return separated(g, sat.axis);
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
   return penetration_witnesses(a, b, rel, std::max(-sat.gap, 0.0), sat.axis);
