@@ -299,7 +299,12 @@ struct SatResult {
 };
 
 // With faces_only, just the 6 face axes: a valid lower bound when positive, and cheap.
-SatResult sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool faces_only = false) {
+// Inlined into its callers so that R and t stay in registers (a measurable share of a box-box query).
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline SatResult
+sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool faces_only = false) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   const Matrix3d absR = R.cwiseAbs();
