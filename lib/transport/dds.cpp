@@ -34,10 +34,13 @@ Qos Qos::make(bool transient_local, std::uint32_t depth) {
   Qos qos;
   dds_qset_reliability(qos.qos_, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(qos.qos_, transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-  if (depth == 0) {
-    dds_qset_history(qos.qos_, DDS_HISTORY_KEEP_ALL, 0);
-  } else {
-    dds_qset_history(qos.qos_, DDS_HISTORY_KEEP_LAST, static_cast<int32_t>(depth));
+  const dds_history_kind_t kind = depth == 0 ? DDS_HISTORY_KEEP_ALL : DDS_HISTORY_KEEP_LAST;
+  dds_qset_history(qos.qos_, kind, static_cast<int32_t>(depth));
+  // Cyclone keeps for late joiners what the durability-service history says (default KEEP_LAST 1), not the
+  // writer history: without this a transient-local KEEP_LAST N writer would hand a late joiner one sample.
+  if (transient_local) {
+    dds_qset_durability_service(qos.qos_, 0, kind, static_cast<int32_t>(depth), DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   }
   return qos;
 }
