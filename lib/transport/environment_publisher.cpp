@@ -35,10 +35,7 @@ void EnvironmentPublisher::check_version(const Environment& env) const {
 }
 
 void EnvironmentPublisher::publish(const Environment& env) {
-  check_version(env);
-  const wire::EnvironmentSample sample(env);
-  snapshot_writer_.write(sample.get());
-  last_version_ = env.version();
+  publish(env, diff(Environment(cell_), env));
 }
 
 void EnvironmentPublisher::publish(const Environment& env, const EnvironmentDelta& delta) {

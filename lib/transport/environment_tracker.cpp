@@ -34,6 +34,16 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment
 std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDelta& delta) {
   std::vector<EnvironmentUpdate> updates;
   if (delta.cell != cell_ || delta.to_version <= delta.from_version) return updates;
+  if (delta.from_version == 0 && current_) {
+    // From nothing: the whole environment (a restarted publisher's first version). Without a local copy yet
+    // it is held like any delta: the snapshot topic brings the current version, not a replay of history.
+    try {
+      return on_snapshot(Environment(delta.cell, delta.to_version, delta.stamp_ns, delta.added));
+    } catch (const Error&) {
+      ++stats_.rejected;  // repeated box ids
+      return updates;
+    }
+  }
   if (current_ && delta.to_version <= current_->version()) return updates;
   if (current_ && delta.from_version != current_->version()) ++stats_.gaps;
   held_[delta.from_version] = delta;

@@ -77,6 +77,19 @@ TEST(EnvironmentTrackerTest, GapHoldsDeltasUntilASnapshotResyncs) {
   EXPECT_EQ(tracker.stats().snapshots_applied, 2u);
 }
 
+TEST(EnvironmentTrackerTest, DeltaFromVersionZeroIsASnapshot) {
+  const History h(6);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[2]);
+  // A restarted publisher sends version 5 whole: the copy jumps there without waiting for the snapshot topic.
+  const auto updates = tracker.on_delta(diff(h.versions[0], h.versions[5]));
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_EQ(updates[0].delta.from_version, 2u);
+  EXPECT_EQ(updates[0].environment, h.versions[5]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+  EXPECT_EQ(tracker.stats().gaps, 0u);
+}
+
 TEST(EnvironmentTrackerTest, ContradictingDeltaWaitsForSnapshot) {
   const History h(3);
   EnvironmentTracker tracker("cell-a");
@@ -92,6 +105,30 @@ TEST(EnvironmentTrackerTest, ContradictingDeltaWaitsForSnapshot) {
   ASSERT_EQ(updates.size(), 1u);
   EXPECT_EQ(*tracker.environment(), h.versions[3]);
   EXPECT_FALSE(tracker.needs_snapshot());
+}
+
+}  // namespace
+}  // namespace cellmap::transport
+
+#include "cellmap/transport/wire_size.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+TEST(WireSizeTest, MatchesTheXcdr1Layout) {
+  // Header 4; cell "c": length 4 + "c\0" 2, padded to 8; version 8; stamp 8; box count 4.
+  const Environment empty("c", 1, 0, {});
+  EXPECT_EQ(wire_size(empty), 4u + 28u);
+  // A box: id 8, center 24, half extents 24, rotation 32, points 8 = 96 bytes, 8-aligned (4 padding first).
+  std::vector<Box> boxes(200);
+  for (std::size_t i = 0; i < boxes.size(); ++i) boxes[i].id = i + 1;
+  EXPECT_EQ(wire_size(Environment("c", 1, 0, boxes)), 4u + 32u + 200u * 96u);
+  // Delta: cell 8, from 8, to 8, stamp 8, added count 4 + pad 4, one box 96, modified count 4, removed
+  // count 4.
+  EnvironmentDelta delta;
+  delta.cell = "c";
+  delta.added = {boxes[0]};
+  EXPECT_EQ(wire_size(delta), 4u + 32u + 8u + 96u + 4u + 4u);
 }
 
 }  // namespace

@@ -24,8 +24,10 @@ class EnvironmentPublisher final {
   EnvironmentPublisher(const dds::Participant& participant, std::string cell,
                        std::uint32_t delta_depth = kDefaultDeltaDepth);
 
-  /// Publishes a snapshot alone: at start or restart (the loaded version), or after versions whose deltas
-  /// were not kept. @throws Error if env is of another cell, is version 0 or not above the last published.
+  /// Publishes a version without a delta from the previous one: at start or restart (the loaded version), or
+  /// after versions that were not published. It goes out as a delta from version 0 (every box added), which
+  /// subscribers in sync take as a snapshot, and as the snapshot.
+  /// @throws Error if env is of another cell, is version 0 or not above the last published.
   void publish(const Environment& env);
   /// Publishes `delta` (to env's version), then `env`. @throws Error as above, or if the delta is of another
   /// cell or does not end at env.version().

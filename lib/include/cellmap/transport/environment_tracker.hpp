@@ -29,6 +29,8 @@ struct TrackerStats final {
 
 /// Keeps a local copy of `cell`. Deltas are applied in version order; a delta that does not start at the
 /// local version is a gap: it is held, and the copy waits for a snapshot at least as new (needs_snapshot()).
+/// A delta from version 0 carries the whole environment (every box added) and counts as a snapshot once a
+/// local copy exists (before, the snapshot itself is awaited, so a late joiner jumps straight to the newest).
 /// Older or duplicate samples are ignored; samples of other cells too. Not thread-safe.
 class EnvironmentTracker final {
  public:
