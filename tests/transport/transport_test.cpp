@@ -11,6 +11,7 @@
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "cellmap/transport/scene_edits.hpp"
+#include "cellmap/transport/status_reader.hpp"
 #include "loopback.hpp"
 #include "scene_steps.hpp"
 
@@ -256,6 +257,37 @@ TEST_F(TransportTest, SceneEditsArriveIntact) {
   EXPECT_EQ(received[1].center, move.center);
   SceneEdit nameless;
   EXPECT_THROW(writer.write(nameless), Error);
+}
+
+TEST_F(TransportTest, StatusReachesALateReader) {
+  dds::Participant daemon(119);
+  EnvironmentPublisher publisher(daemon, "cell-a");
+  CellStatus status;
+  status.cell = "cell-a";
+  status.state = "running";
+  status.sensors = {{"kinect_v2", "streaming"}, {"os32c", "no device"}};
+  status.last_sweep_ns = 1'700'000'000'000'000'000;
+  status.sweeps = 42;
+  status.dropped_frames = 3;
+  status.boxes = 17;
+  status.version = 9;
+  publisher.publish_status(status);
+  EXPECT_THROW(publisher.publish_status(CellStatus{}), Error);  // another cell
+  dds::Participant monitor(119);
+  StatusReader reader(monitor);
+  std::vector<CellStatus> reports;
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (reports.empty() && std::chrono::steady_clock::now() < deadline) reports = reader.take(1s);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports[0].state, "running");
+  ASSERT_EQ(reports[0].sensors.size(), 2u);
+  EXPECT_EQ(reports[0].sensors[1].name, "os32c");
+  EXPECT_EQ(reports[0].sensors[1].state, "no device");
+  EXPECT_EQ(reports[0].last_sweep_ns, status.last_sweep_ns);
+  EXPECT_EQ(reports[0].sweeps, 42u);
+  EXPECT_EQ(reports[0].dropped_frames, 3u);
+  EXPECT_EQ(reports[0].boxes, 17u);
+  EXPECT_EQ(reports[0].version, 9u);
 }
 
 TEST_F(TransportTest, PublisherRefusesWrongVersionsAndCells) {
