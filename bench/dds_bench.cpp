@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -140,17 +141,26 @@ class SubscriberProcess {
   int in_ = -1;
 };
 
-void set_percentiles(benchmark::State& state, std::vector<double> latencies_us) {
+// p50 and p99 one-way latency (us) of each benchmark, kept for the ratio lines printed after the run:
+// on a shared machine the mean time per change is dominated by scheduling outliers, the median is not.
+std::map<std::string, std::pair<double, double>>& percentiles() {
+  static std::map<std::string, std::pair<double, double>> by_benchmark;
+  return by_benchmark;
+}
+
+void set_percentiles(benchmark::State& state, const std::string& name, std::vector<double> latencies_us) {
   if (latencies_us.empty()) return;
   std::sort(latencies_us.begin(), latencies_us.end());
   auto at = [&](double q) { return latencies_us[static_cast<std::size_t>(q * (latencies_us.size() - 1))]; };
   state.counters["p50_us"] = at(0.50);
   state.counters["p99_us"] = at(0.99);
+  percentiles()[name] = {at(0.50), at(0.99)};
 }
 
 // Runs the timed loop: publish(next) then wait until the subscriber reports it.
 template <class Publish>
-void measure(benchmark::State& state, SubscriberProcess& subscriber, Environment env, Publish publish) {
+void measure(benchmark::State& state, const std::string& name, SubscriberProcess& subscriber, Environment env,
+             Publish publish) {
   std::vector<double> latencies_us;
   for (auto _ : state) {
     const Environment next = one_box_moved(env);
@@ -164,7 +174,7 @@ void measure(benchmark::State& state, SubscriberProcess& subscriber, Environment
     latencies_us.push_back(static_cast<double>(arrival->received_ns - sent) / 1e3);
     env = next;
   }
-  set_percentiles(state, latencies_us);
+  set_percentiles(state, name, latencies_us);
 }
 
 void BM_DeltaOneBoxChange(benchmark::State& state) {
@@ -174,9 +184,10 @@ void BM_DeltaOneBoxChange(benchmark::State& state) {
   const Environment first = cell_with_boxes(1);
   publisher.publish(first);
   if (!subscriber.wait_for(1)) return state.SkipWithError("the subscriber never got version 1");
-  measure(state, subscriber, first, [&](const Environment& before, const Environment& after) {
-    publisher.publish(after, diff(before, after));
-  });
+  measure(state, "BM_DeltaOneBoxChange", subscriber, first,
+          [&](const Environment& before, const Environment& after) {
+            publisher.publish(after, diff(before, after));
+          });
   state.counters["bytes_per_change"] =
       static_cast<double>(transport::wire_size(diff(first, one_box_moved(first))));
 }
@@ -191,9 +202,10 @@ void BM_FullSnapshotEachChange(benchmark::State& state) {
   const Environment first = cell_with_boxes(1);
   writer.write(transport::wire::EnvironmentSample(first).get());
   if (!subscriber.wait_for(1)) return state.SkipWithError("the subscriber never got version 1");
-  measure(state, subscriber, first, [&](const Environment&, const Environment& after) {
-    writer.write(transport::wire::EnvironmentSample(after).get());
-  });
+  measure(state, "BM_FullSnapshotEachChange", subscriber, first,
+          [&](const Environment&, const Environment& after) {
+            writer.write(transport::wire::EnvironmentSample(after).get());
+          });
   state.counters["bytes_per_change"] = static_cast<double>(transport::wire_size(first));
 }
 
@@ -221,6 +233,14 @@ int main(int argc, char** argv) {
   const Environment first = cell_with_boxes(1);
   const std::size_t delta_bytes = transport::wire_size(diff(first, one_box_moved(first)));
   const std::size_t snapshot_bytes = transport::wire_size(first);
+  const auto ours = percentiles().find("BM_DeltaOneBoxChange");
+  const auto anchor = percentiles().find("BM_FullSnapshotEachChange");
+  if (ours != percentiles().end() && anchor != percentiles().end()) {
+    std::printf("ratio dds one-box change latency p50: %.2fx (ours %.1f us, anchor %.1f us)\n",
+                anchor->second.first / ours->second.first, ours->second.first, anchor->second.first);
+    std::printf("ratio dds one-box change latency p99: %.2fx (ours %.1f us, anchor %.1f us)\n",
+                anchor->second.second / ours->second.second, ours->second.second, anchor->second.second);
+  }
   std::printf("ratio dds bytes per one-box change (%d boxes): %.2fx (delta %zu B, snapshot %zu B)\n", kBoxes,
               static_cast<double>(snapshot_bytes) / static_cast<double>(delta_bytes), delta_bytes,
               snapshot_bytes);
