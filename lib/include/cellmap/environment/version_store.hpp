@@ -36,6 +36,10 @@ struct RecoveredState final {
 /// either save(v) before publishing v, or reserve(v) before publishing and save(v) after. After a crash
 /// next_version() is above every version that was saved or reserved.
 ///
+/// On restart: if next_version() > recovered().environment.version() + 1, a reserved number may have gone
+/// out unsaved; save the recovered boxes again under next_version() before republishing them, so subscribers
+/// that saw the lost version move forward (tests/transport/publisher_helper.cpp does exactly this).
+///
 /// Not thread-safe; one VersionStore per state directory (no inter-process locking).
 class VersionStore final {
  public:
