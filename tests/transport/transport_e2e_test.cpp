@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include <filesystem>
+#include <future>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -104,6 +105,39 @@ TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
   EXPECT_EQ(WEXITSTATUS(echo.wait()), 0);
   daemon.signal(SIGTERM);
   EXPECT_EQ(WEXITSTATUS(daemon.wait()), 0);
+}
+
+TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
+  constexpr int kDomain = 123;
+  TempDir dir;
+  const dds::Participant planner(kDomain);
+  std::mutex gate;
+  std::unique_lock<std::mutex> hold(gate);  // the first callback blocks until the daemon is done
+  std::promise<void> entered;
+  std::once_flag first;
+  EnvironmentSubscriber subscriber(
+      planner, "cell-e2e",
+      [&](const Environment&, const EnvironmentDelta&) {
+        std::call_once(first, [&] { entered.set_value(); });
+        const std::lock_guard<std::mutex> wait_for_daemon(gate);
+      },
+      /*delta_depth=*/2);
+  test::ChildProcess daemon(helper(kDomain, dir.path(), 1, 0));
+  std::vector<std::uint64_t> published;
+  read_until(daemon, "done", published);
+  ASSERT_EQ(entered.get_future().wait_for(kPatience), std::future_status::ready);
+  daemon.signal(SIGTERM);
+  daemon.wait();
+  // While the planner's callback is stuck, a second daemon run publishes 40 versions; its reader keeps 2.
+  test::ChildProcess busy(helper(kDomain, dir.path(), 40, 0));
+  const std::uint64_t last = read_until(busy, "done", published);
+  hold.unlock();
+  ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
+  busy.signal(SIGTERM);
+  busy.wait();
+  EXPECT_EQ(*subscriber.environment(), VersionStore(dir.path(), "cell-e2e").recovered().environment);
+  EXPECT_GE(subscriber.stats().gaps, 1u);
+  EXPECT_GE(subscriber.stats().snapshots_applied, 2u);
 }
 
 TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
