@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cinttypes>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -46,7 +47,12 @@ std::optional<StateName> parse_name(const std::string& name) {
     if (name.size() < prefix.size() + kDigits || name.compare(0, prefix.size(), prefix) != 0) continue;
     const std::string digits = name.substr(prefix.size(), kDigits);
     if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) return {};
-    return StateName{prefix, std::stoull(digits), name.substr(prefix.size() + kDigits)};
+    std::uint64_t version = 0;
+    for (const char c : digits) {
+      if (version > (UINT64_MAX - 9) / 10) return {};  // beyond uint64: not a name we wrote
+      version = version * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+    return StateName{prefix, version, name.substr(prefix.size() + kDigits)};
   }
   return {};
 }

@@ -163,6 +163,15 @@ TEST(VersionStoreTest, EveryCorruptSnapshotMeansEmptyButVersionsGoOn) {
   EXPECT_EQ(store.next_version(), 3u);
 }
 
+TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
+  TempDir dir;
+  std::ofstream(dir.path() / "environment-99999999999999999999.json") << "{}";
+  std::ofstream(dir.path() / "notes.txt") << "operator notes";
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.next_version(), 1u);
+  EXPECT_TRUE(fs::exists(dir.path() / "notes.txt"));
+}
+
 TEST(VersionStoreTest, ReservationSurvivesWithoutSnapshot) {
   TempDir dir;
   {
