@@ -1,8 +1,12 @@
 #include "cellmap/occupancy/occupancy_map.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <istream>
+#include <ostream>
 #include <tuple>
 
+#include "cellmap/common/error.hpp"
 #include "cellmap/occupancy/key_update.hpp"
 
 namespace cellmap {
@@ -191,6 +195,59 @@ std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
   }
   std::sort(keys.begin(), keys.end(), zyx_less);
   return keys;
+}
+
+}  // namespace cellmap
+
+namespace cellmap {
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres(const std::vector<Region>& regions) const {
+  std::vector<octomap::OcTreeKey> keys;
+  for (const Region& region : regions) {
+    if (region.volume() <= 0) continue;
+    const octomap::point3d min(static_cast<float>(region.min.x()), static_cast<float>(region.min.y()),
+                               static_cast<float>(region.min.z()));
+    const octomap::point3d max(static_cast<float>(region.max.x()), static_cast<float>(region.max.y()),
+                               static_cast<float>(region.max.z()));
+    for (auto it = tree_->begin_leafs_bbx(min, max), end = tree_->end_leafs_bbx(); it != end; ++it) {
+      if (!tree_->isNodeOccupied(*it)) continue;
+      // Pruned leaves stand for several voxels: enumerate the leaf-level keys they cover.
+      const int span = 1 << (tree_->getTreeDepth() - it.getDepth());
+      const octomap::OcTreeKey base = it.getIndexKey();
+      for (int dz = 0; dz < span; ++dz) {
+        for (int dy = 0; dy < span; ++dy) {
+          for (int dx = 0; dx < span; ++dx) {
+            const octomap::OcTreeKey key(base[0] + dx, base[1] + dy, base[2] + dz);
+            if (region.contains(centre(key))) keys.push_back(key);
+          }
+        }
+      }
+    }
+  }
+  const auto zyx = [](const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
+    return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+  };
+  std::sort(keys.begin(), keys.end(), zyx);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(keys.size());
+  for (const auto& key : keys) centres.push_back(centre(key));
+  return centres;
+}
+
+void OccupancyMap::write_binary(std::ostream& out) const {
+  if (!tree_->writeBinaryConst(out) || !out) throw Error("occupancy map: writing the .bt stream failed");
+}
+
+void OccupancyMap::read_binary(std::istream& in) {
+  auto tree = std::make_unique<octomap::OcTree>(config_.resolution);
+  if (!tree->readBinary(in)) throw Error("occupancy map: not a readable OctoMap .bt stream");
+  if (std::abs(tree->getResolution() - config_.resolution) > 1e-9) {
+    throw Error("occupancy map: the stored map has resolution " + std::to_string(tree->getResolution()) +
+                " m, the config says " + std::to_string(config_.resolution) + " m");
+  }
+  apply_sensor_model(config_, *tree);
+  tree_ = std::move(tree);
 }
 
 }  // namespace cellmap

@@ -7,8 +7,10 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <iosfwd>
 #include <vector>
 
+#include "cellmap/common/region.hpp"
 #include "cellmap/occupancy/occupancy_config.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
@@ -55,6 +57,17 @@ class OccupancyMap final {
   [[nodiscard]] Eigen::Vector3d centre(const octomap::OcTreeKey& key) const;
   /// Leaf keys of all occupied voxels, sorted by (z, y, x).
   [[nodiscard]] std::vector<octomap::OcTreeKey> occupied_keys() const;
+
+  /// Centres of the occupied leaf voxels inside any of `regions` (metres, cell frame), each voxel once, in
+  /// (z, y, x) key order. Cost: a bounding-box walk of the tree per region.
+  [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres(const std::vector<Region>& regions) const;
+
+  /// Writes the map as OctoMap's binary .bt stream (occupied/free per leaf; probabilities are rounded to the
+  /// clamps). @throws Error if the stream fails.
+  void write_binary(std::ostream& out) const;
+  /// Replaces the map with a .bt stream written by write_binary() at the same resolution.
+  /// @throws Error if the stream is not a readable .bt tree or its resolution differs from the config's.
+  void read_binary(std::istream& in);
 
   /// The OcTree itself (for queries, writing .bt files, or comparison); its parameters are the config's.
   [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
