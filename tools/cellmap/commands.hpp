@@ -8,5 +8,6 @@
 namespace cellmap::cli {
 
 // void add_<name>_command(CLI::App& app);  -- one line per subcommand, in the order of `cellmap --help`.
+void add_segment_command(CLI::App& app);
 
 }  // namespace cellmap::cli

@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
   CLI::App app{"cellmap: keeps a robot cell's collision environment up to date (tools over the library)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "cellmap 0.1.0");
+  cellmap::cli::add_segment_command(app);
 
   try {
     app.parse(argc, argv);
