@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
@@ -21,7 +22,8 @@ namespace cellmap::mosd {
 struct Score {
   std::size_t object_points = 0;
   std::size_t covered_object_points = 0;
-  std::vector<double> iou;  ///< one per object, ascending object id
+  std::vector<double> iou;          ///< one per object, ascending object id
+  std::vector<std::string> detail;  ///< per object: "id size | best box: held, object points in it"
   [[nodiscard]] double coverage() const {
     return object_points == 0 ? 1.0 : static_cast<double>(covered_object_points) / object_points;
   }
@@ -57,13 +59,31 @@ inline Score score(const Cloud& points, const std::vector<std::uint32_t>& labels
   }
   for (const auto& [object, size] : object_size) {
     double best = 0.0;
+    std::size_t best_box = boxes.size();
     for (std::size_t b = 0; b < boxes.size(); ++b) {
       const auto it = box_object[b].find(object);
       if (it == box_object[b].end()) continue;
       const double inter = static_cast<double>(it->second);
-      best = std::max(best, inter / (static_cast<double>(size) + box_size[b] - inter));
+      const double iou = inter / (static_cast<double>(size) + box_size[b] - inter);
+      if (iou > best) {
+        best = iou;
+        best_box = b;
+      }
     }
     s.iou.push_back(best);
+    std::string text = "object " + std::to_string(object) + ": " + std::to_string(size) + " points, IoU " +
+                       std::to_string(best);
+    if (best_box < boxes.size()) {
+      text += ", best box " + std::to_string(boxes[best_box].id) + " holds " +
+              std::to_string(box_size[best_box]) + " points (" +
+              std::to_string(box_object[best_box][object]) + " of this object); boxes holding it:";
+      for (std::size_t b = 0; b < boxes.size(); ++b) {
+        const auto it = box_object[b].find(object);
+        if (it != box_object[b].end())
+          text += " " + std::to_string(boxes[b].id) + ":" + std::to_string(it->second);
+      }
+    }
+    s.detail.push_back(text);
   }
   return s;
 }

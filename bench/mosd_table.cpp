@@ -1,5 +1,6 @@
 // Prints the per-scene table of the batch pipeline on the mOSD box scenes: points, clusters, boxes, coverage,
 // IoU (see mosd_score.hpp) and time per stage. Usage: cellmap-mosd-table [DIR] [FIRST LAST] [--config FILE]
+// [--verbose]
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -13,9 +14,12 @@
 int main(int argc, char** argv) {
   std::string dir = std::string(CELLMAP_SHARED_DATA) + "/mosd";
   std::string config_file;
+  bool verbose = false;
   std::vector<std::string> positional;
   for (int a = 1; a < argc; ++a) {
-    if (std::strcmp(argv[a], "--config") == 0 && a + 1 < argc) {
+    if (std::strcmp(argv[a], "--verbose") == 0) {
+      verbose = true;
+    } else if (std::strcmp(argv[a], "--config") == 0 && a + 1 < argc) {
       config_file = argv[++a];
     } else {
       positional.emplace_back(argv[a]);
@@ -56,6 +60,9 @@ int main(int argc, char** argv) {
           100.0 * s.coverage(), cellmap::mosd::median(s.iou),
           s.iou.empty() ? 0.0 : *std::min_element(s.iou.begin(), s.iou.end()), t.t_features, t.t_outliers,
           t.t_grow, t.t_leftovers, t.t_merge, t.t_split, t.t_total());
+      if (verbose) {
+        for (const std::string& line : s.detail) std::printf("    %s\n", line.c_str());
+      }
       std::fflush(stdout);
     }
     std::printf("all: objects %zu, coverage %.3f%%, median IoU %.3f\n", all_iou.size(),

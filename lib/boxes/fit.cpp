@@ -2,6 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
+#include <limits>
+
 #include "cellmap/common/error.hpp"
 
 namespace cellmap {
@@ -22,6 +25,46 @@ Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Ma
   box.rotation = Eigen::Quaterniond(R).normalized();
   box.points = indices.size();
   return box;
+}
+
+double volume_with_axes(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (int i : indices) {
+    const Eigen::Vector3d p_B = R.transpose() * cloud[i].getVector3fMap().cast<double>();
+    low = low.cwiseMin(p_B);
+    high = high.cwiseMax(p_B);
+  }
+  return (high - low).prod();
+}
+
+// Principal axes of a partly seen object are tilted (three visible faces of a box skew the covariance), so
+// the PCA rotation is refined by turning it about each of its axes to the smallest volume: a coarse then a
+// fine sweep, on at most 2000 evenly spread points. Hand-written: neither Eigen nor PCL offers a
+// minimum-volume box (PCL's MomentOfInertiaEstimation is PCA as well, and slow).
+Eigen::Matrix3d refine_axes(const Cloud& cloud, const std::vector<int>& indices, Eigen::Matrix3d R) {
+  std::vector<int> sample;
+  const std::size_t stride = std::max<std::size_t>(1, indices.size() / 2000);
+  for (std::size_t i = 0; i < indices.size(); i += stride) sample.push_back(indices[i]);
+  double best = volume_with_axes(cloud, sample, R);
+  constexpr double kDegree = 3.14159265358979323846 / 180.0;
+  for (const auto& [range, step] : {std::pair<double, double>{45.0, 3.0}, {3.0, 0.5}}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      Eigen::Matrix3d best_R = R;
+      for (double angle = -range; angle <= range + 1e-9; angle += step) {
+        if (angle == 0.0) continue;
+        const Eigen::Matrix3d candidate =
+            R * Eigen::AngleAxisd(angle * kDegree, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+        const double volume = volume_with_axes(cloud, sample, candidate);
+        if (volume < best) {
+          best = volume;
+          best_R = candidate;
+        }
+      }
+      R = best_R;
+    }
+  }
+  return R;
 }
 
 }  // namespace
@@ -65,7 +108,7 @@ Box fit_box(const Cloud& cloud, const std::vector<int>& indices, BoxKind kind) {
   R.col(1) = solver.eigenvectors().col(1).normalized();
   R.col(2) = R.col(0).cross(R.col(1)).normalized();
   R.col(1) = R.col(2).cross(R.col(0));
-  const Box obb = enclose(cloud, indices, R);
+  const Box obb = enclose(cloud, indices, refine_axes(cloud, indices, R));
   return obb.volume() < aabb.volume() ? obb : aabb;
 }
 

@@ -2,6 +2,7 @@
 
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <unordered_map>
@@ -73,16 +74,24 @@ Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segmen
     return p;
   };
 
-  const float smooth_cos = static_cast<float>(std::cos(params.concavity_tolerance));
+  const float concave_limit = static_cast<float>(-2.0 * std::sin(0.5 * params.concavity_tolerance));
   UnionFind sets(segments.count);
   MergeStats local;
+  struct Edge {
+    float score;
+    int a, b;
+  };
+  std::vector<Edge> convex, concave;
   for (const auto& [key, pairs] : boundaries) {
     if (static_cast<int>(pairs.size()) < params.min_boundary_points) continue;
     ++local.adjacent_pairs;
     const int a = static_cast<int>(key >> 32);
     const int b = static_cast<int>(key & 0xffffffffu);
     const int samples = std::min<int>(params.samples_per_boundary, static_cast<int>(pairs.size()));
-    int votes = 0, convex = 0;
+    // Per place v = (n_s − n_t)·d̂ with d̂ = (x_s − x_t)/|x_s − x_t|: v >= 0 is LCCP's convex case, v < 0
+    // concave, and a concave bend by an angle β gives v ≈ −2 sin(β/2). The median over the places decides.
+    std::vector<float> v;
+    v.reserve(static_cast<std::size_t>(samples));
     for (int s = 0; s < samples; ++s) {
       const auto [i, j] = pairs[static_cast<std::size_t>(s) * pairs.size() / samples];
       const Patch ps = patch(i, a);
@@ -90,16 +99,26 @@ Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segmen
       if (ps.size < 3 || pt.size < 3) continue;
       const Eigen::Vector3f d = ps.centroid - pt.centroid;
       if (d.norm() <= 0.0f) continue;
-      ++votes;
-      // angle(n_s, d) <= angle(n_t, d)  <=>  n_s·d >= n_t·d, with d = x_s − x_t
-      const bool is_convex = ps.normal.dot(d) >= pt.normal.dot(d);
-      const bool is_smooth = ps.normal.dot(pt.normal) > smooth_cos;
-      convex += is_convex || is_smooth;
+      v.push_back((ps.normal - pt.normal).dot(d.normalized()));
     }
-    if (votes > 0 && convex >= params.min_convex_fraction * votes) {
-      ++local.convex_pairs;
-      sets.unite(a, b);
-    }
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    const float score = v[v.size() / 2];
+    (score >= concave_limit ? convex : concave).push_back({score, a, b});
+  }
+  // Most convex first; a merge that would join two segments with a concave boundary between them is refused,
+  // so a small fragment convex to both an object and the table cannot chain them together.
+  std::sort(convex.begin(), convex.end(), [](const Edge& x, const Edge& y) { return x.score > y.score; });
+  for (const Edge& edge : convex) {
+    const int ra = sets.find(edge.a), rb = sets.find(edge.b);
+    if (ra == rb) continue;
+    const bool conflict = std::any_of(concave.begin(), concave.end(), [&](const Edge& c) {
+      const int ca = sets.find(c.a), cb = sets.find(c.b);
+      return (ca == ra && cb == rb) || (ca == rb && cb == ra);
+    });
+    if (conflict) continue;
+    sets.unite(ra, rb);
+    ++local.convex_pairs;
   }
   if (stats) *stats = local;
 

@@ -92,7 +92,6 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
     c.merge = m.get<bool>("enabled", c.merge);
     p.patch_radius = m.number("patch_radius", p.patch_radius, 1e-4, 1.0);
     p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, kPi);
-    p.min_convex_fraction = m.number("min_convex_fraction", p.min_convex_fraction, 0.0, 1.0);
     p.min_boundary_points =
         static_cast<int>(m.integer("min_boundary_points", p.min_boundary_points, 1, 1000000));
     p.samples_per_boundary =
@@ -180,7 +179,8 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   stats.regions = static_cast<std::size_t>(segments.count);
   stats.t_grow = clock.lap();
 
-  stats.leftovers = cover_leftovers(cloud, segments, config.region_growing.gap, config.leftover_min_points);
+  stats.leftovers =
+      cover_leftovers(cloud, nb, segments, config.region_growing.gap, config.leftover_min_points);
   stats.t_leftovers = clock.lap();
 
   if (config.merge) segments = merge_convex(cloud, nb, segments, config.merge_params, &stats.merge);

@@ -71,44 +71,49 @@ Segments grow_regions(const Neighbourhoods& nb, const RegionGrowingParams& param
   return compact_segments(label, drop);
 }
 
-LeftoverStats cover_leftovers(const Cloud& cloud, Segments& segments, double gap, int min_points) {
-  if (segments.label.size() != cloud.size()) throw Error("cover_leftovers: labels and cloud differ in size");
+LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& nb, Segments& segments, double gap,
+                              int min_points) {
+  if (segments.label.size() != cloud.size() || static_cast<std::size_t>(nb.size()) != cloud.size()) {
+    throw Error("cover_leftovers: labels, neighbourhoods and cloud differ in size");
+  }
   if (!(gap > 0.0)) throw Error("cover_leftovers: gap must be > 0");
   LeftoverStats stats;
-  std::vector<int> labelled, leftover;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    (segments.label[i] >= 0 ? labelled : leftover).push_back(static_cast<int>(i));
-  }
-  if (leftover.empty()) return stats;
-  const auto shared = Cloud::ConstPtr(&cloud, [](const Cloud*) {});
-  const float max_sq_gap = static_cast<float>(gap * gap);
-  pcl::Indices found(1);
-  std::vector<float> found_sq(1);
-
-  // 1. Attach to the nearest labelled point within the gap (labels read from before this pass, so the result
-  //    does not depend on the order of the leftovers).
   std::vector<int> still;
-  if (!labelled.empty()) {
-    pcl::search::KdTree<pcl::PointXYZ> tree(false);
-    tree.setInputCloud(shared, std::make_shared<const pcl::Indices>(labelled.begin(), labelled.end()));
-    std::vector<int> attach(leftover.size(), -1);
-    for (std::size_t l = 0; l < leftover.size(); ++l) {
-      if (tree.nearestKSearch(cloud[leftover[l]], 1, found, found_sq) > 0 && found_sq[0] <= max_sq_gap) {
-        attach[l] = segments.label[found[0]];
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (segments.label[i] < 0) still.push_back(static_cast<int>(i));
+  }
+  const float max_sq_gap = static_cast<float>(gap * gap);
+
+  // 1. Attach in waves: each leftover takes the segment of its nearest labelled k-neighbour within the gap,
+  //    with labels read from the previous wave (so the result does not depend on the order of the points).
+  //    A band of leftovers between two segments is thus shared out by distance, never bridged.
+  std::vector<std::pair<int, int>> assigned;
+  while (!still.empty()) {
+    assigned.clear();
+    std::vector<int> next;
+    for (int i : still) {
+      int found = -1;
+      for (int j = 0; j < nb.k; ++j) {
+        const int other = nb.neighbour(i, j);
+        if (other < 0 || nb.sq_distance(i, j) > max_sq_gap) break;
+        if (segments.label[other] >= 0) {
+          found = segments.label[other];
+          break;
+        }
       }
-    }
-    for (std::size_t l = 0; l < leftover.size(); ++l) {
-      if (attach[l] >= 0) {
-        segments.label[leftover[l]] = attach[l];
-        ++stats.attached;
+      if (found >= 0) {
+        assigned.emplace_back(i, found);
       } else {
-        still.push_back(leftover[l]);
+        next.push_back(i);
       }
     }
-  } else {
-    still = leftover;
+    if (assigned.empty()) break;
+    for (const auto& [i, label] : assigned) segments.label[i] = label;
+    stats.attached += assigned.size();
+    still = std::move(next);
   }
   if (still.empty()) return stats;
+  const auto shared = Cloud::ConstPtr(&cloud, [](const Cloud*) {});
 
   // 2. Euclidean clusters of the rest at the same gap.
   pcl::search::KdTree<pcl::PointXYZ> tree(false);

@@ -20,7 +20,7 @@ namespace cellmap {
 
 /// Every parameter of the pipeline. The defaults here are the documented ones of config/segment.yaml.
 struct SegmentConfig final {
-  int k = 20;  ///< neighbours per point (eq. 1, 2, normals, region growing)
+  int k = 40;  ///< neighbours per point (eq. 1, 2, normals, region growing)
   OutlierMode outlier_mode = OutlierMode::kTwoSided;
   double outlier_u = 3.0;  ///< σ multiplier of the outlier test
   RegionGrowingParams region_growing;

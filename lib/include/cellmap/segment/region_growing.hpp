@@ -10,8 +10,8 @@ namespace cellmap {
 /// The paper's three region conditions.
 struct RegionGrowingParams final {
   double gap = 0.01;  ///< d_th (eq. 3), metres: a neighbour farther than this never joins the region
-  double max_curvature = 0.05;  ///< κ_th (eq. 5): only points with κ <= κ_th continue the growth (seeds)
-  double max_angle = 0.14;      ///< α_th (eq. 6), radians: max angle between the normals of neighbours
+  double max_curvature = 0.03;  ///< κ_th (eq. 5): only points with κ <= κ_th continue the growth (seeds)
+  double max_angle = 0.07;      ///< α_th (eq. 6), radians (4°): max angle between the normals of neighbours
   int min_cluster_size = 50;    ///< regions with fewer points are dissolved (their points become leftovers)
 };
 
@@ -31,12 +31,15 @@ struct LeftoverStats final {
   std::size_t isolated = 0;         ///< dropped: in a leftover group of fewer than `min_points` points
 };
 
-/// Gives every unlabelled point a segment, so that no obstacle point is silently lost: first it joins the
-/// segment of its nearest labelled point if that is within `gap` metres; the rest are grouped by Euclidean
-/// clustering at `gap`, and each group of at least `min_points` points becomes its own segment. Smaller
-/// groups (isolated points that survived outlier removal: fewer than `min_points` points within reach) are
-/// the one documented drop; `stats.isolated` counts them. Mutates `segments`.
+/// Gives every unlabelled point a segment, so that no obstacle point is silently lost: first, in waves, each
+/// joins the segment of its nearest labelled k-neighbour within `gap` metres (a band of leftovers between two
+/// segments is shared out by distance, never turned into a bridge between them); the rest, which reach no
+/// segment, are grouped by Euclidean clustering at `gap`, and each group of at least `min_points` points
+/// becomes its own segment. Smaller groups (isolated points that survived outlier removal: fewer than
+/// `min_points` points within reach) are the one documented drop; `stats.isolated` counts them. Mutates
+/// `segments`.
 /// @throws Error if the sizes disagree or gap <= 0.
-LeftoverStats cover_leftovers(const Cloud& cloud, Segments& segments, double gap, int min_points);
+LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& neighbourhoods, Segments& segments,
+                              double gap, int min_points);
 
 }  // namespace cellmap
