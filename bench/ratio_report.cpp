@@ -18,7 +18,8 @@ class RecordingReporter : public benchmark::ConsoleReporter {
         failed_[run.benchmark_name()] = run.error_message;
       } else if (run.run_type == Run::RT_Iteration || run.aggregate_name == "median") {
         // With repetitions the median is the figure to compare; it overwrites the single runs.
-        seconds_[run.run_name.str()] = run.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(run.time_unit);
+        seconds_[run.run_name.str()] =
+            run.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(run.time_unit);
       }
     }
   }
@@ -48,8 +49,8 @@ int run_and_report(int argc, char** argv, const std::vector<Ratio>& ratios) {
       status = 1;
       continue;
     }
-    std::printf("ratio %s: %.2fx (ours %.6g s, anchor %.6g s)\n", ratio.name.c_str(), anchor->second / ours->second,
-                ours->second, anchor->second);
+    std::printf("ratio %s: %.2fx (ours %.6g s, anchor %.6g s)\n", ratio.name.c_str(),
+                anchor->second / ours->second, ours->second, anchor->second);
   }
   std::fflush(stdout);
   return status;

@@ -72,4 +72,42 @@ Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_norma
   return result;
 }
 
+Neighbourhoods subset_neighbourhoods(const Neighbourhoods& all, const std::vector<int>& kept) {
+  std::vector<int> renumber(static_cast<std::size_t>(all.size()), -1);
+  for (std::size_t n = 0; n < kept.size(); ++n) {
+    if (kept[n] < 0 || kept[n] >= all.size() || (n > 0 && kept[n] <= kept[n - 1])) {
+      throw Error("subset_neighbourhoods: kept indices must be ascending and in range");
+    }
+    renumber[kept[n]] = static_cast<int>(n);
+  }
+  const bool with_normals = !all.normals.empty();
+  Neighbourhoods result;
+  result.k = all.k;
+  result.indices.assign(kept.size() * all.k, -1);
+  result.sq_distances.assign(kept.size() * all.k, 0.0f);
+  result.mean_distance.resize(kept.size());
+  if (with_normals) {
+    result.normals.resize(kept.size());
+    result.curvature.resize(kept.size());
+  }
+  for (std::size_t n = 0; n < kept.size(); ++n) {
+    const int i = kept[n];
+    std::size_t out = n * all.k;
+    for (int j = 0; j < all.k; ++j) {
+      const int other = all.neighbour(i, j);
+      if (other < 0) break;
+      if (renumber[other] < 0) continue;
+      result.indices[out] = renumber[other];
+      result.sq_distances[out] = all.sq_distance(i, j);
+      ++out;
+    }
+    result.mean_distance[n] = all.mean_distance[i];
+    if (with_normals) {
+      result.normals[n] = all.normals[i];
+      result.curvature[n] = all.curvature[i];
+    }
+  }
+  return result;
+}
+
 }  // namespace cellmap

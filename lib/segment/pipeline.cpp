@@ -154,26 +154,20 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   stats.t_crop = clock.lap();
   const Eigen::Vector3f viewpoint = points.sensor_origin_.head<3>();
 
-  // Outlier removal on eq. 1, then features (eq. 2) on the survivors.
-  Neighbourhoods nb;
-  Cloud cloud;
-  if (config.outlier_mode == OutlierMode::kOff) {
-    cloud = std::move(cropped);
-    stats.t_outliers = clock.lap();
-    nb = compute_neighbourhoods(cloud, config.k, true, viewpoint);
-  } else {
-    const Neighbourhoods raw = compute_neighbourhoods(cropped, config.k, false);
-    const OutlierResult outliers = remove_outliers(raw, config.outlier_u, config.outlier_mode);
-    stats.outliers_sparse = outliers.removed_sparse;
-    stats.outliers_dense = outliers.removed_dense;
-    std::vector<int> kept_index(outliers.kept.size());
-    for (std::size_t i = 0; i < outliers.kept.size(); ++i) kept_index[i] = index[outliers.kept[i]];
-    index = std::move(kept_index);
-    cloud = subset(cropped, outliers.kept);
-    stats.t_outliers = clock.lap();
-    nb = compute_neighbourhoods(cloud, config.k, true, viewpoint);
-  }
+  // One kd-tree search serves both outlier removal (eq. 1) and the features (eq. 2) of the survivors; their
+  // normals thus include the removed points' few contributions (sparse outliers are rarely anyone's
+  // neighbour).
+  const Neighbourhoods all = compute_neighbourhoods(cropped, config.k, true, viewpoint);
   stats.t_features = clock.lap();
+  const OutlierResult outliers = remove_outliers(all, config.outlier_u, config.outlier_mode);
+  stats.outliers_sparse = outliers.removed_sparse;
+  stats.outliers_dense = outliers.removed_dense;
+  const Neighbourhoods nb = subset_neighbourhoods(all, outliers.kept);
+  std::vector<int> kept_index(outliers.kept.size());
+  for (std::size_t i = 0; i < outliers.kept.size(); ++i) kept_index[i] = index[outliers.kept[i]];
+  index = std::move(kept_index);
+  const Cloud cloud = subset(cropped, outliers.kept);
+  stats.t_outliers = clock.lap();
 
   Segments segments = grow_regions(nb, config.region_growing);
   stats.regions = static_cast<std::size_t>(segments.count);

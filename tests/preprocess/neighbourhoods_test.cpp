@@ -65,6 +65,29 @@ TEST(Neighbourhoods, CurvatureIsHighAtAnEdge) {
   EXPECT_LT(nb.curvature[flat], 1e-4f);
 }
 
+TEST(Neighbourhoods, SubsetRenumbersAndDropsRemovedNeighbours) {
+  const Cloud cloud = plane_grid();
+  const Neighbourhoods all = compute_neighbourhoods(cloud, 8, true);
+  std::vector<int> kept;
+  for (int i = 0; i < all.size(); ++i) {
+    if (i % 2 == 0) kept.push_back(i);
+  }
+  const Neighbourhoods sub = subset_neighbourhoods(all, kept);
+  ASSERT_EQ(sub.size(), static_cast<int>(kept.size()));
+  for (int n = 0; n < sub.size(); ++n) {
+    EXPECT_EQ(sub.mean_distance[n], all.mean_distance[kept[n]]);
+    float last = 0.0f;
+    for (int j = 0; j < sub.k && sub.neighbour(n, j) >= 0; ++j) {
+      const int original = kept[sub.neighbour(n, j)];
+      const float d = (cloud[original].getVector3fMap() - cloud[kept[n]].getVector3fMap()).squaredNorm();
+      EXPECT_NEAR(sub.sq_distance(n, j), d, 1e-9f);
+      EXPECT_GE(sub.sq_distance(n, j), last);
+      last = sub.sq_distance(n, j);
+    }
+  }
+  EXPECT_THROW((void)subset_neighbourhoods(all, {3, 1}), Error);
+}
+
 TEST(Neighbourhoods, RejectsBadInput) {
   EXPECT_THROW((void)compute_neighbourhoods(plane_grid(), 0, false), Error);
   Cloud cloud = plane_grid();

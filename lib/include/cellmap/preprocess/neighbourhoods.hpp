@@ -40,4 +40,11 @@ struct Neighbourhoods final {
 [[nodiscard]] Neighbourhoods compute_neighbourhoods(
     const Cloud& cloud, int k, bool with_normals, const Eigen::Vector3f& viewpoint = Eigen::Vector3f::Zero());
 
+/// The neighbourhoods of the points `kept` (ascending indices into the cloud of `all`), renumbered to
+/// 0..kept.size()-1 as in a cloud made of those points: neighbours that were not kept are removed from each
+/// list (the rest stay nearest first; the list is padded with -1). Mean distances, normals and curvature are
+/// copied, i.e. they still include the removed points. This lets the pipeline search the kd-tree once for
+/// outlier removal and features. @throws Error if an index is out of range or not ascending.
+[[nodiscard]] Neighbourhoods subset_neighbourhoods(const Neighbourhoods& all, const std::vector<int>& kept);
+
 }  // namespace cellmap

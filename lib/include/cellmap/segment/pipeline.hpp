@@ -1,6 +1,6 @@
 #pragma once
-// The paper's batch pipeline on one cloud: crop → outlier removal → region growing → leftovers → convex
-// merge → VCCS split → boxes.
+// The paper's batch pipeline on one cloud: crop → neighbourhoods and features (eq. 1, 2) → outlier removal →
+// region growing → leftovers → convex merge → VCCS split → boxes.
 
 #include <optional>
 #include <string>
