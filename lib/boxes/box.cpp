@@ -11,7 +11,9 @@ namespace {
 
 using nlohmann::json;
 
-json vector_json(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vector_json(const Eigen::Vector3d& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
 
 class Reader {
  public:
@@ -44,7 +46,8 @@ class Reader {
 
   template <int N>
   Eigen::Matrix<double, N, 1> numbers(const json& value, const std::string& where) const {
-    if (!value.is_array() || value.size() != N) fail(where, "must be an array of " + std::to_string(N) + " numbers");
+    if (!value.is_array() || value.size() != N)
+      fail(where, "must be an array of " + std::to_string(N) + " numbers");
     Eigen::Matrix<double, N, 1> out;
     for (int i = 0; i < N; ++i) out[i] = finite(value[i], where + "[" + std::to_string(i) + "]");
     return out;
@@ -61,7 +64,9 @@ bool Box::contains(const Eigen::Vector3d& p_C, double tolerance) const {
   return (p_B.cwiseAbs() - half_extents).maxCoeff() <= tolerance;
 }
 
-bool Box::is_axis_aligned() const { return rotation.angularDistance(Eigen::Quaterniond::Identity()) == 0.0; }
+bool Box::is_axis_aligned() const {
+  return rotation.angularDistance(Eigen::Quaterniond::Identity()) == 0.0;
+}
 
 std::string to_json(const BoxSet& set) {
   json boxes = json::array();
@@ -101,7 +106,8 @@ BoxSet box_set_from_json(const std::string& text, const std::string& source) {
     box.half_extents = reader.numbers<3>(reader.field(item, "half_extents", where), where + ".half_extents");
     if (box.half_extents.minCoeff() < 0) reader.fail(where + ".half_extents", "must not be negative");
     const Eigen::Vector4d q = reader.numbers<4>(reader.field(item, "rotation", where), where + ".rotation");
-    if (std::abs(q.norm() - 1.0) > 1e-6) reader.fail(where + ".rotation", "must be a unit quaternion [w, x, y, z]");
+    if (std::abs(q.norm() - 1.0) > 1e-6)
+      reader.fail(where + ".rotation", "must be a unit quaternion [w, x, y, z]");
     box.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
     box.points = reader.count(reader.field(item, "points", where), where + ".points");
     set.boxes.push_back(box);
@@ -113,6 +119,8 @@ void write_box_file(const std::filesystem::path& path, const BoxSet& set) {
   write_file_atomically(path, to_json(set));
 }
 
-BoxSet read_box_file(const std::filesystem::path& path) { return box_set_from_json(read_file(path), path.string()); }
+BoxSet read_box_file(const std::filesystem::path& path) {
+  return box_set_from_json(read_file(path), path.string());
+}
 
 }  // namespace cellmap

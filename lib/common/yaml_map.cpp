@@ -28,9 +28,13 @@ YamlMap YamlMap::parse(const std::string& text, const std::string& source) {
   }
 }
 
-YamlMap YamlMap::load(const std::string& file) { return parse(read_file(file), file); }
+YamlMap YamlMap::load(const std::string& file) {
+  return parse(read_file(file), file);
+}
 
-bool YamlMap::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+bool YamlMap::has(const std::string& key) const {
+  return static_cast<bool>(node_[key]);
+}
 
 double YamlMap::number(const std::string& key, double fallback, double min, double max) {
   const double value = get<double>(key, fallback);
@@ -74,6 +78,8 @@ void YamlMap::fail(const std::string& key, const std::string& reason) const {
   throw Error(where + key_path(key) + ": " + reason);
 }
 
-std::string YamlMap::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+std::string YamlMap::key_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
 
 }  // namespace cellmap

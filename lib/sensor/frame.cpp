@@ -10,7 +10,8 @@ void PinholeIntrinsics::validate() const {
   if (width <= 0 || height <= 0) throw Error("intrinsics: width and height must be positive");
   if (!(fx > 0) || !(fy > 0)) throw Error("intrinsics: fx and fy must be positive");
   if (!(depth_scale > 0)) throw Error("intrinsics: depth_scale must be positive");
-  if (!(min_range >= 0) || !(max_range > min_range)) throw Error("intrinsics: need 0 <= min_range < max_range");
+  if (!(min_range >= 0) || !(max_range > min_range))
+    throw Error("intrinsics: need 0 <= min_range < max_range");
 }
 
 Cloud depth_to_points(const DepthImage& image, bool organized) {

@@ -49,7 +49,9 @@ TEST(YamlMapTest, NonFiniteNumbersAreRejected) {
 }
 
 TEST(YamlMapTest, SyntaxErrorGivesLine) {
-  EXPECT_EQ(error_of([] { (void)YamlMap::parse("a: [1, 2\nb: 3\n", "bad.yaml"); }).rfind("bad.yaml: YAML syntax error at line", 0),
+  EXPECT_EQ(error_of([] {
+              (void)YamlMap::parse("a: [1, 2\nb: 3\n", "bad.yaml");
+            }).rfind("bad.yaml: YAML syntax error at line", 0),
             0u);
 }
 

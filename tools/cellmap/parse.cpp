@@ -29,7 +29,8 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& wh
   if (std::find(allowed_counts.begin(), allowed_counts.end(), values.size()) == allowed_counts.end()) {
     std::string counts;
     for (std::size_t n : allowed_counts) counts += (counts.empty() ? "" : " or ") + std::to_string(n);
-    throw Error(what + ": expected " + counts + " comma-separated numbers, got " + std::to_string(values.size()));
+    throw Error(what + ": expected " + counts + " comma-separated numbers, got " +
+                std::to_string(values.size()));
   }
   return values;
 }

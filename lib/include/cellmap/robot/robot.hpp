@@ -22,7 +22,8 @@ class Robot final {
   /// A gantry with three prismatic axes along the cell's x, y and z: the bridge (x), the carriage (y) and the
   /// ram (z). q = (x, y, z) in metres; the tool pose is X_CE(q) = Translation(q) * X_CE_zero, so `X_CE_zero`
   /// is the tool pose at q = 0 (its rotation fixes how the tool, and a sensor on it, looks down).
-  /// Links: "base", "bridge", "carriage", "ram"; the tool frame is the ram's.
+  /// Links: "base" (the cell frame), "bridge", "carriage", "ram"; each moving link's frame is the tool frame
+  /// moved by the axes up to it (bridge: x only, carriage: x and y), and the tool frame is the ram's.
   /// @throws Error if a lower limit exceeds its upper limit or a value is not finite.
   [[nodiscard]] static Robot gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
                                     const Eigen::Isometry3d& X_CE_zero = Eigen::Isometry3d::Identity());
@@ -31,12 +32,13 @@ class Robot final {
   /// folded into their child link's pose; revolute, continuous and prismatic joints become moving joints.
   /// @throws Error naming the file and the reason when the URDF does not parse, `tool_link` is missing, or a
   /// joint type is not supported (floating, planar).
-  [[nodiscard]] static Robot from_urdf_file(const std::string& path, const std::string& tool_link,
-                                            const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity());
+  [[nodiscard]] static Robot from_urdf_file(
+      const std::string& path, const std::string& tool_link,
+      const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity());
   /// As from_urdf_file, on URDF XML text; `source` names it in error messages.
-  [[nodiscard]] static Robot from_urdf_string(const std::string& xml, const std::string& tool_link,
-                                              const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity(),
-                                              const std::string& source = "urdf");
+  [[nodiscard]] static Robot from_urdf_string(
+      const std::string& xml, const std::string& tool_link,
+      const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity(), const std::string& source = "urdf");
 
   /// Number of moving joints (the size of q).
   [[nodiscard]] int dof() const { return static_cast<int>(joint_names_.size()); }
@@ -55,8 +57,8 @@ class Robot final {
   [[nodiscard]] Eigen::Isometry3d tool_pose(const Eigen::VectorXd& q) const;
 
   enum class JointType { kFixed, kPrismatic, kRevolute };
-  /// One step of the chain: link i is placed at X_parent_link(i) = origin * motion(q_i) (motion is identity for
-  /// fixed steps). Public so that tests and tools can inspect the chain.
+  /// One step of the chain: link i is placed at X_parent_link(i) = origin * motion(q_i) (motion is identity
+  /// for fixed steps). Public so that tests and tools can inspect the chain.
   struct Step {
     std::string link;
     Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< joint frame in the parent link frame

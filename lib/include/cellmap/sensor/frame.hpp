@@ -16,8 +16,8 @@ namespace cellmap {
 struct PinholeIntrinsics final {
   int width = 0;
   int height = 0;
-  double fx = 0, fy = 0;  ///< focal lengths, pixels
-  double cx = 0, cy = 0;  ///< principal point, pixels
+  double fx = 0, fy = 0;       ///< focal lengths, pixels
+  double cx = 0, cy = 0;       ///< principal point, pixels
   double depth_scale = 0.001;  ///< metres per raw depth unit (1 mm for Kinect-class and RealSense Z16)
   double min_range = 0.0;      ///< depths below this (metres along z) are treated as no return
   double max_range = 10.0;     ///< depths above this are treated as no return
@@ -40,11 +40,11 @@ struct DepthImage final {
 
 /// One frame of one sensor, with the pose it was taken from.
 struct Frame final {
-  std::string sensor;  ///< sensor name from the configuration
-  double stamp = 0.0;  ///< seconds (sensor clock or simulated time)
+  std::string sensor;                                      ///< sensor name from the configuration
+  double stamp = 0.0;                                      ///< seconds (sensor clock or simulated time)
   Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< sensor pose in the cell frame at `stamp`
-  std::optional<DepthImage> depth;  ///< cameras only
-  Cloud points_S;                   ///< valid points in the sensor frame (from `depth`, or a scanner's scan)
+  std::optional<DepthImage> depth;                         ///< cameras only
+  Cloud points_S;  ///< valid points in the sensor frame (from `depth`, or a scanner's scan)
 };
 
 }  // namespace cellmap

@@ -1,0 +1,127 @@
+#include "cellmap/environment/reconcile.hpp"
+
+#include <algorithm>
+#include <set>
+#include <tuple>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+namespace {
+
+double iou(const Region& a, const Region& b) {
+  const double common = a.intersection(b).volume();
+  const double both = a.volume() + b.volume() - common;
+  return both > 0 ? common / both : 0.0;
+}
+
+bool within_tolerance(const Box& a, const Box& b, const ReconcileOptions& options) {
+  return (a.center - b.center).norm() < options.position_tolerance &&
+         (a.half_extents - b.half_extents).cwiseAbs().maxCoeff() < options.position_tolerance &&
+         a.rotation.angularDistance(b.rotation) < options.rotation_tolerance;
+}
+
+}  // namespace
+
+Region bounds_of(const Box& box) {
+  const Eigen::Vector3d half = box.rotation.toRotationMatrix().cwiseAbs() * box.half_extents;
+  return {box.center - half, box.center + half};
+}
+
+bool box_inside(const Box& inner, const Box& outer, double tolerance) {
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d sign((corner & 1) ? 1 : -1, (corner & 2) ? 1 : -1, (corner & 4) ? 1 : -1);
+    if (!outer.contains(inner.center + inner.rotation * sign.cwiseProduct(inner.half_extents), tolerance)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::uint64_t> boxes_in_scope(const std::vector<Box>& previous,
+                                          const std::vector<Region>& regions,
+                                          const ReconcileOptions& options) {
+  std::vector<std::uint64_t> ids;
+  for (const Box& box : previous) {
+    const Region b = bounds_of(box);
+    const double box_volume = b.volume();
+    double inside = 0.0;
+    bool centre_inside = false;
+    for (const Region& region : regions) {
+      inside += b.intersection(region).volume();
+      centre_inside = centre_inside || region.contains(box.center);
+    }
+    // Overlapping regions may count a volume twice; the share is only compared against a threshold.
+    if (centre_inside || (box_volume > 0 && inside >= options.scope_fraction * box_volume))
+      ids.push_back(box.id);
+  }
+  return ids;
+}
+
+Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::uint64_t>& in_scope,
+                     const std::vector<Box>& resegmented, std::uint64_t next_id,
+                     const ReconcileOptions& options) {
+  for (const Box& box : previous) {
+    if (box.id >= next_id) {
+      throw Error("reconcile: next id " + std::to_string(next_id) + " is not above existing box id " +
+                  std::to_string(box.id));
+    }
+  }
+  const std::set<std::uint64_t> scope(in_scope.begin(), in_scope.end());
+  Reconciled out;
+  std::vector<const Box*> old_in_scope;
+  std::vector<const Box*> kept;
+  for (const Box& box : previous) (scope.count(box.id) ? old_in_scope : kept).push_back(&box);
+
+  std::vector<const Box*> candidates;
+  for (const Box& box : resegmented) {
+    const bool redundant = std::any_of(kept.begin(), kept.end(), [&](const Box* k) {
+      return box_inside(box, *k, options.redundant_tolerance);
+    });
+    if (!redundant) candidates.push_back(&box);
+  }
+
+  // Greedy matching, best overlap first; ties broken by index so the result is deterministic.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t n = 0; n < candidates.size(); ++n) {
+    for (std::size_t o = 0; o < old_in_scope.size(); ++o) {
+      const double overlap = iou(bounds_of(*candidates[n]), bounds_of(*old_in_scope[o]));
+      if (overlap >= options.min_overlap) pairs.emplace_back(-overlap, n, o);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<bool> new_used(candidates.size(), false);
+  std::vector<bool> old_used(old_in_scope.size(), false);
+  for (const auto& [negative_overlap, n, o] : pairs) {
+    if (new_used[n] || old_used[o]) continue;
+    new_used[n] = old_used[o] = true;
+    const Box& old_box = *old_in_scope[o];
+    if (within_tolerance(*candidates[n], old_box, options)) {
+      out.boxes.push_back(old_box);
+    } else {
+      Box updated = *candidates[n];
+      updated.id = old_box.id;
+      out.boxes.push_back(updated);
+      out.modified.push_back(updated);
+    }
+  }
+  for (const Box* box : kept) out.boxes.push_back(*box);
+  for (std::size_t o = 0; o < old_in_scope.size(); ++o) {
+    if (!old_used[o]) out.removed.push_back(old_in_scope[o]->id);
+  }
+  for (std::size_t n = 0; n < candidates.size(); ++n) {
+    if (new_used[n]) continue;
+    Box added = *candidates[n];
+    added.id = next_id++;
+    out.boxes.push_back(added);
+    out.added.push_back(added);
+  }
+  out.next_id = next_id;
+  const auto by_id = [](const Box& a, const Box& b) { return a.id < b.id; };
+  std::sort(out.boxes.begin(), out.boxes.end(), by_id);
+  std::sort(out.modified.begin(), out.modified.end(), by_id);
+  std::sort(out.removed.begin(), out.removed.end());
+  return out;
+}
+
+}  // namespace cellmap
