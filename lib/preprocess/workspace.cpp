@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/robot/robot.hpp"
 
 namespace cellmap {
 namespace {
@@ -70,6 +71,41 @@ std::int64_t Workspace::key(const Eigen::Vector3d& p_C) const {
 bool Workspace::contains(const Eigen::Vector3d& p_C) const {
   if ((p_C.array() < lower_.array()).any() || (p_C.array() > upper_.array()).any()) return false;
   return is_box() || voxels_.count(key(p_C)) > 0;
+}
+
+Workspace workspace_from_robot(const Robot& robot, double tool_envelope, int samples, double voxel) {
+  if (samples < 2) throw Error("workspace: samples per joint must be >= 2");
+  if (!std::isfinite(tool_envelope) || tool_envelope < 0.0)
+    throw Error("workspace: tool envelope must be >= 0");
+  if (!std::isfinite(voxel) || voxel <= 0.0) throw Error("workspace: voxel must be > 0");
+  const int dof = robot.dof();
+  bool prismatic_only = true;
+  for (const Robot::Step& step : robot.steps()) prismatic_only &= step.type != Robot::JointType::kRevolute;
+  const int per_joint = prismatic_only ? 2 : samples;  // corners suffice for an affine map q -> tool position
+  const double configurations = std::pow(static_cast<double>(per_joint), dof);
+  if (configurations > 1e6) throw Error("workspace: samples^dof exceeds 1e6 configurations");
+
+  std::vector<Eigen::Vector3d> tool_C;
+  Eigen::VectorXd q(dof);
+  std::vector<int> digit(static_cast<std::size_t>(dof), 0);
+  for (long n = 0; n < static_cast<long>(configurations); ++n) {
+    for (int j = 0; j < dof; ++j) {
+      const JointLimits& limits = robot.limits()[static_cast<std::size_t>(j)];
+      q[j] =
+          limits.lower + (limits.upper - limits.lower) * digit[static_cast<std::size_t>(j)] / (per_joint - 1);
+    }
+    tool_C.push_back(robot.tool_pose(q).translation());
+    for (int j = 0; j < dof && ++digit[static_cast<std::size_t>(j)] == per_joint; ++j) {
+      digit[static_cast<std::size_t>(j)] = 0;
+    }
+  }
+  if (!prismatic_only) return Workspace::from_points(tool_C, tool_envelope, voxel);
+  Eigen::Vector3d lower = tool_C.front(), upper = tool_C.front();
+  for (const Eigen::Vector3d& p : tool_C) {
+    lower = lower.cwiseMin(p);
+    upper = upper.cwiseMax(p);
+  }
+  return Workspace::box(lower.array() - tool_envelope, upper.array() + tool_envelope);
 }
 
 std::vector<int> crop_to_workspace(const Cloud& cloud, const Workspace& workspace) {

@@ -43,6 +43,16 @@ class Workspace final {
   std::unordered_set<std::int64_t> voxels_;
 };
 
+/// The region the robot's tool can reach, grown by `tool_envelope` metres (the tool's and its load's size).
+/// A chain of prismatic joints only (a linear/gantry robot) sweeps a parallelepiped: the result is the box
+/// around the tool positions at its 2^dof corner configurations, grown by the envelope. Any other chain is
+/// sampled: `samples` values per joint, evenly over its limits (samples^dof configurations, tool positions by
+/// FK), voxelised at `voxel` metres with Workspace::from_points. Sampling covers the reachable set only when
+/// neighbouring samples' tool positions lie within about tool_envelope of each other: choose samples so.
+/// @throws Error if samples < 2, samples^dof > 1e6, voxel <= 0 or tool_envelope < 0.
+[[nodiscard]] Workspace workspace_from_robot(const Robot& robot, double tool_envelope, int samples,
+                                             double voxel);
+
 /// Indices (ascending) of the points of `cloud` inside `workspace`.
 [[nodiscard]] std::vector<int> crop_to_workspace(const Cloud& cloud, const Workspace& workspace);
 
