@@ -4,6 +4,7 @@
 #include <cmath>
 #include <istream>
 #include <ostream>
+#include <string>
 #include <tuple>
 
 #include "cellmap/common/error.hpp"
@@ -235,18 +236,28 @@ std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres(const std::vector<Re
   return centres;
 }
 
-void OccupancyMap::write_binary(std::ostream& out) const {
-  if (!tree_->writeBinaryConst(out) || !out) throw Error("occupancy map: writing the .bt stream failed");
+void OccupancyMap::write(std::ostream& out) const {
+  out.precision(17);
+  out << "cellmap-occupancy resolution " << config_.resolution << "\n";
+  tree_->writeData(out);
+  if (!out) throw Error("occupancy map: writing the map failed");
 }
 
-void OccupancyMap::read_binary(std::istream& in) {
-  auto tree = std::make_unique<octomap::OcTree>(config_.resolution);
-  if (!tree->readBinary(in)) throw Error("occupancy map: not a readable OctoMap .bt stream");
-  if (std::abs(tree->getResolution() - config_.resolution) > 1e-9) {
-    throw Error("occupancy map: the stored map has resolution " + std::to_string(tree->getResolution()) +
+void OccupancyMap::read(std::istream& in) {
+  std::string magic, word;
+  double resolution = 0;
+  if (!(in >> magic >> word >> resolution) || magic != "cellmap-occupancy" || word != "resolution" ||
+      in.get() != '\n') {
+    throw Error("occupancy map: not a saved cellmap occupancy map");
+  }
+  if (std::abs(resolution - config_.resolution) > 1e-12) {
+    throw Error("occupancy map: the saved map has resolution " + std::to_string(resolution) +
                 " m, the config says " + std::to_string(config_.resolution) + " m");
   }
+  auto tree = std::make_unique<octomap::OcTree>(config_.resolution);
   apply_sensor_model(config_, *tree);
+  tree->readData(in);
+  if (!in) throw Error("occupancy map: the saved map is truncated");
   tree_ = std::move(tree);
 }
 

@@ -62,12 +62,13 @@ class OccupancyMap final {
   /// (z, y, x) key order. Cost: a bounding-box walk of the tree per region.
   [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres(const std::vector<Region>& regions) const;
 
-  /// Writes the map as OctoMap's binary .bt stream (occupied/free per leaf; probabilities are rounded to the
-  /// clamps). @throws Error if the stream fails.
-  void write_binary(std::ostream& out) const;
-  /// Replaces the map with a .bt stream written by write_binary() at the same resolution.
-  /// @throws Error if the stream is not a readable .bt tree or its resolution differs from the config's.
-  void read_binary(std::istream& in);
+  /// Writes the whole map, log-odds included, to `out` (a resolution line, then OctoMap's node data), so a
+  /// restarted daemon continues with the same evidence. Silent (OctoMap's .bt writer prints to stderr).
+  /// @throws Error if the stream fails.
+  void write(std::ostream& out) const;
+  /// Replaces the map with one written by write() at the same resolution.
+  /// @throws Error if the stream is not such a map or its resolution differs from the config's.
+  void read(std::istream& in);
 
   /// The OcTree itself (for queries, writing .bt files, or comparison); its parameters are the config's.
   [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
