@@ -146,6 +146,54 @@ struct BrickGrid {
   }
 };
 
+// Walk cursor over a BrickGrid's bit array: keeps each axis' table entry, so a step costs one lookup.
+class DenseCursor {
+ public:
+  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : grid_(grid), words_(words) {}
+  bool start(const int key[3]) {
+    for (int i = 0; i < 3; ++i) {
+      if (!move(i, key[i])) return false;
+    }
+    return true;
+  }
+  bool move(int axis, int key) {
+    const std::size_t d = std::size_t(key - grid_.lo[axis]);
+    if (d >= grid_.offset[axis].size()) return false;
+    offset_[axis] = grid_.offset[axis][d];
+    return true;
+  }
+  void mark() {
+    const std::uint32_t i = offset_[0] + offset_[1] + offset_[2];
+    words_[i >> 6] |= std::uint64_t{1} << (i & 63);
+  }
+
+ private:
+  const BrickGrid& grid_;
+  std::uint64_t* words_;
+  std::uint32_t offset_[3] = {0, 0, 0};
+};
+
+// Walk cursor that lists packed keys (for boxes too large for a dense bit array).
+class SparseCursor {
+ public:
+  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
+  bool start(const int key[3]) {
+    for (int i = 0; i < 3; ++i) key_[i] = key[i];
+    return true;
+  }
+  bool move(int axis, int key) {
+    key_[axis] = key;
+    return key >= 0 && key <= 0xffff;
+  }
+  void mark() {
+    out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
+  }
+
+ private:
+  std::vector<std::uint64_t>& out_;
+  int key_[3] = {0, 0, 0};
+};
+
 void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
   words[i >> 6] |= std::uint64_t{1} << (i & 63);
 }
@@ -210,13 +258,16 @@ struct Ray {
 
 // Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic
 // (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
-// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `mark` instead
+// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `cursor` instead
 // of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
-// nothing.
-template <class Mark>
-void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Mark&& mark) {
+// nothing. The cursor follows the walk one axis step at a time (move(axis, key) returns false when the walk
+// leaves its grid; the walk then stops, as it never comes back on that axis) and marks the current voxel.
+template <class Cursor>
+void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
   if (origin.key == ray.end_key) return;
-  mark(int{origin.key[0]}, int{origin.key[1]}, int{origin.key[2]});
+  int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
+  if (!cursor.start(key)) return;
+  cursor.mark();
 
   float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
   const float norm_sq =
@@ -225,7 +276,6 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   for (float& d : direction) d /= length;
 
   const double resolution = grid.getResolution();
-  int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
   int step[3];
   double t_max[3];
   double t_delta[3];
@@ -241,23 +291,30 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
+  // The axis whose voxel border comes next (OctoMap's tie-breaking: the later axis wins ties).
+  // Written with selects rather than branches: the choice is unpredictable and a mispredicted branch per
+  // voxel would cost more than the rest of the step.
+  auto next_axis = [&t_max] {
+    const bool first = t_max[0] < t_max[1];
+    const int axis01 = first ? 0 : 1;
+    const double t01 = first ? t_max[0] : t_max[1];
+    return t01 < t_max[2] ? axis01 : 2;
+  };
 
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
   int steps_left = 3;
   for (int i = 0; i < 3; ++i) steps_left += std::abs(int{ray.end_key[i]} - key[i]);
+  int dim = next_axis();
   while (steps_left-- > 0) {
-    int dim;
-    if (t_max[0] < t_max[1]) {
-      dim = t_max[0] < t_max[2] ? 0 : 2;
-    } else {
-      dim = t_max[1] < t_max[2] ? 1 : 2;
-    }
     key[dim] += step[dim];
     t_max[dim] += t_delta[dim];
     if (key[0] == ray.end_key[0] && key[1] == ray.end_key[1] && key[2] == ray.end_key[2]) return;
+    const int moved = dim;
+    dim = next_axis();
     // Past the end point without entering its voxel (rounding at a corner): stop, as OctoMap does.
-    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
-    mark(key[0], key[1], key[2]);
+    if (t_max[dim] > length) return;
+    if (!cursor.move(moved, key[moved])) return;
+    cursor.mark();
   }
 }
 
@@ -416,19 +473,11 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     std::vector<std::uint64_t>& set = sets[t];
     if (dense) {
       set.assign(bits / 64, 0);
-      std::uint64_t* words = set.data();
-      for (std::size_t r = begin; r < end; ++r) {
-        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
-          const std::uint32_t i = grid_bits.index(x, y, z);
-          if (i < bits) words[i >> 6] |= std::uint64_t{1} << (i & 63);
-        });
-      }
+      DenseCursor cursor(grid_bits, set.data());
+      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
     } else {
-      for (std::size_t r = begin; r < end; ++r) {
-        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
-          set.push_back(std::uint64_t(x) | (std::uint64_t(y) << 16) | (std::uint64_t(z) << 32));
-        });
-      }
+      SparseCursor cursor(set);
+      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
     }
   });
 
