@@ -50,7 +50,7 @@ Sweep one_scan(const Eigen::Isometry3d& X_CS, int width = 96, int height = 72) {
 }
 
 TEST(KeyUpdateTest, EqualsOctomapsDiscreteUpdateForOneScan) {
-  octomap::OcTree tree(0.03);
+  octomap::OcTree tree(0.04);
   for (const Eigen::Isometry3d& X_CS : {Eigen::Isometry3d::Identity(), tilted_pose()}) {
     for (const double max_range : {5.0, 2.5}) {  // 2.5 m truncates the rays to the back wall
       const Sweep sweep = one_scan(X_CS);
@@ -79,7 +79,7 @@ TEST(KeyUpdateTest, ResultDoesNotDependOnThreads) {
 }
 
 TEST(KeyUpdateTest, SeveralScansUniteWithOccupiedWinning) {
-  octomap::OcTree tree(0.02);
+  octomap::OcTree tree(0.04);
   Sweep sweep = one_scan(Eigen::Isometry3d::Identity(), 80, 60);
   sweep.scans.push_back(one_scan(tilted_pose(), 80, 60).scans[0]);
   octomap::KeySet free, occupied;

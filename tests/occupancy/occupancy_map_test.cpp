@@ -35,7 +35,7 @@ Sweep sweep_of(const std::vector<AlignedBox>& scene, const std::vector<Eigen::Is
 
 TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
   OccupancyConfig config;
-  config.resolution = 0.03;
+  config.resolution = 0.05;
   OccupancyMap map(config);
   octomap::OcTree reference(config.resolution);
   apply_sensor_model(config, reference);
@@ -55,7 +55,7 @@ TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
     reference.insertPointCloud(to_octomap(scan), origin, config.max_range, false, true);
   }
   const TreeAgreement agreement = compare_trees(map.tree(), reference);
-  EXPECT_GT(agreement.voxels, 20000u);
+  EXPECT_GT(agreement.voxels, 5000u);
   EXPECT_GE(agreement.fraction(), 0.999);
   EXPECT_EQ(agreement.same, agreement.voxels);  // measured: identical, voxel for voxel
   EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
@@ -81,7 +81,9 @@ TEST(OccupancyMapTest, ReportsFlipsAndStates) {
 
 // A removed object vanishes after exactly config.sweeps_to_clear() sweeps that see through it.
 TEST(OccupancyMapTest, RemovedBoxClearsAfterDocumentedSweeps) {
-  OccupancyMap map;
+  OccupancyConfig config;
+  config.resolution = 0.04;
+  OccupancyMap map(config);
   const AlignedBox box{{-0.2, 0.6, 1.51}, {0.2, 1.0, 1.9}};
   std::vector<AlignedBox> scene = {{{-2, 1.0, 0}, {2, 1.1, 4}}, {{-2, -1.5, 3.0}, {2, 1.1, 3.1}}, box};
   const std::vector<Eigen::Isometry3d> poses = {camera_at({0, -0.3, 0}, -0.35)};  // looking down
@@ -109,8 +111,8 @@ TEST(OccupancyMapTest, RemovedBoxClearsAfterDocumentedSweeps) {
   EXPECT_GT(vanished, 50u);
   for (const octomap::OcTreeKey& key : map.occupied_keys()) {
     const Eigen::Vector3d p_C = map.centre(key);
-    const bool inside_box = (p_C.array() > box.min_C.array() - 0.02).all() &&
-                            (p_C.array() < box.max_C.array() + 0.02).all() && p_C.y() < 0.98;
+    const bool inside_box = (p_C.array() > box.min_C.array() - 0.04).all() &&
+                            (p_C.array() < box.max_C.array() + 0.04).all() && p_C.y() < 0.96;
     EXPECT_FALSE(inside_box) << "voxel at " << p_C.transpose() << " still occupied";
   }
 }
