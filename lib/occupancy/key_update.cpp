@@ -99,8 +99,8 @@ struct BrickGrid {
   int lo[3];     // key of the first brick's base
   int count[3];  // bricks per axis
 
-  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that the ray
-  // walk pays three loads per voxel. Entries outside the box hold an index past the end.
+  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that a ray
+  // walk step (one axis) costs one table lookup.
   std::vector<std::uint32_t> offset[3];  // 32 bits: dense grids have at most 2^28 bits
 
   explicit BrickGrid(const KeyBox& box) {
