@@ -138,44 +138,42 @@ struct BrickGrid {
   }
 };
 
-// Walk cursor over a BrickGrid's bit array: keeps each axis' table entry, so a step costs one lookup.
+// Walk cursor over a BrickGrid's bit array (local copies of the tables, so the walk keeps them in registers).
 class DenseCursor {
  public:
-  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : grid_(grid), words_(words) {}
-  bool start(const int key[3]) {
+  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : words_(words) {
     for (int i = 0; i < 3; ++i) {
-      if (!move(i, key[i])) return false;
+      lo_[i] = grid.lo[i];
+      size_[i] = grid.offset[i].size();
+      table_[i] = grid.offset[i].data();
     }
+  }
+  bool move(int x, int y, int z) {
+    const std::size_t dx = std::size_t(x - lo_[0]), dy = std::size_t(y - lo_[1]),
+                      dz = std::size_t(z - lo_[2]);
+    if ((dx >= size_[0]) | (dy >= size_[1]) | (dz >= size_[2])) return false;
+    index_ = table_[0][dx] + table_[1][dy] + table_[2][dz];
     return true;
   }
-  bool move(int axis, int key) {
-    const std::size_t d = std::size_t(key - grid_.lo[axis]);
-    if (d >= grid_.offset[axis].size()) return false;
-    offset_[axis] = grid_.offset[axis][d];
-    return true;
-  }
-  void mark() {
-    const std::uint32_t i = offset_[0] + offset_[1] + offset_[2];
-    words_[i >> 6] |= std::uint64_t{1} << (i & 63);
-  }
+  void mark() { words_[index_ >> 6] |= std::uint64_t{1} << (index_ & 63); }
 
  private:
-  const BrickGrid& grid_;
   std::uint64_t* words_;
-  std::uint32_t offset_[3] = {0, 0, 0};
+  int lo_[3];
+  std::size_t size_[3];
+  const std::uint32_t* table_[3];
+  std::uint32_t index_ = 0;
 };
 
 // Walk cursor that lists packed keys (for boxes too large for a dense bit array).
 class SparseCursor {
  public:
   explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
-  bool start(const int key[3]) {
-    for (int i = 0; i < 3; ++i) key_[i] = key[i];
-    return true;
-  }
-  bool move(int axis, int key) {
-    key_[axis] = key;
-    return key >= 0 && key <= 0xffff;
+  bool move(int x, int y, int z) {
+    key_[0] = x;
+    key_[1] = y;
+    key_[2] = z;
+    return x >= 0 && y >= 0 && z >= 0 && x <= 0xffff && y <= 0xffff && z <= 0xffff;
   }
   void mark() {
     out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
@@ -257,8 +255,8 @@ struct Ray {
 template <class Cursor>
 void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
   if (origin.key == ray.end_key) return;
-  int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
-  if (!cursor.start(key)) return;
+  const int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
+  if (!cursor.move(key[0], key[1], key[2])) return;
   cursor.mark();
 
   float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
@@ -284,28 +282,31 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
     }
   }
   // The axis whose voxel border comes next (OctoMap's tie-breaking: the later axis wins ties).
-  // Written with selects rather than branches: the choice is unpredictable and a mispredicted branch per
-  // voxel would cost more than the rest of the step.
-  auto next_axis = [&t_max] {
-    const bool first = t_max[0] < t_max[1];
-    const int axis01 = first ? 0 : 1;
-    const double t01 = first ? t_max[0] : t_max[1];
-    return t01 < t_max[2] ? axis01 : 2;
-  };
-
+  // The loop keeps everything in scalars and chooses the axis with selects rather than branches: the choice
+  // is unpredictable, and a mispredicted branch (or an array indexed by it) per voxel costs more than the
+  // rest.
+  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
+  int kx = key[0], ky = key[1], kz = key[2];
+  const int ex = ray.end_key[0], ey = ray.end_key[1], ez = ray.end_key[2];
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
-  int steps_left = 3;
-  for (int i = 0; i < 3; ++i) steps_left += std::abs(int{ray.end_key[i]} - key[i]);
-  int dim = next_axis();
+  int steps_left = 3 + std::abs(ex - kx) + std::abs(ey - ky) + std::abs(ez - kz);
   while (steps_left-- > 0) {
-    key[dim] += step[dim];
-    t_max[dim] += t_delta[dim];
-    if (key[0] == ray.end_key[0] && key[1] == ray.end_key[1] && key[2] == ray.end_key[2]) return;
-    const int moved = dim;
-    dim = next_axis();
+    // OctoMap's tie-breaking: the later axis wins ties.
+    const bool x_before_y = tx < ty;
+    const double t_xy = x_before_y ? tx : ty;
+    const bool z_axis = !(t_xy < tz);
+    const bool x_axis = !z_axis && x_before_y;
+    const bool y_axis = !z_axis && !x_before_y;
+    kx += x_axis ? step[0] : 0;
+    ky += y_axis ? step[1] : 0;
+    kz += z_axis ? step[2] : 0;
+    tx = x_axis ? tx + t_delta[0] : tx;
+    ty = y_axis ? ty + t_delta[1] : ty;
+    tz = z_axis ? tz + t_delta[2] : tz;
+    if (kx == ex && ky == ey && kz == ez) return;
     // Past the end point without entering its voxel (rounding at a corner): stop, as OctoMap does.
-    if (t_max[dim] > length) return;
-    if (!cursor.move(moved, key[moved])) return;
+    if (std::min(std::min(tx, ty), tz) > length) return;
+    if (!cursor.move(kx, ky, kz)) return;
     cursor.mark();
   }
 }
