@@ -74,6 +74,19 @@ TEST(OccupancyMapTest, ReportsFlipsAndStates) {
   EXPECT_EQ(map.state(Eigen::Vector3d(0.01, 0.01, 1.0)), VoxelState::free);
   EXPECT_EQ(map.state(Eigen::Vector3d(0.01, 0.01, 3.0)), VoxelState::unknown);
   EXPECT_EQ(map.state(Eigen::Vector3d(std::nan(""), 0, 0)), VoxelState::unknown);
+  // Occupied evidence in a box: the wall voxels whose centres lie in it (checked against a full scan).
+  const Eigen::Vector3d lo(-0.1, -0.1, 1.9), hi(0.1, 0.1, 2.1);
+  const std::vector<Eigen::Vector3d> in_box = map.occupied_centres_in(lo, hi);
+  std::size_t expected = 0;
+  for (const octomap::OcTreeKey& key : map.occupied_keys()) {
+    const Eigen::Vector3d c = map.centre(key);
+    expected += (c.array() >= lo.array()).all() && (c.array() <= hi.array()).all();
+  }
+  EXPECT_EQ(in_box.size(), expected);
+  EXPECT_GT(in_box.size(),
+            60u);  // of the 10 × 10 voxel centres there (the 120-pixel frame misses a few columns)
+  for (const Eigen::Vector3d& c : in_box) EXPECT_NEAR(c.z(), 2.01, 1e-9);  // the hit layer, z in [2.00, 2.02)
+  EXPECT_TRUE(map.occupied_centres_in({-0.1, -0.1, 1.0}, {0.1, 0.1, 1.5}).empty());
   const OccupancyUpdate second = map.integrate(sweep);
   EXPECT_TRUE(second.appeared.empty());
   EXPECT_TRUE(second.vanished.empty());
