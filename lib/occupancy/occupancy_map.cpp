@@ -178,11 +178,15 @@ Eigen::Vector3d OccupancyMap::centre(const octomap::OcTreeKey& key) const {
   return {tree_->keyToCoord(key[0]), tree_->keyToCoord(key[1]), tree_->keyToCoord(key[2])};
 }
 
-std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
-  std::vector<octomap::OcTreeKey> keys;
-  const unsigned depth = tree_->getTreeDepth();
-  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (!tree_->isNodeOccupied(*it)) continue;
+namespace {
+
+// Appends the leaf keys of the occupied leaves (pruned ones expanded) that `begin`..`end` visit.
+template <class Iterator>
+void append_occupied(const octomap::OcTree& tree, Iterator begin, Iterator end,
+                     std::vector<octomap::OcTreeKey>& keys) {
+  const unsigned depth = tree.getTreeDepth();
+  for (auto it = begin; it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
     if (it.getDepth() == depth) {
       keys.push_back(it.getKey());
       continue;
@@ -195,7 +199,29 @@ std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
         for (int x = 0; x < span; ++x) keys.emplace_back(first[0] + x, first[1] + y, first[2] + z);
   }
   std::sort(keys.begin(), keys.end(), zyx_less);
+}
+
+}  // namespace
+
+std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
+  std::vector<octomap::OcTreeKey> keys;
+  append_occupied(*tree_, tree_->begin_leafs(), tree_->end_leafs(), keys);
   return keys;
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres_in(const Eigen::Vector3d& min_C,
+                                                               const Eigen::Vector3d& max_C) const {
+  std::vector<Eigen::Vector3d> centres;
+  if (!min_C.allFinite() || !max_C.allFinite() || (min_C.array() > max_C.array()).any()) return centres;
+  const octomap::point3d lo(float(min_C.x()), float(min_C.y()), float(min_C.z()));
+  const octomap::point3d hi(float(max_C.x()), float(max_C.y()), float(max_C.z()));
+  std::vector<octomap::OcTreeKey> keys;
+  append_occupied(*tree_, tree_->begin_leafs_bbx(lo, hi), tree_->end_leafs_bbx(), keys);
+  for (const octomap::OcTreeKey& key : keys) {
+    const Eigen::Vector3d c = centre(key);
+    if ((c.array() >= min_C.array()).all() && (c.array() <= max_C.array()).all()) centres.push_back(c);
+  }
+  return centres;
 }
 
 }  // namespace cellmap

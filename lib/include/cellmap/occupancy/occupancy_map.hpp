@@ -57,6 +57,11 @@ class OccupancyMap final {
   [[nodiscard]] Eigen::Vector3d centre(const octomap::OcTreeKey& key) const;
   /// Leaf keys of all occupied voxels, sorted by (z, y, x).
   [[nodiscard]] std::vector<octomap::OcTreeKey> occupied_keys() const;
+  /// Centres (metres, cell frame) of the occupied voxels whose centre lies in the box [min_C, max_C], sorted
+  /// by key (z, y, x) — the occupied evidence inside a change region. Cost: the tree's leaves overlapping the
+  /// box.
+  [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres_in(const Eigen::Vector3d& min_C,
+                                                                 const Eigen::Vector3d& max_C) const;
 
   /// Centres of the occupied leaf voxels inside any of `regions` (metres, cell frame), each voxel once, in
   /// (z, y, x) key order. Cost: a bounding-box walk of the tree per region.
