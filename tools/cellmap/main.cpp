@@ -10,7 +10,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "cellmap 0.1.0");
   cellmap::cli::add_bench_command(app);
   cellmap::cli::add_distance_command(app);
+  cellmap::cli::add_sensors_command(app);
+  cellmap::cli::add_simulate_command(app);
   cellmap::cli::add_paper_figure_command(app);
+  cellmap::cli::add_echo_command(app);
 
   try {
     app.parse(argc, argv);

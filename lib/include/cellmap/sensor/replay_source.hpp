@@ -1,0 +1,101 @@
+#pragma once
+// Replay of recorded frames from a directory: reproduces a field problem on a desk.
+//
+// Replay directory format (version 1):
+//
+//   DIR/poses.csv     one row per frame, in time order, after one header line that must read exactly
+//                       file,stamp,x,y,z,qw,qx,qy,qz
+//                     file   the frame, relative to DIR (or absolute):
+//                            - a depth image: single-channel 16-bit grayscale PNG (.png) or TIFF
+//                            (.tif/.tiff),
+//                              raw sensor units (0 = no return), converted with the intrinsics below; or
+//                            - a point cloud (.pcd, any PCL point type with x y z), already in the sensor
+//                            frame
+//                              (metres, x right, y down, z forward); NaN points are skipped.
+//                     stamp  seconds, strictly increasing (any epoch; frames keep it as Frame::stamp)
+//                     x,y,z  position of the END-EFFECTOR (tool) in the cell frame, metres: X_CE
+//                     qw..qz its orientation, unit quaternion [w, x, y, z]
+//                     Blank lines and lines starting with '#' are skipped. A recorder that knows sensor poses
+//                     instead writes X_CS here and configures the sensor with an identity hand-eye extrinsic.
+//   Intrinsics of a depth image, first found of:
+//     DIR/<image stem without a trailing "_depth">.xml   PCL grabber format (<depth><focal_length_x> …
+//                                                        <z_multiplication_factor>), as PCL's ImageGrabber
+//                                                        writes beside frame_<time>_depth.tiff
+//     DIR/intrinsics.yaml                                width, height, fx, fy, cx, cy, depth_scale
+//                                                        [, min_range, max_range] (see read_intrinsics_yaml)
+//
+// Example: pcl/grabber_sequence (frame_<t>_depth.tiff + frame_<t>.xml) plus a poses.csv is a replay
+// directory.
+
+#include <Eigen/Geometry>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "cellmap/sensor/depth_source.hpp"
+#include "cellmap/sensor/pose_buffer.hpp"
+
+namespace cellmap {
+
+/// One row of poses.csv.
+struct ReplayEntry final {
+  std::string file;  ///< as written in the file (relative to the directory or absolute)
+  double stamp = 0.0;
+  Eigen::Isometry3d X_CE = Eigen::Isometry3d::Identity();
+};
+
+/// Reads poses.csv. @throws Error naming the file and line on a wrong header, a malformed or non-finite
+/// number, a quaternion whose norm is not 1 ± 1e-3 (a hint of swapped columns), or a stamp not after the
+/// previous one.
+[[nodiscard]] std::vector<ReplayEntry> read_replay_poses(const std::string& path);
+/// Writes poses.csv in the format above (17 significant digits), crash-safely. @throws Error if writing
+/// fails.
+void write_replay_poses(const std::string& path, const std::vector<ReplayEntry>& entries);
+
+struct ReplayConfig final {
+  std::string name = "replay";  ///< sensor name given to the frames
+  std::string directory;
+  enum class Playback {
+    kRecorded,  ///< frames are due at their recorded stamp intervals (times `speed`)
+    kFixed,     ///< frames are due every 1 / rate_hz seconds
+    kFastest,   ///< frames are due at once
+  };
+  Playback playback = Playback::kRecorded;
+  double speed = 1.0;     ///< kRecorded: 2 plays twice as fast
+  double rate_hz = 10.0;  ///< kFixed
+};
+
+/// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
+/// frame file exists (kError naming the first problem otherwise); next() loads one frame when it is due and
+/// turns kEnded after the last. Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so
+/// frames and poses meet exactly as recorded. Not thread-safe.
+class ReplaySource final : public DepthSource {
+ public:
+  /// @throws Error if speed or rate_hz is not positive.
+  explicit ReplaySource(ReplayConfig config);
+
+  [[nodiscard]] const std::string& name() const override { return config_.name; }
+  SourceStatus open() override;
+  std::optional<Frame> next(std::chrono::milliseconds timeout) override;
+  [[nodiscard]] SourceStatus status() const override { return status_; }
+  void close() override;
+
+  /// The recorded tool poses (valid after a successful open()).
+  [[nodiscard]] std::vector<StampedPose> poses() const;
+  /// Loads frame `index` of the recording, independent of playback timing. @throws Error naming the file.
+  [[nodiscard]] Frame load(std::size_t index) const;
+  [[nodiscard]] std::size_t size() const { return entries_.size(); }
+
+ private:
+  [[nodiscard]] std::string resolve(const std::string& file) const;
+  [[nodiscard]] PinholeIntrinsics intrinsics_for(const std::string& image_path, int width, int height) const;
+
+  ReplayConfig config_;
+  SourceStatus status_;
+  std::vector<ReplayEntry> entries_;
+  std::size_t next_index_ = 0;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace cellmap

@@ -1,0 +1,248 @@
+#include "cellmap/sensor/replay_source.hpp"
+
+#include <pcl/io/pcd_io.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <thread>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+#include "cellmap/sensor/depth_io.hpp"
+
+namespace cellmap {
+namespace {
+
+constexpr const char* kPosesHeader = "file,stamp,x,y,z,qw,qx,qy,qz";
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return "";
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream stream(line);
+  std::string field;
+  while (std::getline(stream, field, ',')) fields.push_back(trim(field));
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+double parse_number(const std::string& text, const std::string& where) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw Error(where + ": '" + text + "' is not a finite number");
+  }
+  return value;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace
+
+std::vector<ReplayEntry> read_replay_poses(const std::string& path) {
+  std::stringstream text(read_file(path));
+  std::vector<ReplayEntry> entries;
+  std::string line;
+  bool have_header = false;
+  for (int number = 1; std::getline(text, line); ++number) {
+    line = trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    const std::string where = path + ":" + std::to_string(number);
+    if (!have_header) {
+      std::string header;
+      for (const std::string& field : split_csv(line)) header += (header.empty() ? "" : ",") + field;
+      if (header != kPosesHeader) throw Error(where + ": header must be '" + std::string(kPosesHeader) + "'");
+      have_header = true;
+      continue;
+    }
+    const std::vector<std::string> fields = split_csv(line);
+    if (fields.size() != 9) throw Error(where + ": expected 9 fields, got " + std::to_string(fields.size()));
+    if (fields[0].empty()) throw Error(where + ": file is empty");
+    ReplayEntry entry;
+    entry.file = fields[0];
+    entry.stamp = parse_number(fields[1], where + ": stamp");
+    const Eigen::Vector3d p(parse_number(fields[2], where + ": x"), parse_number(fields[3], where + ": y"),
+                            parse_number(fields[4], where + ": z"));
+    const Eigen::Quaterniond q(
+        parse_number(fields[5], where + ": qw"), parse_number(fields[6], where + ": qx"),
+        parse_number(fields[7], where + ": qy"), parse_number(fields[8], where + ": qz"));
+    if (std::abs(q.norm() - 1.0) > 1e-3) {
+      throw Error(where + ": quaternion [qw, qx, qy, qz] has norm " + std::to_string(q.norm()) +
+                  ", expected 1");
+    }
+    if (!entries.empty() && !(entry.stamp > entries.back().stamp)) {
+      throw Error(where + ": stamp " + fields[1] + " is not after the previous one");
+    }
+    entry.X_CE.linear() = q.normalized().toRotationMatrix();
+    entry.X_CE.translation() = p;
+    entries.push_back(entry);
+  }
+  if (!have_header) throw Error(path + ": empty; header must be '" + std::string(kPosesHeader) + "'");
+  return entries;
+}
+
+void write_replay_poses(const std::string& path, const std::vector<ReplayEntry>& entries) {
+  std::ostringstream out;
+  out << kPosesHeader << "\n" << std::setprecision(17);
+  for (const ReplayEntry& entry : entries) {
+    const Eigen::Quaterniond q(entry.X_CE.linear());
+    const Eigen::Vector3d& p = entry.X_CE.translation();
+    out << entry.file << "," << entry.stamp << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w()
+        << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
+  }
+  write_file_atomically(path, out.str());
+}
+
+ReplaySource::ReplaySource(ReplayConfig config) : config_(std::move(config)) {
+  if (!(config_.speed > 0) || !std::isfinite(config_.speed)) throw Error("replay: speed must be > 0");
+  if (!(config_.rate_hz > 0) || !std::isfinite(config_.rate_hz)) throw Error("replay: rate_hz must be > 0");
+}
+
+std::string ReplaySource::resolve(const std::string& file) const {
+  const std::filesystem::path path(file);
+  return path.is_absolute() ? file : (std::filesystem::path(config_.directory) / path).string();
+}
+
+SourceStatus ReplaySource::open() {
+  ++status_.attempts;
+  next_index_ = 0;
+  entries_.clear();
+  try {
+    if (!std::filesystem::is_directory(config_.directory)) {
+      throw Error(config_.directory + ": no such replay directory");
+    }
+    entries_ = read_replay_poses((std::filesystem::path(config_.directory) / "poses.csv").string());
+    for (const ReplayEntry& entry : entries_) {
+      if (!std::filesystem::is_regular_file(resolve(entry.file)))
+        throw Error(resolve(entry.file) + ": no such frame");
+    }
+  } catch (const Error& e) {
+    entries_.clear();
+    status_.state = SourceState::kError;
+    status_.reason = e.what();
+    return status_;
+  }
+  status_.state = entries_.empty() ? SourceState::kEnded : SourceState::kConnected;
+  status_.reason = entries_.empty() ? config_.directory + ": poses.csv lists no frames" : "";
+  start_ = std::chrono::steady_clock::now();
+  return status_;
+}
+
+std::vector<StampedPose> ReplaySource::poses() const {
+  std::vector<StampedPose> poses;
+  poses.reserve(entries_.size());
+  for (const ReplayEntry& entry : entries_) poses.push_back(StampedPose{entry.stamp, entry.X_CE});
+  return poses;
+}
+
+PinholeIntrinsics ReplaySource::intrinsics_for(const std::string& image_path, int width, int height) const {
+  std::string stem = std::filesystem::path(image_path).stem().string();
+  const std::string suffix = "_depth";
+  if (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0) {
+    stem.resize(stem.size() - suffix.size());
+  }
+  const std::filesystem::path xml = std::filesystem::path(image_path).parent_path() / (stem + ".xml");
+  const std::filesystem::path yaml = std::filesystem::path(config_.directory) / "intrinsics.yaml";
+  PinholeIntrinsics intrinsics;
+  if (std::filesystem::is_regular_file(xml)) {
+    intrinsics = read_pcl_intrinsics_xml(xml.string());
+    intrinsics.width = width;
+    intrinsics.height = height;
+  } else if (std::filesystem::is_regular_file(yaml)) {
+    intrinsics = read_intrinsics_yaml(yaml.string());
+    if (intrinsics.width != width || intrinsics.height != height) {
+      throw Error(image_path + ": image is " + std::to_string(width) + "x" + std::to_string(height) +
+                  " but " + yaml.string() + " says " + std::to_string(intrinsics.width) + "x" +
+                  std::to_string(intrinsics.height));
+    }
+  } else {
+    throw Error(image_path + ": no intrinsics (neither " + xml.string() + " nor " + yaml.string() + ")");
+  }
+  return intrinsics;
+}
+
+Frame ReplaySource::load(std::size_t index) const {
+  if (index >= entries_.size()) throw Error("replay: frame " + std::to_string(index) + " out of range");
+  const ReplayEntry& entry = entries_[index];
+  const std::string path = resolve(entry.file);
+  Frame frame;
+  frame.sensor = config_.name;
+  frame.stamp = entry.stamp;
+  if (lower_extension(path) == ".pcd") {
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    pcl::PCDReader reader;
+    if (reader.read(path, cloud) < 0) throw Error(path + ": cannot read PCD");
+    frame.points_S.reserve(cloud.size());
+    for (const pcl::PointXYZ& p : cloud) {
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) frame.points_S.push_back(p);
+    }
+    frame.points_S.width = static_cast<std::uint32_t>(frame.points_S.size());
+    frame.points_S.height = 1;
+    frame.points_S.is_dense = true;
+    return frame;
+  }
+  RawDepth raw = read_depth_image(path);
+  DepthImage image;
+  image.intrinsics = intrinsics_for(path, raw.width, raw.height);
+  image.depth = std::move(raw.depth);
+  frame.points_S = depth_to_points(image);
+  frame.depth = std::move(image);
+  return frame;
+}
+
+std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
+  if (status_.state != SourceState::kConnected) return std::nullopt;
+  if (next_index_ >= entries_.size()) {
+    status_.state = SourceState::kEnded;
+    status_.reason = config_.directory + ": end of recording";
+    return std::nullopt;
+  }
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point due = Clock::now();
+  if (config_.playback == ReplayConfig::Playback::kRecorded) {
+    due = start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                       (entries_[next_index_].stamp - entries_.front().stamp) / config_.speed));
+  } else if (config_.playback == ReplayConfig::Playback::kFixed) {
+    due = start_ + std::chrono::duration_cast<Clock::duration>(
+                       std::chrono::duration<double>(static_cast<double>(next_index_) / config_.rate_hz));
+  }
+  if (due > Clock::now() + timeout) {
+    std::this_thread::sleep_for(timeout);
+    return std::nullopt;
+  }
+  std::this_thread::sleep_until(due);
+  try {
+    Frame frame = load(next_index_);
+    ++next_index_;
+    ++status_.frames;
+    return frame;
+  } catch (const Error& e) {
+    status_.state = SourceState::kError;
+    status_.reason = e.what();
+    return std::nullopt;
+  }
+}
+
+void ReplaySource::close() {
+  entries_.clear();
+  next_index_ = 0;
+  status_.state = SourceState::kClosed;
+  status_.reason.clear();
+}
+
+}  // namespace cellmap
