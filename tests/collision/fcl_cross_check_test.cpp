@@ -152,8 +152,9 @@ TEST(FclCrossCheckTest, HundredThousandRandomBoxPairs) {
       const SignedDistance epa = epa_penetration(a, b);
       worst_epa = std::max(worst_epa, std::abs(epa.distance - ours.distance));
       ASSERT_NEAR(epa.distance, ours.distance, 1e-9) << "pair " << i;
-      // FCL's depth comes from fcl::collide (its box-box routine), not from its signed distance: that one runs
-      // EPA, which throws on nearly touching boxes (fcl#445/#493) and aborts on an assertion for touching ones.
+      // FCL's depth comes from fcl::collide (its box-box routine), not from its signed distance: that one
+      // runs EPA, which throws on nearly touching boxes (fcl#445/#493) and aborts on an assertion for
+      // touching ones.
       fcl::CollisionRequestd request(1, true);
       request.gjk_solver_type = fcl::GST_INDEP;
       fcl::CollisionResultd result;
