@@ -227,9 +227,12 @@ std::optional<Frame> OpenNI2Source::next(std::chrono::milliseconds timeout) {
   }
   openni::VideoStream* streams[] = {&device_->stream};
   int ready = -1;
+  const auto waited_since = std::chrono::steady_clock::now();
   const openni::Status waited =
       openni::OpenNI::waitForAnyStream(streams, 1, &ready, static_cast<int>(timeout.count()));
   if (waited != openni::STATUS_OK) {
+    // A failing device can return at once; wait out the timeout so callers never spin.
+    if (waited != openni::STATUS_TIME_OUT) std::this_thread::sleep_until(waited_since + timeout);
     if (reconnector_.check(steady_seconds())) {
       if (device_->frame_count >= 0) {
         ended_ = true;  // an .oni file that stops delivering has been played to its end
