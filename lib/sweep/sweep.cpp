@@ -1,5 +1,7 @@
 #include "cellmap/sweep/sweep.hpp"
 
+#include <cmath>
+
 namespace cellmap {
 
 Cloud Sweep::merged() const {
@@ -13,6 +15,30 @@ std::size_t Sweep::point_count() const {
   std::size_t n = 0;
   for (const Scan& scan : scans) n += scan.points_C.size();
   return n;
+}
+
+Scan to_scan(const Frame& frame) {
+  Scan scan;
+  scan.origin_C = frame.X_CS.translation();
+  const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
+  scan.points_C.reserve(frame.points_S.size());
+  for (const pcl::PointXYZ& p : frame.points_S) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+    const Eigen::Vector3f p_C = X_CS * p.getVector3fMap();
+    scan.points_C.push_back(pcl::PointXYZ(p_C.x(), p_C.y(), p_C.z()));
+  }
+  scan.points_C.width = static_cast<std::uint32_t>(scan.points_C.size());
+  scan.points_C.height = 1;
+  scan.points_C.is_dense = true;
+  return scan;
+}
+
+Sweep merge_frames(const std::vector<Frame>& frames) {
+  Sweep sweep;
+  sweep.scans.reserve(frames.size());
+  for (const Frame& frame : frames) sweep.scans.push_back(to_scan(frame));
+  if (!frames.empty()) sweep.stamp = frames.back().stamp;
+  return sweep;
 }
 
 }  // namespace cellmap

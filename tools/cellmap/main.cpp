@@ -9,7 +9,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "cellmap 0.1.0");
   cellmap::cli::add_bench_command(app);
+  cellmap::cli::add_distance_command(app);
   cellmap::cli::add_sensors_command(app);
+  cellmap::cli::add_simulate_command(app);
 
   try {
     app.parse(argc, argv);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cellmap/common/cloud.hpp"
+#include "cellmap/sensor/frame.hpp"
 
 namespace cellmap {
 
@@ -25,5 +26,14 @@ struct Sweep final {
   [[nodiscard]] Cloud merged() const;
   [[nodiscard]] std::size_t point_count() const;
 };
+
+/// The frame's valid points moved into the cell frame (p_C = X_CS · p_S), seen from origin_C = the sensor
+/// position. Non-finite points (an organized cloud's NaN pixels) are skipped. Every source — real or
+/// simulated — goes through this one function.
+[[nodiscard]] Scan to_scan(const Frame& frame);
+
+/// The sweep of `frames`, in the order given: one Scan per frame (to_scan), stamp = the last frame's stamp
+/// (0 when there are no frames).
+[[nodiscard]] Sweep merge_frames(const std::vector<Frame>& frames);
 
 }  // namespace cellmap

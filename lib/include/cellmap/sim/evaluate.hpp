@@ -1,0 +1,36 @@
+#pragma once
+// Scoring collision boxes against a simulated scene's true obstacles (the paper's sensor comparison).
+
+#include <cstddef>
+#include <vector>
+
+#include "cellmap/boxes/box.hpp"
+#include "cellmap/common/cloud.hpp"
+#include "cellmap/sim/scene.hpp"
+
+namespace cellmap::sim {
+
+/// How well a set of boxes stands for the true obstacles inside an evaluation region.
+struct BoxScore final {
+  std::size_t boxes = 0;
+  std::size_t surface_points = 0;  ///< true surface points inside the region
+  /// Share of the true surface points that lie inside some box (a missed surface is a possible collision).
+  double coverage = 0.0;
+  double true_volume = 0.0;  ///< m³ of the region inside some obstacle
+  double box_volume = 0.0;   ///< m³ of the region inside some box (overlaps counted once)
+  /// (box_volume − true_volume) / true_volume: workspace the boxes take beyond the objects' own volume.
+  double lost_free_space = 0.0;
+  /// m³ of the region inside some box but inside no obstacle, over true_volume (the free space boxes block).
+  double blocked_free_space = 0.0;
+};
+
+/// Scores `boxes` against `obstacles` in `region`. `true_surface_C` is the surface the boxes should cover,
+/// e.g. the exact (zero-noise) cloud of the same sweep; points outside the region are ignored. Volumes are
+/// counted on a grid of `voxel` metres (cell centres), so they are exact to about one voxel layer of each
+/// surface. Cost: one containment test per voxel inside each box's and obstacle's bounding box.
+/// @throws Error if `voxel` is not positive, the region is empty, or it holds no obstacle volume.
+[[nodiscard]] BoxScore score_boxes(const std::vector<Obstacle>& obstacles, const std::vector<Box>& boxes,
+                                   const Cloud& true_surface_C, const Bounds& region, double voxel = 0.01,
+                                   double tolerance = 0.001);
+
+}  // namespace cellmap::sim

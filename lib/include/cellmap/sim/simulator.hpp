@@ -1,0 +1,73 @@
+#pragma once
+// The simulated sensors: frames rendered by ray casting the scene from the robot's sensor poses.
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cellmap/sensor/frame.hpp"
+#include "cellmap/sim/noise.hpp"
+#include "cellmap/sim/ray_cast.hpp"
+#include "cellmap/sim/scene.hpp"
+#include "cellmap/sim/scene_edit.hpp"
+
+namespace cellmap::sim {
+
+struct SimOptions final {
+  bool noise = true;  ///< false: zero-noise mode (exact depths, only quantized to the depth unit)
+  int threads = 2;    ///< threads casting one camera frame (rows are split between them)
+};
+
+/// One simulated frame with the ground truth behind it.
+struct SimFrame final {
+  Frame frame;        ///< exactly what a real source delivers (cameras: depth + points_S; scanners: points_S)
+  Eigen::VectorXd q;  ///< the joint vector the frame was taken at
+  /// Per pixel (row-major) or per beam: exact depth along the optical axis (cameras) or range (scanners) of
+  /// the first surface, metres, before noise and quantization; 0 = no return (nothing within range in the
+  /// cell).
+  std::vector<double> exact;
+  /// Per pixel or beam: index of the obstacle the exact ray hit, -1 = none.
+  std::vector<int> hit;
+};
+
+/// Renders frames of a scene. Returns are deterministic: the same scene, options, sensor, stop, sweep and
+/// frame index give bit-identical frames. render() and sweep() are const and may run concurrently; apply()
+/// must not run concurrently with them.
+class Simulator final {
+ public:
+  /// @throws Error if the scene does not validate.
+  explicit Simulator(Scene scene, SimOptions options = {});
+
+  [[nodiscard]] const Scene& scene() const { return scene_; }
+  [[nodiscard]] const SimOptions& options() const { return options_; }
+
+  /// Applies a scene edit (see sim::apply) for the following frames. @throws Error as sim::apply.
+  std::string apply(const SceneEdit& edit);
+
+  /// One frame of sensor `sensor` (index into scene().sensors) at joint vector q. Rays are cast through pixel
+  /// centres (pixel (u, v) looks along ((u − cx)/fx, (v − cy)/fy, 1)) or along the scanner's beams. Depths
+  /// outside [min_range, max_range] and points that would lie outside the cell give no return (no walls are
+  /// modelled: what is beyond the cell bounds is not seen). Camera depths are rounded to the depth unit.
+  /// @throws Error if `sensor` is out of range or q is invalid for the robot.
+  [[nodiscard]] SimFrame render(int sensor, const Eigen::VectorXd& q, double stamp, std::uint64_t sweep_index,
+                                std::uint64_t frame_index) const;
+
+  /// All frames of one sweep of `sensor` along its plan: frame k at stop k, stamp start + k·period.
+  /// `sweep_index` keys the noise, so successive sweeps see fresh noise and a repeated index repeats it.
+  [[nodiscard]] std::vector<SimFrame> sweep(int sensor, std::uint64_t sweep_index = 0,
+                                            double start_stamp = 0.0) const;
+
+ private:
+  [[nodiscard]] SimFrame render_camera(const SensorSpec& spec, const Eigen::Isometry3d& X_CS,
+                                       const NoiseKey& key) const;
+  [[nodiscard]] SimFrame render_scanner(const SensorSpec& spec, const Eigen::Isometry3d& X_CS,
+                                        const NoiseKey& key) const;
+
+  Scene scene_;
+  SimOptions options_;
+  SceneCaster caster_;
+};
+
+}  // namespace cellmap::sim

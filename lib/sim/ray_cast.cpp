@@ -1,0 +1,158 @@
+#include "cellmap/sim/ray_cast.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cellmap::sim {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kParallel = 1e-12;  // a direction component below this counts as parallel to the slab
+
+// Where the ray o + t·d lies between the planes x = lo and x = hi along one axis: [t0, t1], or empty.
+bool slab(double o, double d, double lo, double hi, double& t0, double& t1) {
+  if (std::abs(d) < kParallel) {
+    if (o < lo || o > hi) return false;
+    t0 = -kInf, t1 = kInf;
+    return true;
+  }
+  const double a = (lo - o) / d, b = (hi - o) / d;
+  t0 = std::min(a, b), t1 = std::max(a, b);
+  return true;
+}
+
+// Roots of a·t² + b·t + c = 0 with a > 0, as [t0, t1]; false if none. Uses the cancellation-free form.
+bool quadratic(double a, double b, double c, double& t0, double& t1) {
+  const double disc = b * b - 4 * a * c;
+  if (disc < 0) return false;
+  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+  if (q == 0) {  // b = 0 and c = 0: double root at 0
+    t0 = t1 = 0;
+    return true;
+  }
+  t0 = q / a, t1 = c / q;
+  if (t0 > t1) std::swap(t0, t1);
+  return true;
+}
+
+// The first t >= 0 inside [t0, t1], if the interval reaches t >= 0.
+std::optional<double> entry(double t0, double t1) {
+  if (t0 > t1 || t1 < 0) return std::nullopt;
+  return std::max(t0, 0.0);
+}
+
+}  // namespace
+
+std::optional<double> intersect(const BoxShape& box, const Eigen::Vector3d& o_O, const Eigen::Vector3d& d_O) {
+  double t0 = -kInf, t1 = kInf;
+  for (int i = 0; i < 3; ++i) {
+    double a, b;
+    if (!slab(o_O[i], d_O[i], -box.half_extents[i], box.half_extents[i], a, b)) return std::nullopt;
+    t0 = std::max(t0, a), t1 = std::min(t1, b);
+  }
+  return entry(t0, t1);
+}
+
+std::optional<double> intersect(const CylinderShape& cylinder, const Eigen::Vector3d& o_O,
+                                const Eigen::Vector3d& d_O) {
+  // The solid is the infinite cylinder x² + y² <= r² intersected with the slab |z| <= half_length.
+  double t0 = -kInf, t1 = kInf;
+  const double a = d_O.x() * d_O.x() + d_O.y() * d_O.y();
+  const double c = o_O.x() * o_O.x() + o_O.y() * o_O.y() - cylinder.radius * cylinder.radius;
+  if (a < kParallel) {
+    if (c > 0) return std::nullopt;  // parallel to the axis, outside the radius
+  } else {
+    const double b = 2 * (o_O.x() * d_O.x() + o_O.y() * d_O.y());
+    if (!quadratic(a, b, c, t0, t1)) return std::nullopt;
+  }
+  double z0, z1;
+  if (!slab(o_O.z(), d_O.z(), -cylinder.half_length, cylinder.half_length, z0, z1)) return std::nullopt;
+  return entry(std::max(t0, z0), std::min(t1, z1));
+}
+
+std::optional<double> intersect(const SphereShape& sphere, const Eigen::Vector3d& o_O,
+                                const Eigen::Vector3d& d_O) {
+  double t0, t1;
+  if (!quadratic(d_O.squaredNorm(), 2 * o_O.dot(d_O), o_O.squaredNorm() - sphere.radius * sphere.radius, t0,
+                 t1)) {
+    return std::nullopt;
+  }
+  return entry(t0, t1);
+}
+
+SceneCaster::SceneCaster(const std::vector<Obstacle>& obstacles) {
+  entries_.reserve(obstacles.size());
+  for (const Obstacle& o : obstacles) {
+    entries_.push_back(
+        Entry{o, o.shape, o.X_CO.linear().transpose(), o.X_CO.translation(), o.bounding_radius()});
+  }
+}
+
+std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3d& apex_C,
+                                                            const Eigen::Vector3d& axis_C,
+                                                            double half_angle) const {
+  std::vector<Candidate> out;
+  for (int i = 0; i < size(); ++i) {
+    const Entry& e = entries_[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d v = e.p_CO - apex_C;
+    const double distance = v.norm();
+    bool keep = half_angle >= M_PI / 2 || distance <= e.bounding_radius;
+    if (!keep) {
+      // The sphere is seen under a half angle asin(R/distance) about its centre direction.
+      const double angle = std::acos(std::clamp(v.dot(axis_C) / distance, -1.0, 1.0));
+      keep = angle - std::asin(e.bounding_radius / distance) <= half_angle;
+    }
+    if (keep) out.push_back(Candidate{i, std::max(0.0, e.obstacle.signed_distance(apex_C))});
+  }
+  // Nearest first: once a hit is found, farther obstacles (e.g. the floor under the table) are never tested.
+  std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
+    return a.min_t < b.min_t || (a.min_t == b.min_t && a.obstacle < b.obstacle);
+  });
+  return out;
+}
+
+std::optional<double> SceneCaster::hit(const Entry& e, const Eigen::Vector3d& o_C,
+                                       const Eigen::Vector3d& d_C) const {
+  const Eigen::Vector3d o_O = e.R_OC * (o_C - e.p_CO);
+  const Eigen::Vector3d d_O = e.R_OC * d_C;
+  return std::visit([&](const auto& shape) { return intersect(shape, o_O, d_O); }, e.shape);
+}
+
+RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C, double t_max,
+                         const std::vector<Candidate>* candidates) const {
+  RayHit best{t_max, -1};
+  auto consider = [&](int i) {
+    const Entry& e = entries_[static_cast<std::size_t>(i)];
+    // Bounding-sphere rejection before the exact test: behind the ray, farther than the best hit, or missed.
+    const Eigen::Vector3d v = e.p_CO - o_C;
+    const double along = v.dot(d_C);
+    const double r = e.bounding_radius;
+    if (along + r < 0 || along - r > best.t) return;
+    if (v.squaredNorm() - along * along > r * r) return;
+    const std::optional<double> t = hit(e, o_C, d_C);
+    if (t && *t <= best.t) best = RayHit{*t, i};
+  };
+  if (candidates) {
+    for (const Candidate& c : *candidates) {
+      if (c.min_t > best.t) break;
+      consider(c.obstacle);
+    }
+  } else {
+    for (int i = 0; i < size(); ++i) consider(i);
+  }
+  if (best.obstacle < 0) best.t = 0;
+  return best;
+}
+
+double exit_distance(const Bounds& bounds, const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C) {
+  if (!bounds.contains(o_C)) return 0.0;
+  double t = kInf;
+  for (int i = 0; i < 3; ++i) {
+    if (d_C[i] > kParallel) t = std::min(t, (bounds.max[i] - o_C[i]) / d_C[i]);
+    if (d_C[i] < -kParallel) t = std::min(t, (bounds.min[i] - o_C[i]) / d_C[i]);
+  }
+  return t;
+}
+
+}  // namespace cellmap::sim

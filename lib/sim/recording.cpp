@@ -1,0 +1,309 @@
+#include "cellmap/sim/recording.hpp"
+
+#include <pcl/io/pcd_io.h>
+#include <png.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::sim {
+namespace {
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+std::vector<std::string> split(const std::string& line, char separator) {
+  std::vector<std::string> items;
+  std::stringstream stream(line);
+  std::string item;
+  while (std::getline(stream, item, separator)) items.push_back(item);
+  if (!line.empty() && line.back() == separator) items.emplace_back();
+  return items;
+}
+
+double parse_double(const std::string& text, const std::string& where) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw Error(where + ": '" + text + "' is not a finite number");
+  }
+  return value;
+}
+
+// ---- libpng glue. libpng reports errors by longjmp; the functions that call setjmp keep only trivially
+// destructible locals, so no C++ destructor is skipped.
+
+struct PngError {
+  char message[256] = "";
+};
+
+void on_png_error(png_structp png, png_const_charp message) {
+  auto* error = static_cast<PngError*>(png_get_error_ptr(png));
+  std::snprintf(error->message, sizeof error->message, "%s", message);
+  png_longjmp(png, 1);
+}
+
+void on_png_warning(png_structp, png_const_charp) {}
+
+void append_bytes(png_structp png, png_bytep data, png_size_t length) {
+  static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
+}
+
+void flush_nothing(png_structp) {}
+
+struct ReadCursor {
+  const std::string* bytes;
+  std::size_t offset;
+};
+
+void read_bytes(png_structp png, png_bytep data, png_size_t length) {
+  auto* cursor = static_cast<ReadCursor*>(png_get_io_ptr(png));
+  if (cursor->offset + length > cursor->bytes->size()) png_error(png, "file is truncated");
+  std::memcpy(data, cursor->bytes->data() + cursor->offset, length);
+  cursor->offset += length;
+}
+
+bool encode_png(std::uint32_t width, std::uint32_t height, png_bytep* rows, std::string* out,
+                PngError* error) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_set_write_fn(png, out, append_bytes, flush_nothing);
+  png_set_compression_level(png, 1);  // depth compresses well even at the fastest level
+  png_set_IHDR(png, info, width, height, 16, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  png_write_image(png, rows);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+// Reads the header into width/height/depth/color, then (if `rows` is set) the pixels.
+bool decode_png(ReadCursor* cursor, std::uint32_t* width, std::uint32_t* height, int* bit_depth, int* color,
+                png_bytep* rows, PngError* error) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  png_set_read_fn(png, cursor, read_bytes);
+  png_read_info(png, info);
+  *width = png_get_image_width(png, info);
+  *height = png_get_image_height(png, info);
+  *bit_depth = png_get_bit_depth(png, info);
+  *color = png_get_color_type(png, info);
+  if (rows) png_read_image(png, rows);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+}  // namespace
+
+void write_poses(const std::filesystem::path& path, const std::vector<PoseRecord>& records,
+                 const std::vector<std::string>& joint_names) {
+  auto check_name = [&](const std::string& name) {
+    if (name.find_first_of(",\n\r") != std::string::npos) {
+      throw Error(path.string() + ": '" + name + "' holds a comma or line break");
+    }
+  };
+  std::string out = "frame,sensor,stamp,file,x,y,z,qw,qx,qy,qz";
+  for (const std::string& joint : joint_names) {
+    check_name(joint);
+    out += ",q:" + joint;
+  }
+  out += "\n";
+  for (const PoseRecord& r : records) {
+    check_name(r.sensor);
+    check_name(r.file);
+    if (r.q.size() != static_cast<Eigen::Index>(joint_names.size())) {
+      throw Error(path.string() + ": frame " + std::to_string(r.frame) + " has " +
+                  std::to_string(r.q.size()) + " joints, the header " + std::to_string(joint_names.size()));
+    }
+    const Eigen::Vector3d p = r.X_CS.translation();
+    const Eigen::Quaterniond q(r.X_CS.linear());
+    out += std::to_string(r.frame) + "," + r.sensor + "," + number(r.stamp) + "," + r.file;
+    for (double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}) out += "," + number(v);
+    for (Eigen::Index j = 0; j < r.q.size(); ++j) out += "," + number(r.q[j]);
+    out += "\n";
+  }
+  write_file_atomically(path, out);
+}
+
+std::vector<PoseRecord> read_poses(const std::filesystem::path& path) {
+  std::stringstream text(read_file(path));
+  std::string line;
+  if (!std::getline(text, line)) throw Error(path.string() + ": empty poses file");
+  const std::vector<std::string> header = split(line, ',');
+  const std::vector<std::string> fixed = {"frame", "sensor", "stamp", "file", "x", "y",
+                                          "z",     "qw",     "qx",    "qy",   "qz"};
+  if (header.size() < fixed.size() || !std::equal(fixed.begin(), fixed.end(), header.begin())) {
+    throw Error(path.string() + ": line 1: header must start with frame,sensor,stamp,file,x,y,z,qw,qx,qy,qz");
+  }
+  const std::size_t joints = header.size() - fixed.size();
+  std::vector<PoseRecord> records;
+  for (int number = 2; std::getline(text, line); ++number) {
+    if (line.empty()) continue;
+    const std::string where = path.string() + ": line " + std::to_string(number);
+    const std::vector<std::string> items = split(line, ',');
+    if (items.size() != header.size()) {
+      throw Error(where + ": " + std::to_string(items.size()) + " fields, header has " +
+                  std::to_string(header.size()));
+    }
+    PoseRecord r;
+    const double frame = parse_double(items[0], where + ": frame");
+    if (frame < 0 || frame != std::floor(frame))
+      throw Error(where + ": frame must be a non-negative integer");
+    r.frame = static_cast<std::uint64_t>(frame);
+    r.sensor = items[1];
+    r.stamp = parse_double(items[2], where + ": stamp");
+    r.file = items[3];
+    double v[7];
+    for (int i = 0; i < 7; ++i) v[i] = parse_double(items[4 + i], where + ": " + fixed[4 + i]);
+    const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (std::abs(q.norm() - 1.0) > 1e-6) throw Error(where + ": orientation is not a unit quaternion");
+    r.X_CS = Eigen::Isometry3d::Identity();
+    r.X_CS.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    r.X_CS.linear() = q.normalized().toRotationMatrix();
+    r.q.resize(static_cast<Eigen::Index>(joints));
+    for (std::size_t j = 0; j < joints; ++j) {
+      r.q[static_cast<Eigen::Index>(j)] =
+          parse_double(items[fixed.size() + j], where + ": " + header[fixed.size() + j]);
+    }
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+void write_depth_png(const std::filesystem::path& path, const DepthImage& image) {
+  const PinholeIntrinsics& k = image.intrinsics;
+  if (k.width <= 0 || k.height <= 0 ||
+      image.depth.size() != static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height)) {
+    throw Error(path.string() + ": depth image size disagrees with its intrinsics");
+  }
+  // PNG stores 16-bit samples big-endian.
+  std::vector<png_byte> bytes(image.depth.size() * 2);
+  for (std::size_t i = 0; i < image.depth.size(); ++i) {
+    bytes[2 * i] = static_cast<png_byte>(image.depth[i] >> 8);
+    bytes[2 * i + 1] = static_cast<png_byte>(image.depth[i] & 0xff);
+  }
+  std::vector<png_bytep> rows(static_cast<std::size_t>(k.height));
+  for (int v = 0; v < k.height; ++v)
+    rows[static_cast<std::size_t>(v)] = bytes.data() + 2 * static_cast<std::size_t>(v) * k.width;
+  std::string encoded;
+  PngError error;
+  if (!encode_png(static_cast<std::uint32_t>(k.width), static_cast<std::uint32_t>(k.height), rows.data(),
+                  &encoded, &error)) {
+    throw Error(path.string() + ": PNG encoding failed: " + error.message);
+  }
+  write_file_atomically(path, encoded);
+}
+
+DepthImage read_depth_png(const std::filesystem::path& path, const PinholeIntrinsics& intrinsics) {
+  const std::string bytes = read_file(path);
+  std::uint32_t width = 0, height = 0;
+  int bit_depth = 0, color = 0;
+  PngError error;
+  ReadCursor cursor{&bytes, 0};
+  if (!decode_png(&cursor, &width, &height, &bit_depth, &color, nullptr, &error)) {
+    throw Error(path.string() + ": not a readable PNG: " + error.message);
+  }
+  if (bit_depth != 16 || color != PNG_COLOR_TYPE_GRAY) {
+    throw Error(path.string() + ": depth PNG must be 16-bit greyscale, got " + std::to_string(bit_depth) +
+                "-bit colour type " + std::to_string(color));
+  }
+  if (static_cast<int>(width) != intrinsics.width || static_cast<int>(height) != intrinsics.height) {
+    throw Error(path.string() + ": image is " + std::to_string(width) + "x" + std::to_string(height) +
+                ", intrinsics say " + std::to_string(intrinsics.width) + "x" +
+                std::to_string(intrinsics.height));
+  }
+  std::vector<png_byte> data(static_cast<std::size_t>(width) * height * 2);
+  std::vector<png_bytep> rows(height);
+  for (std::uint32_t v = 0; v < height; ++v) rows[v] = data.data() + 2 * static_cast<std::size_t>(v) * width;
+  cursor.offset = 0;
+  if (!decode_png(&cursor, &width, &height, &bit_depth, &color, rows.data(), &error)) {
+    throw Error(path.string() + ": corrupt PNG: " + error.message);
+  }
+  DepthImage image;
+  image.intrinsics = intrinsics;
+  image.depth.resize(static_cast<std::size_t>(width) * height);
+  for (std::size_t i = 0; i < image.depth.size(); ++i) {
+    image.depth[i] = static_cast<std::uint16_t>((data[2 * i] << 8) | data[2 * i + 1]);
+  }
+  return image;
+}
+
+void write_intrinsics(const std::filesystem::path& path, const PinholeIntrinsics& k) {
+  std::string out = "# pinhole depth intrinsics: pixels, metres per depth unit, metres\n";
+  out += "width: " + std::to_string(k.width) + "\nheight: " + std::to_string(k.height) + "\n";
+  out += "fx: " + number(k.fx) + "\nfy: " + number(k.fy) + "\ncx: " + number(k.cx) + "\ncy: " + number(k.cy) +
+         "\n";
+  out += "depth_scale: " + number(k.depth_scale) + "\nmin_range: " + number(k.min_range) +
+         "\nmax_range: " + number(k.max_range) + "\n";
+  write_file_atomically(path, out);
+}
+
+namespace {
+
+template <typename Point>
+void save_binary_pcd(const std::filesystem::path& path, const pcl::PointCloud<Point>& cloud) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  int status = -1;
+  try {
+    status = cloud.empty() ? -2 : pcl::io::savePCDFileBinary(path.string(), cloud);
+  } catch (const std::exception& e) {
+    throw Error(path.string() + ": cannot write PCD: " + e.what());
+  }
+  if (status == -2) {
+    // PCL refuses to write empty clouds; an empty sweep is still a valid recording.
+    write_file_atomically(
+        path,
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
+        "TYPE F F F\nCOUNT 1 1 1\nWIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA ascii\n");
+    return;
+  }
+  if (status < 0) throw Error(path.string() + ": cannot write PCD");
+}
+
+}  // namespace
+
+void write_pcd(const std::filesystem::path& path, const Cloud& cloud) {
+  save_binary_pcd(path, cloud);
+}
+
+void write_sweep_pcd(const std::filesystem::path& path, const Sweep& sweep) {
+  pcl::PointCloud<pcl::PointWithViewpoint> cloud;
+  cloud.reserve(sweep.point_count());
+  for (const Scan& scan : sweep.scans) {
+    for (const pcl::PointXYZ& p : scan.points_C) {
+      cloud.push_back(pcl::PointWithViewpoint(p.x, p.y, p.z, static_cast<float>(scan.origin_C.x()),
+                                              static_cast<float>(scan.origin_C.y()),
+                                              static_cast<float>(scan.origin_C.z())));
+    }
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  save_binary_pcd(path, cloud);
+}
+
+}  // namespace cellmap::sim

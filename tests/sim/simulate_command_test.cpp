@@ -1,0 +1,104 @@
+// `cellmap simulate` as a user runs it: files on disk, exit codes, one-line errors.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/sim/default_scene.hpp"
+#include "cellmap/sim/recording.hpp"
+
+namespace cellmap::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ToolRun {
+  int status;
+  std::string err;
+};
+
+ToolRun run_tool(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = std::string(CELLMAP_TOOL) + " " + args + " 2> " + err.string();
+  const int raw = std::system(command.c_str());
+  return ToolRun{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, fs::exists(err) ? read_file(err) : ""};
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("cellmap_simulate_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::size_t pcd_points(const fs::path& file) {
+  Cloud cloud;
+  EXPECT_EQ(pcl::io::loadPCDFile(file.string(), cloud), 0) << file;
+  return cloud.size();
+}
+
+TEST(SimulateCommandTest, LineScannerSweepWritesScansPosesAndTheMergedCloud) {
+  const fs::path dir = temp_dir("os32c");
+  const ToolRun run = run_tool("simulate --sensor os32c -o " + (dir / "out").string(), dir);
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("151 frames"), std::string::npos) << run.err;
+  const std::vector<PoseRecord> poses = read_poses(dir / "out" / "poses.csv");
+  ASSERT_EQ(poses.size(), 151u);
+  std::size_t total = 0;
+  for (const PoseRecord& pose : poses) total += pcd_points(dir / "out" / pose.file);
+  EXPECT_GT(total, 10000u);
+  EXPECT_EQ(pcd_points(dir / "out" / "merged.pcd"), total);
+  // Equidistant stops 2 cm apart along x.
+  EXPECT_NEAR((poses[1].X_CS.translation() - poses[0].X_CS.translation()).norm(), 0.02, 1e-12);
+  fs::remove_all(dir);
+}
+
+TEST(SimulateCommandTest, ExactCameraSweepWritesSixteenBitPngs) {
+  const fs::path dir = temp_dir("kinect");
+  const ToolRun run = run_tool(std::string("simulate ") + CELLMAP_SOURCE_DIR +
+                               "/config/cell.yaml --sensor kinect_v2 "
+                               "--exact --seed 9 -o " +
+                               (dir / "out").string(),
+                           dir);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const Scene scene = default_scene();
+  const PinholeIntrinsics& k =
+      scene.sensors[static_cast<std::size_t>(scene.find_sensor("kinect_v2"))].intrinsics;
+  const std::vector<PoseRecord> poses = read_poses(dir / "out" / "poses.csv");
+  ASSERT_EQ(poses.size(), scene.sweep.stops.size());
+  std::size_t valid = 0;
+  for (const PoseRecord& pose : poses) {
+    EXPECT_EQ(pose.q, scene.sweep.stops[pose.frame]);
+    const DepthImage image = read_depth_png(dir / "out" / pose.file, k);
+    for (std::uint16_t raw : image.depth) valid += raw != 0;
+  }
+  EXPECT_EQ(pcd_points(dir / "out" / "merged.pcd"), valid);
+  fs::remove_all(dir);
+}
+
+TEST(SimulateCommandTest, BadInputGivesOneLineReasonsAndNonZeroExit) {
+  const fs::path dir = temp_dir("bad");
+  std::string text = default_scene_yaml();
+  const std::string from = "{name: floor, box:";
+  text.replace(text.find(from), from.size(), "{name: floor, colour: grey, box:");
+  write_file_atomically(dir / "typo.yaml", text);
+  ToolRun run = run_tool("simulate " + (dir / "typo.yaml").string() + " -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(run.status, 1);
+  EXPECT_EQ(run.err, "cellmap: " + (dir / "typo.yaml").string() + ": obstacles[0].colour: unknown key\n");
+  run = run_tool("simulate --sensor kinect_v1 -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(run.status, 1);
+  EXPECT_EQ(run.err.rfind("cellmap: simulate: --sensor kinect_v1: the scene has no such sensor", 0), 0u)
+      << run.err;
+  run = run_tool("simulate " + (dir / "missing.yaml").string() + " -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(run.status, 1);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cellmap::sim

@@ -1,0 +1,43 @@
+#include "cellmap/sweep/sweep.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace cellmap {
+namespace {
+
+Frame frame_at(const Eigen::Vector3d& p_CS, double yaw, double stamp) {
+  Frame frame;
+  frame.sensor = "cam";
+  frame.stamp = stamp;
+  frame.X_CS.translation() = p_CS;
+  frame.X_CS.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  frame.points_S.push_back(pcl::PointXYZ(1, 0, 0));
+  frame.points_S.push_back(pcl::PointXYZ(nan, nan, nan));  // an organized cloud's missing pixel
+  frame.points_S.push_back(pcl::PointXYZ(0, 1, 2));
+  return frame;
+}
+
+TEST(SweepTest, ToScanMovesPointsIntoTheCellAndKeepsTheOrigin) {
+  const Scan scan = to_scan(frame_at({1, 2, 3}, M_PI / 2, 0.5));
+  EXPECT_TRUE(scan.origin_C.isApprox(Eigen::Vector3d(1, 2, 3)));
+  ASSERT_EQ(scan.points_C.size(), 2u);  // the NaN point is skipped
+  // R_z(90°)·(1, 0, 0) = (0, 1, 0); R_z(90°)·(0, 1, 2) = (−1, 0, 2); then + (1, 2, 3).
+  EXPECT_TRUE(scan.points_C[0].getVector3fMap().isApprox(Eigen::Vector3f(1, 3, 3), 1e-6f));
+  EXPECT_TRUE(scan.points_C[1].getVector3fMap().isApprox(Eigen::Vector3f(0, 2, 5), 1e-6f));
+}
+
+TEST(SweepTest, MergeFramesKeepsOrderAndStampsTheLastFrame) {
+  const Sweep sweep = merge_frames({frame_at({0, 0, 1}, 0, 1.0), frame_at({1, 0, 1}, 0, 1.2)});
+  ASSERT_EQ(sweep.scans.size(), 2u);
+  EXPECT_DOUBLE_EQ(sweep.stamp, 1.2);
+  EXPECT_TRUE(sweep.scans[1].origin_C.isApprox(Eigen::Vector3d(1, 0, 1)));
+  EXPECT_EQ(sweep.point_count(), 4u);
+  EXPECT_EQ(sweep.merged().size(), 4u);
+  EXPECT_EQ(merge_frames({}).stamp, 0.0);
+}
+
+}  // namespace
+}  // namespace cellmap
