@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <chrono>
+
 #include <cstdio>
 #include <thread>
 
@@ -160,14 +162,46 @@ TEST(OpenNI2SourceTest, DeviceWithoutFieldOfViewNeedsConfiguredIntrinsics) {
   EXPECT_NE(status.reason.find("reports no field of view"), std::string::npos) << status.reason;
 }
 
-TEST(SensorsCommandTest, ListsAndExitsZero) {
-  const std::string command = std::string(CELLMAP_TOOL) + " sensors 2>&1";
+// Runs `cellmap sensors ARGS`; returns the exit status and stdout + stderr.
+std::pair<int, std::string> run_sensors_command(const std::string& args) {
+  const std::string command = std::string(CELLMAP_TOOL) + " sensors " + args + " 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
+  if (!pipe) return {-1, "popen failed"};
   std::string output;
   char buffer[256];
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
   const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+TEST(ProbeOpenNI2DeviceTest, ListsTheModesOfANamedDevice) {
+  const DepthDeviceInfo info = probe_openni2_device("Dummy");
+  EXPECT_EQ(info.driver, "openni2");
+  EXPECT_EQ(info.uri, "Dummy");
+  EXPECT_EQ(describe_modes(info.modes), "320x240@30 DEPTH_1_MM");
+  try {
+    (void)probe_openni2_device("/nonexistent/sweep.oni");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "openni2 /nonexistent/sweep.oni: no such recording");
+  }
+}
+
+TEST(SensorsCommandTest, ProbesAUriAndFailsInOneLine) {
+  const auto [status, output] = run_sensors_command("--openni2-uri Dummy");
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("OpenNI2 devices opened by URI: 1 device\n  Dummy  Table Tennis"), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("    320x240@30 DEPTH_1_MM\n"), std::string::npos) << output;
+  EXPECT_EQ(output.find("No depth sensors found."), std::string::npos) << output;
+  const auto [bad_status, bad_output] = run_sensors_command("--openni2-uri /nonexistent/sweep.oni");
+  EXPECT_EQ(bad_status, 1);
+  EXPECT_EQ(bad_output.rfind("cellmap: openni2 /nonexistent/sweep.oni: no such recording\n", 0), 0u)
+      << bad_output;
+}
+
+TEST(SensorsCommandTest, ListsAndExitsZero) {
+  const auto [status, output] = run_sensors_command("");
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("OpenNI2 depth devices:"), std::string::npos) << output;
   EXPECT_NE(output.find("V4L2 depth devices (Z16) in /dev:"), std::string::npos) << output;
