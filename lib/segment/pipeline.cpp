@@ -1,5 +1,6 @@
 #include "cellmap/segment/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -79,6 +80,7 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
     r.max_curvature = m.number("max_curvature", r.max_curvature, 0.0, 1.0 / 3.0);
     r.max_angle = m.number("max_angle", r.max_angle, 0.0, kPi);
     r.min_cluster_size = static_cast<int>(m.integer("min_cluster_size", r.min_cluster_size, 1, 100000000));
+    c.gap_floor_factor = m.number("gap_floor_factor", c.gap_floor_factor, 0.0, 100.0);
     m.expect_all_read();
   }
   {
@@ -169,15 +171,23 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   const Cloud cloud = subset(cropped, outliers.kept);
   stats.t_outliers = clock.lap();
 
-  Segments segments = grow_regions(nb, config.region_growing);
+  RegionGrowingParams growing = config.region_growing;
+  ConvexMergeParams merging = config.merge_params;
+  if (config.gap_floor_factor > 0.0 && nb.size() > 0) {
+    std::vector<float> d = nb.mean_distance;
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    growing.gap = std::max(growing.gap, config.gap_floor_factor * d[d.size() / 2]);
+    merging.gap = std::max(merging.gap, growing.gap);
+  }
+  stats.gap = growing.gap;
+  Segments segments = grow_regions(nb, growing);
   stats.regions = static_cast<std::size_t>(segments.count);
   stats.t_grow = clock.lap();
 
-  stats.leftovers =
-      cover_leftovers(cloud, nb, segments, config.region_growing.gap, config.leftover_min_points);
+  stats.leftovers = cover_leftovers(cloud, nb, segments, growing.gap, config.leftover_min_points);
   stats.t_leftovers = clock.lap();
 
-  if (config.merge) segments = merge_convex(cloud, nb, segments, config.merge_params, &stats.merge);
+  if (config.merge) segments = merge_convex(cloud, nb, segments, merging, &stats.merge);
   stats.merged_segments = static_cast<std::size_t>(segments.count);
   stats.t_merge = clock.lap();
 
@@ -200,10 +210,11 @@ std::string summary(const SegmentStats& s) {
   char line[512];
   std::snprintf(line, sizeof line,
                 "points %zu, dropped: outside workspace %zu, outliers sparse %zu dense %zu, isolated %zu; "
-                "regions %zu, leftovers attached %zu own segments %zu, merged to %zu, split %zu; boxes %zu; "
+                "gap %.4f m, regions %zu, leftovers attached %zu own segments %zu, merged to %zu, split %zu; "
+                "boxes %zu; "
                 "time %.3f s (features %.3f, outliers %.3f, grow %.3f, merge %.3f, split %.3f)",
                 s.points_in, s.outside_workspace, s.outliers_sparse, s.outliers_dense, s.leftovers.isolated,
-                s.regions, s.leftovers.attached, s.leftovers.own_segments, s.merged_segments,
+                s.gap, s.regions, s.leftovers.attached, s.leftovers.own_segments, s.merged_segments,
                 s.split_segments, s.boxes, s.t_total(), s.t_features, s.t_outliers, s.t_grow, s.t_merge,
                 s.t_split);
   return line;

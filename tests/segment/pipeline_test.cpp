@@ -156,6 +156,23 @@ TEST(Pipeline, ObbVolumeIsAtMostAabbVolumeOnRotatedObjects) {
   EXPECT_LT(obb_volume, 0.8 * aabb_volume);
 }
 
+TEST(Pipeline, ASparseCloudStillConnects) {
+  // 3 cm sampling, three times the default d_th of 1 cm: without the gap floor every point would be isolated.
+  test::Scene scene(Eigen::Vector3f(0.3f, -1.5f, 1.5f));
+  scene.add_box({0.0, 0.0, 0.2}, {0.2, 0.2, 0.2}, Eigen::Matrix3d::Identity(), 0.03);
+  scene.add_floor(1.0, {Footprint({-0.2, -0.2}, {0.2, 0.2})}, 0.03);
+  SegmentConfig config = no_split();
+  config.outlier_mode = OutlierMode::kOff;
+  const SegmentResult result = segment_cloud(scene.points, config);
+  EXPECT_GE(result.stats.gap, 0.03);
+  EXPECT_EQ(result.stats.leftovers.isolated, 0u);
+  EXPECT_LE(result.boxes.boxes.size(), 4u) << summary(result.stats);
+  config.gap_floor_factor = 0.0;
+  const SegmentResult fixed = segment_cloud(scene.points, config);
+  EXPECT_EQ(fixed.stats.gap, 0.01);
+  EXPECT_GT(fixed.stats.leftovers.isolated, scene.points.size() / 2);
+}
+
 TEST(SegmentConfig, TheConfigFileHoldsTheDefaults) {
   const SegmentConfig file = load_segment_config(std::string(CELLMAP_SOURCE_DIR) + "/config/segment.yaml");
   const SegmentConfig defaults;
@@ -166,6 +183,7 @@ TEST(SegmentConfig, TheConfigFileHoldsTheDefaults) {
   EXPECT_EQ(file.region_growing.max_curvature, defaults.region_growing.max_curvature);
   EXPECT_EQ(file.region_growing.max_angle, defaults.region_growing.max_angle);
   EXPECT_EQ(file.region_growing.min_cluster_size, defaults.region_growing.min_cluster_size);
+  EXPECT_EQ(file.gap_floor_factor, defaults.gap_floor_factor);
   EXPECT_EQ(file.leftover_min_points, defaults.leftover_min_points);
   EXPECT_EQ(file.merge, defaults.merge);
   EXPECT_EQ(file.merge_params.gap, defaults.merge_params.gap);

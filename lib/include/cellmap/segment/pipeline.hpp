@@ -24,6 +24,10 @@ struct SegmentConfig final {
   OutlierMode outlier_mode = OutlierMode::kTwoSided;
   double outlier_u = 3.0;  ///< σ multiplier of the outlier test
   RegionGrowingParams region_growing;
+  /// The gap d_th actually used is at least this multiple of the median mean neighbour distance (eq. 1), so
+  /// that a cloud sparser than d_th assumes still connects instead of falling apart into isolated points
+  /// (0 = use d_th as given). Also applies to the leftover and merge gaps.
+  double gap_floor_factor = 2.0;
   int leftover_min_points = 3;  ///< smaller leftover groups are dropped (counted)
   bool merge = true;            ///< convex merging on/off
   ConvexMergeParams merge_params;
@@ -45,6 +49,7 @@ struct SegmentStats final {
   std::size_t outside_workspace = 0;
   std::size_t outliers_sparse = 0;  ///< mean neighbour distance above μ + u·σ
   std::size_t outliers_dense = 0;   ///< below μ − u·σ (two-sided mode)
+  double gap = 0.0;                 ///< d_th used (metres), see SegmentConfig::gap_floor_factor
   std::size_t regions = 0;          ///< segments after region growing (of at least min_cluster_size)
   LeftoverStats leftovers;
   MergeStats merge;
