@@ -206,7 +206,7 @@ SubResult closest_tetrahedron(const std::array<Vertex, 4>& s) {
 
 // Runs GJK in A's frame; returns points in A's frame. `simplex_out` receives the final simplex (for EPA).
 GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
-                       Simplex* simplex_out = nullptr) {
+                       Simplex* simplex_out = nullptr, const Vector3d* towards_b = nullptr) {
   const Support support{ha, hb, rel};
   // (|ha| + |hb| + |t|)^2 <= 3 (|ha|^2 + |hb|^2 + |t|^2): a scene size without square roots.
   const double scale2 = 3.0 * (ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm());
@@ -215,8 +215,9 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
   constexpr int kMaxIterations = 64;
 
   Simplex simplex;
-  // Start from D's centre (-t): the first support point is then in the direction of the origin.
-  Vector3d v = -rel.t;
+  // Start from D's centre (-t), or from a known direction A → B (a separating axis): the first support point
+  // is then in the direction of the origin.
+  Vector3d v = towards_b != nullptr ? Vector3d(-*towards_b) : Vector3d(-rel.t);
   if (!(v.squaredNorm() > tiny2)) v = Vector3d(1.0, 0.0, 0.0) * std::max(std::sqrt(scale2), 1.0);
   double vv = std::numeric_limits<double>::infinity();
   GjkResult result;
@@ -287,49 +288,212 @@ GjkResult gjk_relative(const Vector3d& ha, const Vector3d& hb, const Relative& r
   return result;
 }
 
-// The largest separation along the 15 axes (negative: minus the smallest overlap), exact rotation terms.
-// Returns the gap and the unit axis in A's frame pointing from A to B.
-double sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, Vector3d* axis) {
+// The largest separation along the 15 axes (negative: minus the smallest overlap), exact rotation terms, with
+// the unit axis in A's frame pointing from A to B and which axis it is.
+struct SatResult {
+  double gap = -std::numeric_limits<double>::infinity();
+  Vector3d axis = Vector3d::UnitX();
+  enum Kind { kFaceA, kFaceB, kEdges } kind = kFaceA;
+  int i = 0;  // face of A, or A's edge direction
+  int j = 0;  // face of B, or B's edge direction
+};
+
+// With faces_only, just the 6 face axes: a valid lower bound when positive, and cheap.
+// Inlined into its callers so that R and t stay in registers (a measurable share of a box-box query).
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline SatResult
+sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool faces_only = false) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   const Matrix3d absR = R.cwiseAbs();
-  double best = -std::numeric_limits<double>::infinity();
-  Vector3d best_axis = Vector3d::UnitX();
-  const auto consider = [&](double gap, const Vector3d& unit_axis) {
-    if (gap > best) {
-      best = gap;
-      best_axis = unit_axis;
-    }
-  };
-  for (int i = 0; i < 3; ++i) {
-    const double gap = std::abs(t[i]) - ha[i] - hb.dot(absR.row(i));
-    consider(gap, Vector3d::Unit(i) * (t[i] >= 0.0 ? 1.0 : -1.0));
-  }
+  double gap[15];
+  double tb[3];
+  for (int i = 0; i < 3; ++i) gap[i] = std::abs(t[i]) - ha[i] - hb.dot(absR.row(i));
   for (int j = 0; j < 3; ++j) {
-    const double tj = t.dot(R.col(j));
-    const double gap = std::abs(tj) - ha.dot(absR.col(j)) - hb[j];
-    consider(gap, R.col(j) * (tj >= 0.0 ? 1.0 : -1.0));
+    tb[j] = t.dot(R.col(j));
+    gap[3 + j] = std::abs(tb[j]) - ha.dot(absR.col(j)) - hb[j];
   }
-  // Edge axes: L = e_i x R.col(j); near-parallel edges (|L| < 1e-8) are skipped, their facets of the
-  // Minkowski difference degenerate and the neighbouring axes bound the same overlap.
+  // Edge axes: L = e_i x R.col(j), |L|^2 = R(i1, j)^2 + R(i2, j)^2. Near-parallel edges (|L| < 1e-8) are
+  // skipped: their facets of the Minkowski difference degenerate and the neighbouring axes bound the same
+  // overlap.
+  if (faces_only) {
+    int k = 0;
+    for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
+    SatResult best;
+    best.gap = gap[k];
+    if (k < 3) {
+      best.kind = SatResult::kFaceA;
+      best.i = k;
+      best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
+    } else {
+      best.kind = SatResult::kFaceB;
+      best.j = k - 3;
+      best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
+    }
+    return best;
+  }
+  double tl[9];
+  double numerator[9];
+  double length2[9];
   for (int i = 0; i < 3; ++i) {
     const int i1 = (i + 1) % 3;
     const int i2 = (i + 2) % 3;
     for (int j = 0; j < 3; ++j) {
       const int j1 = (j + 1) % 3;
       const int j2 = (j + 2) % 3;
-      const Vector3d L = Vector3d::Unit(i).cross(R.col(j));
-      const double length2 = L.squaredNorm();
-      if (length2 < 1e-16) continue;
+      const int m = 3 * i + j;
+      length2[m] = R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j);
       const double ra = ha[i1] * absR(i2, j) + ha[i2] * absR(i1, j);
       const double rb = hb[j1] * absR(i, j2) + hb[j2] * absR(i, j1);
-      const double tl = t[i2] * R(i1, j) - t[i1] * R(i2, j);
-      const double length = std::sqrt(length2);
-      consider((std::abs(tl) - ra - rb) / length, L * ((tl >= 0.0 ? 1.0 : -1.0) / length));
+      tl[m] = t[i2] * R(i1, j) - t[i1] * R(i2, j);
+      numerator[m] = std::abs(tl[m]) - ra - rb;
     }
   }
-  *axis = best_axis;
+  int k = 0;
+  for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
+  for (int m = 0; m < 9; ++m) {
+    gap[6 + m] = -std::numeric_limits<double>::infinity();
+    if (length2[m] < 1e-16) continue;
+    // With a positive gap known, an edge axis can only win with a positive numerator and then the comparison
+    // needs no square root; most edge axes are discarded here.
+    const double best = gap[k];
+    if (best > 0.0 && (numerator[m] <= 0.0 || numerator[m] * numerator[m] <= best * best * length2[m]))
+      continue;
+    gap[6 + m] = numerator[m] / std::sqrt(length2[m]);
+    if (gap[6 + m] > best) k = 6 + m;
+  }
+  SatResult best;
+  best.gap = gap[k];
+  if (k < 3) {
+    best.kind = SatResult::kFaceA;
+    best.i = k;
+    best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
+  } else if (k < 6) {
+    best.kind = SatResult::kFaceB;
+    best.j = k - 3;
+    best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
+  } else {
+    best.kind = SatResult::kEdges;
+    best.i = (k - 6) / 3;
+    best.j = (k - 6) % 3;
+    const Vector3d L = Vector3d::Unit(best.i).cross(R.col(best.j));
+    best.axis = L * ((tl[k - 6] >= 0.0 ? 1.0 : -1.0) / L.norm());
+  }
   return best;
+}
+
+double sign_of(double x) {
+  return x >= 0.0 ? 1.0 : -1.0;
+}
+
+// Exact distance certificate: the separating axis gives a lower bound `gap` on the distance; if the support
+// features along it hold a pair of points exactly `gap` apart (a vertex projecting into the facing face, or
+// two edges whose common perpendicular meets both), that pair is a closest pair. Returns false otherwise.
+bool certify_axis(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat,
+                  Vector3d* pa, Vector3d* pb) {
+  const Matrix3d& R = rel.R;
+  const Vector3d& t = rel.t;
+  if (sat.kind == SatResult::kFaceA) {
+    // B's vertex deepest towards A's face i.
+    const int i = sat.i;
+    const double s = sat.axis[i];
+    const Vector3d sigma(sign_of(-s * R(i, 0)), sign_of(-s * R(i, 1)), sign_of(-s * R(i, 2)));
+    const Vector3d v = t + R * sigma.cwiseProduct(hb);
+    const int k1 = (i + 1) % 3, k2 = (i + 2) % 3;
+    if (std::abs(v[k1]) > ha[k1] || std::abs(v[k2]) > ha[k2]) return false;
+    *pb = v;
+    *pa = v;
+    (*pa)[i] = s * ha[i];
+    return true;
+  }
+  if (sat.kind == SatResult::kFaceB) {
+    // A's vertex deepest towards B's face j, tested in B's frame.
+    const int j = sat.j;
+    const double s = sign_of(sat.axis.dot(R.col(j)));
+    const Vector3d u =
+        Vector3d(sign_of(s * R(0, j)), sign_of(s * R(1, j)), sign_of(s * R(2, j))).cwiseProduct(ha);
+    Vector3d u_B = R.transpose() * (u - t);
+    const int k1 = (j + 1) % 3, k2 = (j + 2) % 3;
+    if (std::abs(u_B[k1]) > hb[k1] || std::abs(u_B[k2]) > hb[k2]) return false;
+    *pa = u;
+    u_B[j] = -s * hb[j];
+    *pb = t + R * u_B;
+    return true;
+  }
+  // Edge-edge: A's edge along e_i and B's edge along R.col(j), the ones extreme along the axis.
+  const int i = sat.i;
+  const int j = sat.j;
+  const Vector3d& L = sat.axis;
+  Vector3d a0(sign_of(L[0]) * ha[0], sign_of(L[1]) * ha[1], sign_of(L[2]) * ha[2]);
+  a0[i] = 0.0;
+  const Vector3d L_B = R.transpose() * L;
+  Vector3d b_local(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
+  b_local[j] = 0.0;
+  const Vector3d b0 = t + R * b_local;
+  const Vector3d d2 = R.col(j);
+  const Vector3d r = a0 - b0;
+  const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+  const double a12 = R(i, j);
+  const double c1 = r[i];
+  const double c2 = d2.dot(r);
+  const double alpha = (a12 * c2 - c1) / (R(i1, j) * R(i1, j) + R(i2, j) * R(i2, j));  // = 1 - a12^2 > 1e-16
+  const double beta = c2 + alpha * a12;
+  if (std::abs(alpha) > ha[i] || std::abs(beta) > hb[j]) return false;
+  *pa = a0;
+  (*pa)[i] += alpha;
+  *pb = b0 + beta * d2;
+  return true;
+}
+
+// Second certificate: a vertex extreme along the axis and the closest point of the other box to it, when
+// each is the other's closest point (mutually closest points of two convex sets are a closest pair: the
+// direction between them lies in both normal cones). Covers vertex-vertex and vertex-edge contacts.
+bool certify_vertex(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat,
+                    Vector3d* pa, Vector3d* pb) {
+  const Matrix3d& R = rel.R;
+  const Vector3d& t = rel.t;
+  const double tolerance2 = 1e-26 * (ha.squaredNorm() + hb.squaredNorm() + t.squaredNorm());
+  // B's vertex extreme towards A, A's closest point to it, B's closest point to that.
+  const Vector3d L_B = R.transpose() * sat.axis;
+  const Vector3d v_B(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
+  const Vector3d v = t + R * v_B;
+  const Vector3d p = v.cwiseMax(-ha).cwiseMin(ha);
+  const Vector3d p_B = R.transpose() * (p - t);
+  if ((p_B.cwiseMax(-hb).cwiseMin(hb) - v_B).squaredNorm() <= tolerance2) {
+    *pa = p;
+    *pb = v;
+    return true;
+  }
+  // A's vertex extreme towards B, symmetric.
+  const Vector3d u(sign_of(sat.axis[0]) * ha[0], sign_of(sat.axis[1]) * ha[1], sign_of(sat.axis[2]) * ha[2]);
+  const Vector3d u_B = R.transpose() * (u - t);
+  const Vector3d q_B = u_B.cwiseMax(-hb).cwiseMin(hb);
+  const Vector3d q = t + R * q_B;
+  if ((q.cwiseMax(-ha).cwiseMin(ha) - u).squaredNorm() <= tolerance2) {
+    *pa = u;
+    *pb = q;
+    return true;
+  }
+  return false;
+}
+
+bool certify(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat, Vector3d* pa,
+             Vector3d* pb) {
+  return certify_axis(ha, hb, rel, sat, pa, pb) || certify_vertex(ha, hb, rel, sat, pa, pb);
+}
+
+// Distance of separated boxes (sat.gap > 0) in A's frame: the certificate when it applies, else GJK started
+// along the separating axis.
+GjkResult separated_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel,
+                             const SatResult& sat) {
+  GjkResult result;
+  if (certify(ha, hb, rel, sat, &result.point_a, &result.point_b)) {
+    result.distance = (result.point_b - result.point_a).norm();
+    return result;
+  }
+  return gjk_relative(ha, hb, rel, nullptr, &sat.axis);
 }
 
 }  // namespace
@@ -366,11 +530,10 @@ bool overlap(const Obb& a, const Obb& b, double margin) {
 }
 
 SignedDistance separating_axis_depth(const Obb& a, const Obb& b) {
-  const Relative rel = relative(a, b);
-  Vector3d axis;
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, relative(a, b));
   SignedDistance out;
-  out.distance = sat_relative(a.half_extents, b.half_extents, rel, &axis);
-  out.normal = a.rotation * axis;
+  out.distance = sat.gap;
+  out.normal = a.rotation * sat.axis;
   return out;
 }
 
@@ -392,7 +555,9 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const Relative&
   const double shift = depth + clearance;
   Relative moved = rel;
   moved.t += shift * axis_a;
-  const GjkResult g = gjk_relative(a.half_extents, b.half_extents, moved);
+  SatResult sat = sat_relative(a.half_extents, b.half_extents, moved);
+  if (!(sat.gap > 0.0)) sat = {clearance, axis_a, SatResult::kFaceA, 0, 0};  // rounding; GJK decides below
+  const GjkResult g = separated_relative(a.half_extents, b.half_extents, moved, sat);
   Vector3d pa = g.point_a;
   Vector3d pb = g.point_b - shift * axis_a;
   if (g.intersecting) {  // cannot happen for a true separating direction; stay finite regardless
@@ -411,20 +576,33 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const Relative&
 
 SignedDistance signed_distance(const Obb& a, const Obb& b) {
   const Relative rel = relative(a, b);
-  const GjkResult g = gjk_relative(a.half_extents, b.half_extents, rel);
-  if (!g.intersecting) {
+  const auto separated = [&](const GjkResult& g, const Vector3d& axis) {
     SignedDistance out;
     out.distance = g.distance;
     out.point_a = a.rotation * g.point_a + a.center;
     out.point_b = a.rotation * g.point_b + a.center;
-    // Not intersecting means the gap exceeds the rounding floor, so the direction is well defined.
-    out.normal = a.rotation * (g.point_b - g.point_a).normalized();
+    // A positive separation exceeds the rounding floor, so the direction is well defined; a certified pair
+    // at zero distance cannot occur (the axis gap is positive), the fallback only guards against rounding.
+    const Vector3d gap = g.point_b - g.point_a;
+    out.normal = a.rotation * (gap.squaredNorm() > 0.0 ? Vector3d(gap.normalized()) : axis);
     return out;
+  };
+  // Fast path: a face axis already separates and a certificate holds (most separated pairs).
+  const SatResult faces = sat_relative(a.half_extents, b.half_extents, rel, true);
+  if (faces.gap > 0.0) {
+    GjkResult g;
+    if (certify(a.half_extents, b.half_extents, rel, faces, &g.point_a, &g.point_b)) {
+      g.distance = (g.point_b - g.point_a).norm();
+      return separated(g, faces.axis);
+    }
+  }
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, rel);
+  if (sat.gap > 0.0) {
+    const GjkResult g = separated_relative(a.half_extents, b.half_extents, rel, sat);
+    if (!g.intersecting) return separated(g, sat.axis);
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
-  Vector3d axis;
-  const double gap = sat_relative(a.half_extents, b.half_extents, rel, &axis);
-  return penetration_witnesses(a, b, rel, std::max(-gap, 0.0), axis);
+  return penetration_witnesses(a, b, rel, std::max(-sat.gap, 0.0), sat.axis);
 }
 
 namespace {
@@ -454,8 +632,9 @@ SignedDistance epa_penetration(const Obb& a, const Obb& b) {
   const Relative rel = relative(a, b);
   Simplex simplex;
   const GjkResult g = gjk_relative(a.half_extents, b.half_extents, rel, &simplex);
-  Vector3d sat_axis;
-  const double sat_gap = sat_relative(a.half_extents, b.half_extents, rel, &sat_axis);
+  const SatResult sat = sat_relative(a.half_extents, b.half_extents, rel);
+  const double sat_gap = sat.gap;
+  const Vector3d& sat_axis = sat.axis;
   if (!g.intersecting) {
     SignedDistance out;
     out.distance = g.distance;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <thread>
 
 #include "cellmap/common/error.hpp"
@@ -60,17 +61,20 @@ bool is_oni_file(const std::string& uri) {
   return ext == ".oni" || ext == ".ONI";
 }
 
-// Keeps OpenNI2 initialised while an object of it lives (OpenNI::initialize/shutdown are reference counted).
-class OpenNIRuntime {
- public:
-  OpenNIRuntime() {
-    if (openni::OpenNI::initialize() != openni::STATUS_OK)
-      throw Error("openni2: cannot initialise: " + openni_error());
-  }
-  ~OpenNIRuntime() { openni::OpenNI::shutdown(); }
-  OpenNIRuntime(const OpenNIRuntime&) = delete;
-  OpenNIRuntime& operator=(const OpenNIRuntime&) = delete;
-};
+// Initialises OpenNI2 once per process and never shuts it down. OpenNI2's context is process-wide anyway, and
+// OpenNI::shutdown() unloads the driver libraries while driver threads may still be winding down: Debian's
+// DummyDevice driver does not join its frame thread, and a shutdown right after closing its stream crashed
+// the process here (SIGSEGV in unmapped driver code). @throws Error with OpenNI2's reason (retried next
+// call).
+void ensure_openni() {
+  static std::mutex mutex;
+  static bool initialised = false;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (initialised) return;
+  if (openni::OpenNI::initialize() != openni::STATUS_OK)
+    throw Error("openni2: cannot initialise: " + openni_error());
+  initialised = true;
+}
 
 }  // namespace
 
@@ -91,12 +95,17 @@ PinholeIntrinsics intrinsics_from_fov(int width, int height, double hfov, double
 }
 
 struct OpenNI2Source::Device {
-  OpenNIRuntime runtime;
   openni::Device device;
   openni::VideoStream stream;
   int frame_count = -1;  // frames in an .oni file, -1 for live devices
   ~Device() {
-    stream.stop();
+    if (stream.isValid()) {
+      stream.stop();
+      // Some drivers' frame threads poll a stop flag and are never joined (Debian's DummyDevice checks it
+      // every 33 ms); freeing the stream at once let such a thread run on freed memory and crash here. 50 ms
+      // on close or reconnect is cheap.
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
     stream.destroy();
     device.close();
   }
@@ -141,6 +150,7 @@ void OpenNI2Source::connect(double now) {
     return;
   }
   try {
+    ensure_openni();
     auto device = std::make_unique<Device>();
     if (device->device.open(config_.uri.empty() ? openni::ANY_DEVICE : config_.uri.c_str()) !=
         openni::STATUS_OK) {
@@ -279,7 +289,7 @@ void OpenNI2Source::close() {
 }
 
 std::vector<DepthDeviceInfo> list_openni2_devices() {
-  OpenNIRuntime runtime;
+  ensure_openni();
   openni::Array<openni::DeviceInfo> found;
   openni::OpenNI::enumerateDevices(&found);
   std::vector<DepthDeviceInfo> devices;

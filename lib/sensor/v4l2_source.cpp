@@ -4,6 +4,7 @@
 #include <libv4l2.h>
 #include <linux/videodev2.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -86,9 +87,16 @@ std::vector<DepthMode> enumerate_modes(int fd) {
   return modes;
 }
 
-bool is_capture_device(int fd) {
+// Checked with the plain ioctl before libv4l2 sees the descriptor: libv4l2 prints to stderr when a node is
+// not a V4L2 device, and library code must not print.
+bool is_capture_device(int fd, std::string* card = nullptr) {
   v4l2_capability caps{};
-  if (xioctl(fd, VIDIOC_QUERYCAP, &caps) != 0) return false;
+  int result;
+  do {
+    result = ::ioctl(fd, VIDIOC_QUERYCAP, &caps);
+  } while (result == -1 && errno == EINTR);
+  if (result != 0) return false;
+  if (card) *card = reinterpret_cast<const char*>(caps.card);
   const std::uint32_t device_caps =
       (caps.capabilities & V4L2_CAP_DEVICE_CAPS) ? caps.device_caps : caps.capabilities;
   return (device_caps & V4L2_CAP_VIDEO_CAPTURE) && (device_caps & V4L2_CAP_STREAMING);
@@ -208,14 +216,22 @@ void V4l2Source::connect(double now) {
   ++attempts_;
   const std::string& device = config_.device;
   auto stream = std::make_unique<Stream>();
-  stream->fd = v4l2_open(device.c_str(), O_RDWR | O_NONBLOCK);
-  if (stream->fd < 0) {
+  const int fd = ::open(device.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
     const int error = errno;
     reconnector_.lost(now, "v4l2 " + device + ": cannot open: " + std::strerror(error));
     return;
   }
-  if (!is_capture_device(stream->fd)) {
+  if (!is_capture_device(fd)) {
+    ::close(fd);
     reconnector_.failed("v4l2 " + device + ": not a streaming video capture device");
+    return;
+  }
+  stream->fd = v4l2_fd_open(fd, 0);
+  if (stream->fd < 0) {
+    const int error = errno;
+    ::close(fd);
+    reconnector_.lost(now, "v4l2 " + device + ": libv4l2 cannot use it: " + std::strerror(error));
     return;
   }
   DepthMode chosen;
@@ -381,17 +397,22 @@ std::vector<DepthDeviceInfo> list_v4l2_devices(const std::string& dev_dir) {
   }
   std::sort(nodes.begin(), nodes.end());
   for (const std::string& node : nodes) {
-    const int fd = v4l2_open(node.c_str(), O_RDWR | O_NONBLOCK);
-    if (fd < 0) continue;
+    const int raw_fd = ::open(node.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+    if (raw_fd < 0) continue;
     DepthDeviceInfo info;
     info.driver = "v4l2";
     info.uri = node;
-    v4l2_capability caps{};
-    if (is_capture_device(fd) && xioctl(fd, VIDIOC_QUERYCAP, &caps) == 0) {
-      info.name = reinterpret_cast<const char*>(caps.card);
-      for (const DepthMode& mode : enumerate_modes(fd)) {
-        if (mode.format == "Z16") info.modes.push_back(mode);
-      }
+    if (!is_capture_device(raw_fd, &info.name)) {
+      ::close(raw_fd);
+      continue;
+    }
+    const int fd = v4l2_fd_open(raw_fd, 0);
+    if (fd < 0) {
+      ::close(raw_fd);
+      continue;
+    }
+    for (const DepthMode& mode : enumerate_modes(fd)) {
+      if (mode.format == "Z16") info.modes.push_back(mode);
     }
     v4l2_close(fd);
     if (!info.modes.empty()) devices.push_back(std::move(info));

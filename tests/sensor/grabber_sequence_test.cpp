@@ -1,6 +1,6 @@
-// Depth → points and replay on three real frames of one Kinect-type sensor (shared/data/pcl/grabber_sequence):
-// each frame is stored as raw 16-bit depth (TIFF, millimetres), its intrinsics (PCL grabber XML) and the
-// organized cloud PCL's grabber computed from the same depth (PCD).
+// Depth → points and replay on three real frames of one Kinect-type sensor
+// (shared/data/pcl/grabber_sequence): each frame is stored as raw 16-bit depth (TIFF, millimetres), its
+// intrinsics (PCL grabber XML) and the organized cloud PCL's grabber computed from the same depth (PCD).
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 
@@ -31,8 +31,8 @@ std::vector<std::string> frame_stems() {
   return stems;
 }
 
-#define SKIP_WITHOUT_DATA()                                                                        \
-  if (!fs::is_directory(kSequence)) {                                                              \
+#define SKIP_WITHOUT_DATA()                                                                           \
+  if (!fs::is_directory(kSequence)) {                                                                 \
     GTEST_SKIP() << "shared data folder " << kSequence << " is absent; skipping the real-frame test"; \
   }
 
@@ -81,9 +81,8 @@ TEST(GrabberSequenceTest, PointsFromDepthMatchTheRecordedClouds) {
       }
       if (!have) continue;
       ++valid;
-      const double deviation = (computed[i].getVector3fMap().cast<double>() -
-                                recorded[i].getVector3fMap().cast<double>())
-                                   .norm();
+      const double deviation =
+          (computed[i].getVector3fMap().cast<double>() - recorded[i].getVector3fMap().cast<double>()).norm();
       frame_max = std::max(frame_max, deviation);
     }
     std::cout << stem << ": " << valid << " valid points, " << validity_mismatch
@@ -102,8 +101,9 @@ TEST(GrabberSequenceTest, ReplayGivesEachFrameItsRecordedPose) {
   SKIP_WITHOUT_DATA();
   const std::vector<std::string> stems = frame_stems();
   ASSERT_EQ(stems.size(), 3u);
-  // A replay directory over the real frames: links to the depth images and XMLs, plus a poses file of a gantry
-  // moving the tool 0.1 m along x per frame while turning 10 degrees about z; stamps from the file names.
+  // A replay directory over the real frames: links to the depth images and XMLs, plus a poses file of a
+  // gantry moving the tool 0.1 m along x per frame while turning 10 degrees about z; stamps from the file
+  // names.
   const fs::path dir = fs::temp_directory_path() / ("cellmap_replay_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);

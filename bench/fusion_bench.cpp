@@ -1,0 +1,156 @@
+// cellmap bench fusion: our sweep fusion (OccupancyMap::integrate) against OctoMap's own
+// OcTree::insertPointCloud on the same frames, in the same run. Each frame is one sweep fused into a fresh
+// map per iteration. Prints the voxel-state agreement of the resulting maps before the timings.
+
+#include <benchmark/benchmark.h>
+#include <pcl/io/pcd_io.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/occupancy/tree_agreement.hpp"
+#include "occupancy/box_scene.hpp"
+#include "ratio_report.hpp"
+
+namespace {
+
+using cellmap::OccupancyConfig;
+using cellmap::OccupancyMap;
+using cellmap::Sweep;
+
+// The frame sets, each a list of one-scan sweeps (camera frame = cell frame, identity pose).
+std::map<std::string, std::vector<Sweep>>& frame_sets() {
+  static std::map<std::string, std::vector<Sweep>> sets;
+  return sets;
+}
+
+octomap::Pointcloud to_octomap(const cellmap::Scan& scan) {
+  octomap::Pointcloud cloud;
+  cloud.reserve(scan.points_C.size());
+  for (const auto& p : scan.points_C.points) {
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud.push_back(p.x, p.y, p.z);
+  }
+  return cloud;
+}
+
+octomap::point3d origin_of(const cellmap::Scan& scan) {
+  return octomap::point3d(float(scan.origin_C.x()), float(scan.origin_C.y()), float(scan.origin_C.z()));
+}
+
+void fuse_ours(const std::vector<Sweep>& sweeps, OccupancyMap& map) {
+  for (const Sweep& sweep : sweeps) map.integrate(sweep);
+}
+
+void fuse_octomap(const std::vector<Sweep>& sweeps, const std::vector<octomap::Pointcloud>& clouds,
+                  bool discretize, octomap::OcTree& tree, double max_range) {
+  for (std::size_t i = 0; i < sweeps.size(); ++i) {
+    tree.insertPointCloud(clouds[i], origin_of(sweeps[i].scans.front()), max_range, false, discretize);
+  }
+}
+
+void BM_FusionOurs(benchmark::State& state, const std::string& set) {
+  const std::vector<Sweep>& sweeps = frame_sets().at(set);
+  for (auto _ : state) {
+    OccupancyMap map;
+    fuse_ours(sweeps, map);
+    benchmark::DoNotOptimize(map.tree().size());
+  }
+}
+
+void BM_FusionOctomap(benchmark::State& state, const std::string& set, bool discretize) {
+  const std::vector<Sweep>& sweeps = frame_sets().at(set);
+  std::vector<octomap::Pointcloud> clouds;
+  for (const Sweep& sweep : sweeps) clouds.push_back(to_octomap(sweep.scans.front()));
+  const OccupancyConfig config;
+  for (auto _ : state) {
+    octomap::OcTree tree(config.resolution);
+    cellmap::apply_sensor_model(config, tree);
+    fuse_octomap(sweeps, clouds, discretize, tree, config.max_range);
+    benchmark::DoNotOptimize(tree.size());
+  }
+}
+
+std::vector<Sweep> grabber_frames() {
+  const std::filesystem::path dir = std::filesystem::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
+  std::vector<std::filesystem::path> files;
+  if (std::filesystem::is_directory(dir)) {
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      if (entry.path().extension() == ".pcd") files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<Sweep> sweeps;
+  for (const auto& file : files) {
+    Sweep sweep;
+    sweep.scans.emplace_back();
+    if (pcl::io::loadPCDFile(file.string(), sweep.scans.back().points_C) != 0) return {};
+    sweeps.push_back(std::move(sweep));
+  }
+  return sweeps;
+}
+
+std::vector<Sweep> synthetic_frame() {
+  Sweep sweep;
+  sweep.scans.push_back(cellmap::testing::render_scan(
+      cellmap::testing::box_room(), Eigen::Isometry3d::Identity(), cellmap::testing::kinect_intrinsics()));
+  return {sweep};
+}
+
+void print_agreement(const std::string& set) {
+  const std::vector<Sweep>& sweeps = frame_sets().at(set);
+  std::vector<octomap::Pointcloud> clouds;
+  std::size_t points = 0;
+  for (const Sweep& sweep : sweeps) {
+    clouds.push_back(to_octomap(sweep.scans.front()));
+    points += clouds.back().size();
+  }
+  const OccupancyConfig config;
+  OccupancyMap ours(config);
+  fuse_ours(sweeps, ours);
+  for (const bool discretize : {true, false}) {
+    octomap::OcTree reference(config.resolution);
+    cellmap::apply_sensor_model(config, reference);
+    fuse_octomap(sweeps, clouds, discretize, reference, config.max_range);
+    const cellmap::TreeAgreement a = cellmap::compare_trees(ours.tree(), reference);
+    std::printf(
+        "agreement fusion %s vs insertPointCloud(discretize=%s): %.4f %% of %zu voxels "
+        "(occupied: ours %zu, octomap %zu, both %zu; %zu valid points)\n",
+        set.c_str(), discretize ? "true" : "false", 100.0 * a.fraction(), a.voxels, a.occupied_a,
+        a.occupied_b, a.occupied_both, points);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<cellmap::bench::Ratio> ratios;
+  std::vector<Sweep> grabber = grabber_frames();
+  if (grabber.empty()) {
+    std::printf("fusion bench: %s/pcl/grabber_sequence is absent; only the synthetic frame runs\n",
+                CELLMAP_SHARED_DATA);
+  } else {
+    frame_sets()["grabber_3frames"] = std::move(grabber);
+  }
+  frame_sets()["synthetic_1frame"] = synthetic_frame();
+
+  for (const auto& entry : frame_sets()) {
+    const std::string& name = entry.first;
+    print_agreement(name);
+    const std::string ours = "BM_FusionOurs/" + name;
+    const std::string anchor = "BM_FusionOctomap/" + name;
+    const std::string anchor_discrete = "BM_FusionOctomapDiscretized/" + name;
+    benchmark::RegisterBenchmark(ours.c_str(), BM_FusionOurs, name)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(anchor.c_str(), BM_FusionOctomap, name, false)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(anchor_discrete.c_str(), BM_FusionOctomap, name, true)
+        ->Unit(benchmark::kMillisecond);
+    ratios.push_back({"fusion " + name, ours, anchor});
+    ratios.push_back({"fusion " + name + " (vs discretized insert)", ours, anchor_discrete});
+  }
+  return cellmap::bench::run_and_report(argc, argv, ratios);
+}

@@ -1,0 +1,139 @@
+#include "cellmap/change/change_detector.hpp"
+
+#include <algorithm>
+#include <sstream>
+#include <tuple>
+#include <unordered_set>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+namespace {
+
+using Key = octomap::OcTreeKey;
+using KeySet = std::unordered_set<Key, Key::KeyHash>;
+
+bool zyx_less(const Key& a, const Key& b) {
+  return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
+}
+
+// Calls visit(neighbour) for the 26 neighbours of `key` inside the key range.
+template <class Visit>
+void for_each_neighbour(const Key& key, Visit&& visit) {
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const int x = key[0] + dx, y = key[1] + dy, z = key[2] + dz;
+        if (x < 0 || y < 0 || z < 0 || x > 0xffff || y > 0xffff || z > 0xffff) continue;
+        visit(
+            Key(static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), static_cast<std::uint16_t>(z)));
+      }
+    }
+  }
+}
+
+[[noreturn]] void bad(const std::string& field, const std::string& rule, double value) {
+  std::ostringstream msg;
+  msg << "change." << field << ": " << rule << ", got " << value;
+  throw Error(msg.str());
+}
+
+}  // namespace
+
+void ChangeConfig::validate() const {
+  if (persist_sweeps < 1 || persist_sweeps > 1000)
+    bad("persist_sweeps", "must be an integer in [1, 1000]", persist_sweeps);
+  if (!(margin >= 0.0 && margin <= 10.0)) bad("margin", "must be in [0, 10] m", margin);
+  if (min_voxels < 1 || min_voxels > 1000000)
+    bad("min_voxels", "must be an integer in [1, 1000000]", min_voxels);
+}
+
+ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
+  ChangeConfig c;
+  c.persist_sweeps = static_cast<int>(section.integer("persist_sweeps", c.persist_sweeps, 1, 1000));
+  c.margin = section.number("margin", c.margin, 0.0, 10.0);
+  c.min_voxels = static_cast<int>(section.integer("min_voxels", c.min_voxels, 1, 1000000));
+  section.expect_all_read();
+  return c;
+}
+
+bool ChangeRegion::contains(const Eigen::Vector3d& p_C) const {
+  return (p_C.array() >= min_C.array()).all() && (p_C.array() <= max_C.array()).all();
+}
+
+ChangeDetector::ChangeDetector(const ChangeConfig& config) : config_(config) {
+  config_.validate();
+}
+
+ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyMap& map) {
+  ChangeSet changes;
+  changes.sweep = ++sweep_;
+
+  // 1. Flips: a pending voxel that flips again is back at its confirmed state; any other starts pending.
+  auto flip = [&](const Key& key, bool now_occupied) {
+    const auto it = pending_.find(key);
+    if (it != pending_.end()) {
+      pending_.erase(it);
+    } else {
+      pending_.emplace(key, Pending{!now_occupied, 0});
+    }
+  };
+  for (const Key& key : update.appeared) flip(key, true);
+  for (const Key& key : update.vanished) flip(key, false);
+
+  // 2. Confirm the voxels whose new state has now held for persist_sweeps sweeps.
+  std::unordered_map<Key, bool, Key::KeyHash> confirmed;  // key → now occupied
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    if (++it->second.sweeps >= config_.persist_sweeps) {
+      confirmed.emplace(it->first, !it->second.was_occupied);
+      it = pending_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  if (confirmed.empty()) return changes;
+
+  // 3. Group by 26-connectivity, in sorted order so that the result is deterministic.
+  std::vector<Key> seeds;
+  seeds.reserve(confirmed.size());
+  for (const auto& entry : confirmed) seeds.push_back(entry.first);
+  std::sort(seeds.begin(), seeds.end(), zyx_less);
+  const double half = 0.5 * map.tree().getResolution();
+  KeySet grouped;
+  for (const Key& seed : seeds) {
+    if (!grouped.insert(seed).second) continue;
+    ChangeRegion region;
+    int off_surface = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+    Eigen::Vector3d hi = -lo;
+    std::vector<Key> stack = {seed};
+    while (!stack.empty()) {
+      const Key key = stack.back();
+      stack.pop_back();
+      (confirmed.at(key) ? region.appeared : region.vanished).push_back(key);
+      const Eigen::Vector3d c = map.centre(key);
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+      bool touches_unchanged_surface = false;
+      for_each_neighbour(key, [&](const Key& n) {
+        if (confirmed.count(n) != 0) {
+          if (grouped.insert(n).second) stack.push_back(n);
+        } else if (!touches_unchanged_surface && pending_.count(n) == 0 &&
+                   map.state(n) == VoxelState::occupied) {
+          touches_unchanged_surface = true;
+        }
+      });
+      if (!touches_unchanged_surface) ++off_surface;
+    }
+    if (off_surface < config_.min_voxels) continue;  // surface jitter
+    std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
+    std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
+    region.min_C = lo.array() - half - config_.margin;
+    region.max_C = hi.array() + half + config_.margin;
+    changes.regions.push_back(std::move(region));
+  }
+  return changes;
+}
+
+}  // namespace cellmap

@@ -1,0 +1,75 @@
+#include "cellmap/collision/batch.hpp"
+
+#include <algorithm>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::collision {
+namespace {
+
+ConstraintSet empty_set(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                        const std::vector<Obb>& environment) {
+  ConstraintSet set;
+  set.n_checkpoints = static_cast<int>(robot_at_checkpoints.size());
+  set.n_rob = robot_at_checkpoints.empty() ? 0 : static_cast<int>(robot_at_checkpoints.front().size());
+  set.n_env = static_cast<int>(environment.size());
+  for (std::size_t k = 0; k < robot_at_checkpoints.size(); ++k) {
+    if (static_cast<int>(robot_at_checkpoints[k].size()) != set.n_rob) {
+      throw Error("constraints: checkpoint " + std::to_string(k) + " has " +
+                  std::to_string(robot_at_checkpoints[k].size()) + " robot boxes, checkpoint 0 has " +
+                  std::to_string(set.n_rob));
+    }
+  }
+  return set;
+}
+
+}  // namespace
+
+double ConstraintSet::min_distance() const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Constraint& c : entries) best = std::min(best, c.result.distance);
+  return best;
+}
+
+bool ConstraintSet::clear(double margin) const {
+  return margin < cutoff && min_distance() >= margin;
+}
+
+ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                          const std::vector<Obb>& environment) {
+  ConstraintSet set = empty_set(robot_at_checkpoints, environment);
+  set.entries.reserve(set.n_constr());
+  for (int k = 0; k < set.n_checkpoints; ++k) {
+    for (int r = 0; r < set.n_rob; ++r) {
+      const Obb& robot_box = robot_at_checkpoints[k][r];
+      for (int e = 0; e < set.n_env; ++e) {
+        set.entries.push_back({k, r, e, signed_distance(robot_box, environment[e])});
+      }
+    }
+  }
+  return set;
+}
+
+ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                          const std::vector<Obb>& environment, const BoxTree& tree, double cutoff) {
+  if (tree.size() != environment.size()) {
+    throw Error("constraints: the box tree holds " + std::to_string(tree.size()) +
+                " boxes, the environment " + std::to_string(environment.size()));
+  }
+  if (!(cutoff > 0.0)) throw Error("constraints: cutoff must be > 0");
+  ConstraintSet set = empty_set(robot_at_checkpoints, environment);
+  set.cutoff = cutoff;
+  std::vector<int> near;
+  for (int k = 0; k < set.n_checkpoints; ++k) {
+    for (int r = 0; r < set.n_rob; ++r) {
+      const Obb& robot_box = robot_at_checkpoints[k][r];
+      near.clear();
+      tree.query(robot_box.center, robot_box.aabb_half_extents(), cutoff, &near);
+      std::sort(near.begin(), near.end());
+      for (const int e : near) set.entries.push_back({k, r, e, signed_distance(robot_box, environment[e])});
+    }
+  }
+  return set;
+}
+
+}  // namespace cellmap::collision

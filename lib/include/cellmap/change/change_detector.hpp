@@ -1,0 +1,90 @@
+#pragma once
+// Change detection: which parts of the occupancy map changed, as connected regions with bounds, with
+// hysteresis so that sensor noise does not produce changes.
+
+#include <octomap/OcTree.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/occupancy/occupancy_map.hpp"
+
+namespace cellmap {
+
+/// Parameters of change detection (YAML section `change`).
+struct ChangeConfig final {
+  /// Sweeps a voxel's new occupied/free state must hold, counting the sweep it flipped in, before the flip
+  /// counts (`change.persist_sweeps`, ≥ 1; default 3). A voxel that flips back earlier never counts.
+  int persist_sweeps = 3;
+  /// Metres added on every side of a region's bounds (`change.margin`, ≥ 0; default 0.05).
+  double margin = 0.05;
+  /// A region is reported only when at least this many of its voxels lie off the unchanged surface, i.e. have
+  /// no unchanged occupied 26-neighbour (`change.min_voxels`, ≥ 1; default 2). Depth noise only moves a
+  /// surface by a voxel, so its flips all touch the surface they belong to and never make a region.
+  int min_voxels = 2;
+
+  /// @throws Error naming the field if a value is out of range.
+  void validate() const;
+  /// Reads the `change` section (keys persist_sweeps, margin, min_voxels; absent keys keep their defaults).
+  /// @throws Error naming the key ("change.margin: ...") for unknown keys, wrong types or bad ranges.
+  [[nodiscard]] static ChangeConfig from_yaml(YamlMap section);
+};
+
+/// One connected group (26-connectivity) of voxels whose change was confirmed in the same sweep.
+struct ChangeRegion final {
+  Eigen::Vector3d min_C;  ///< lower corner of the changed voxels' extent minus the margin, metres, cell frame
+  Eigen::Vector3d max_C;  ///< upper corner plus the margin
+  std::vector<octomap::OcTreeKey>
+      appeared;  ///< voxels now occupied that were free or unknown, sorted (z, y, x)
+  std::vector<octomap::OcTreeKey> vanished;  ///< voxels now free that were occupied, sorted (z, y, x)
+
+  /// Whether p_C lies inside the bounds.
+  [[nodiscard]] bool contains(const Eigen::Vector3d& p_C) const;
+};
+
+/// The changes confirmed after one sweep; regions in the (z, y, x) order of their first voxel.
+struct ChangeSet final {
+  std::uint64_t sweep = 0;  ///< 1 for the first sweep given to the detector
+  std::vector<ChangeRegion> regions;
+  [[nodiscard]] bool empty() const { return regions.empty(); }
+};
+
+/// Turns the voxel flips of each sweep (OccupancyUpdate) into confirmed change regions.
+///
+/// A voxel that flips becomes pending with the state it had before; it is confirmed once it has held its new
+/// state for `persist_sweeps` sweeps, and dropped if it flips back first. Confirmed voxels of one sweep are
+/// grouped by 26-connectivity; a group is reported when at least `min_voxels` of its voxels have no occupied
+/// 26-neighbour that is itself unchanged (the others are surface jitter; so objects less than 2 voxels tall
+/// on a surface go unreported). A new object placed in observed free space is reported after
+/// `OccupancyConfig::sweeps_to_occupy() + persist_sweeps - 1` sweeps that see it (5 with the defaults), and a
+/// removed one after `OccupancyConfig::sweeps_to_clear() + persist_sweeps - 1` sweeps that see through where
+/// it was (11 with the defaults). The first sweeps report the scene itself as appeared (a change from the
+/// empty map). Not thread-safe; keep one detector per map.
+class ChangeDetector final {
+ public:
+  /// @throws Error if `config` is invalid.
+  explicit ChangeDetector(const ChangeConfig& config = {});
+
+  /// Call once per sweep, right after `map.integrate(sweep)` returned `update`.
+  [[nodiscard]] ChangeSet update(const OccupancyUpdate& update, const OccupancyMap& map);
+
+  /// Voxels whose flip is still waiting for confirmation.
+  [[nodiscard]] std::size_t pending() const { return pending_.size(); }
+  [[nodiscard]] const ChangeConfig& config() const { return config_; }
+
+ private:
+  struct Pending {
+    bool was_occupied;  // the state before the flip (the last confirmed state)
+    int sweeps;         // sweeps the new state has held, counting the flip's sweep
+  };
+  ChangeConfig config_;
+  std::uint64_t sweep_ = 0;
+  std::unordered_map<octomap::OcTreeKey, Pending, octomap::OcTreeKey::KeyHash> pending_;
+};
+
+}  // namespace cellmap

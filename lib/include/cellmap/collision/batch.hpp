@@ -1,0 +1,56 @@
+#pragma once
+// Batch distance queries: robot boxes × environment boxes × checkpoints → the constraint vector of the paper.
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+#include "cellmap/collision/box_distance.hpp"
+#include "cellmap/collision/box_tree.hpp"
+#include "cellmap/collision/obb.hpp"
+
+namespace cellmap::collision {
+
+/// One constraint: robot box `robot_box` at checkpoint `checkpoint` against environment box `env_box`.
+/// distance, points and normal as SignedDistance (A = robot box, B = environment box), cell frame.
+struct Constraint final {
+  int checkpoint = 0;
+  int robot_box = 0;
+  int env_box = 0;
+  SignedDistance result;
+};
+
+/// The constraint vector of a path: the paper counts n_constr = n_rob · n_env · N. `entries` holds all of
+/// them (dense, ordered by checkpoint, robot box, environment box) unless a cutoff was used; then only the
+/// pairs whose bounds come closer than the cutoff are listed, the others being at least `cutoff` away.
+struct ConstraintSet final {
+  int n_rob = 0;
+  int n_env = 0;
+  int n_checkpoints = 0;
+  double cutoff = std::numeric_limits<double>::infinity();
+  std::vector<Constraint> entries;
+
+  [[nodiscard]] std::size_t n_constr() const {
+    return static_cast<std::size_t>(n_rob) * static_cast<std::size_t>(n_env) * n_checkpoints;
+  }
+  /// Smallest signed distance among the entries (+infinity if none).
+  [[nodiscard]] double min_distance() const;
+  /// True when every entry keeps the safety margin δ (distance >= margin) and margin < cutoff, so skipped
+  /// pairs keep it too.
+  [[nodiscard]] bool clear(double margin) const;
+};
+
+/// Computes the constraints for `robot_at_checkpoints[k]` (the robot's boxes at checkpoint k, all of equal
+/// count) against `environment`. Dense: every pair. Thread-safe (pure).
+[[nodiscard]] ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                                        const std::vector<Obb>& environment);
+
+/// As above with a broad phase: `tree` must be built over `environment`; only pairs whose bounds come closer
+/// than `cutoff` (> 0, metres, e.g. the safety margin plus the planner's influence distance) are computed.
+[[nodiscard]] ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                                        const std::vector<Obb>& environment, const BoxTree& tree,
+                                        double cutoff);
+
+}  // namespace cellmap::collision

@@ -1,0 +1,72 @@
+#pragma once
+// The occupancy map: an octomap::OcTree that each sweep updates with hits at the points and free-space
+// evidence along the rays from each scan's origin.
+
+#include <octomap/OcTree.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <vector>
+
+#include "cellmap/occupancy/occupancy_config.hpp"
+#include "cellmap/sweep/sweep.hpp"
+
+namespace cellmap {
+
+/// What one sweep did to the map. Keys are leaf keys of `OccupancyMap::tree()`, sorted by (z, y, x).
+struct OccupancyUpdate final {
+  std::size_t hit_voxels = 0;                ///< voxels that received a hit
+  std::size_t free_voxels = 0;               ///< voxels that received free-space evidence
+  std::vector<octomap::OcTreeKey> appeared;  ///< voxels occupied now that were free or unknown before
+  std::vector<octomap::OcTreeKey> vanished;  ///< voxels free now that were occupied before
+};
+
+/// Occupancy of one voxel. Unknown = never observed.
+enum class VoxelState { unknown, free, occupied };
+
+/// The fused occupancy of the cell (frame C) at `OccupancyConfig::resolution`. Each sweep updates every voxel
+/// it observes exactly once: +log-odds(hit) where it holds a point, +log-odds(miss) where a ray from a scan
+/// origin crosses it (never both; occupied wins), so a removed object that the sensor now sees through
+/// becomes free after `config().sweeps_to_clear()` sweeps. Not copyable (a map can hold millions of nodes);
+/// movable. Not thread-safe: one writer, and no readers during `integrate`.
+class OccupancyMap final {
+ public:
+  /// @throws Error if `config` is invalid (see OccupancyConfig::validate).
+  explicit OccupancyMap(const OccupancyConfig& config = {});
+  OccupancyMap(const OccupancyMap&) = delete;
+  OccupancyMap& operator=(const OccupancyMap&) = delete;
+  OccupancyMap(OccupancyMap&&) = default;
+  OccupancyMap& operator=(OccupancyMap&&) = default;
+
+  /// Fuses one sweep: computes its occupied and free voxels (compute_key_update, on config().threads
+  /// threads), applies them with lazy inner-node updates and refreshes the inner nodes once. Cost is
+  /// dominated by the number of distinct voxels observed, not by the number of points. Non-finite points are
+  /// skipped.
+  /// @return the voxels whose occupied/free state flipped, for change detection.
+  /// @throws Error if a scan origin is not finite or outside the map's key range.
+  OccupancyUpdate integrate(const Sweep& sweep);
+
+  /// State of the voxel holding `p_C` (metres, cell frame); unknown outside the key range.
+  [[nodiscard]] VoxelState state(const Eigen::Vector3d& p_C) const;
+  /// State of the leaf voxel `key`.
+  [[nodiscard]] VoxelState state(const octomap::OcTreeKey& key) const;
+  /// Centre of the leaf voxel `key`, metres, cell frame.
+  [[nodiscard]] Eigen::Vector3d centre(const octomap::OcTreeKey& key) const;
+  /// Leaf keys of all occupied voxels, sorted by (z, y, x).
+  [[nodiscard]] std::vector<octomap::OcTreeKey> occupied_keys() const;
+
+  /// The OcTree itself (for queries, writing .bt files, or comparison); its parameters are the config's.
+  [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
+  [[nodiscard]] const OccupancyConfig& config() const { return config_; }
+
+ private:
+  OccupancyConfig config_;
+  std::unique_ptr<octomap::OcTree> tree_;
+};
+
+/// Applies `config`'s sensor model (hit, miss, clamps, threshold) to `tree` — also for reference trees fed
+/// with OcTree::insertPointCloud, so that both use the same parameters.
+void apply_sensor_model(const OccupancyConfig& config, octomap::OcTree& tree);
+
+}  // namespace cellmap

@@ -1,0 +1,41 @@
+#pragma once
+// The paper's comparison (section 5.3, fig. 6b): a cube moved along y past a row of boxes; its minimum
+// distance by GJK and by bounding spheres with N = 1, 2, 6 per box, and the constraints each method costs.
+//
+// Scene (cell frame, metres): the moving cube has half extents 0.1 and centre (0, y, 0.1), y from −1.5 to 1.5
+// in steps of 0.01 (301 checkpoints). The row: three boxes of half extents (0.1, 0.2, 0.1) centred at x =
+// 0.4, z = 0.1 and y = −0.8, 0, 0.8; the middle one is turned 30° about z. The cube's face is 0.2 from the
+// outer boxes' faces and 0.1134 from the turned box's nearest edge.
+
+#include <string>
+#include <vector>
+
+#include "cellmap/collision/obb.hpp"
+
+namespace cellmap::planning {
+
+struct PaperFigure final {
+  std::vector<double> y;           ///< cube centre y per checkpoint
+  std::vector<double> gjk;         ///< exact minimum signed distance (GJK/EPA) per checkpoint
+  std::vector<double> spheres[3];  ///< sphere-method minimum distance for N = 1, 2, 6 per checkpoint
+  static constexpr int kSphereCounts[3] = {1, 2, 6};
+  int n_rob = 1;
+  int n_env = 3;
+};
+
+/// The scene's row of boxes and the cube at centre y (see above).
+[[nodiscard]] std::vector<collision::Obb> paper_row();
+[[nodiscard]] collision::Obb paper_cube(double y);
+
+/// Computes the four curves. Pure; a few milliseconds.
+[[nodiscard]] PaperFigure compute_paper_figure();
+
+/// CSV with header exactly `y;dist_gjk;dist_sphere_n1;dist_sphere_n2;dist_sphere_n6`, one row per checkpoint.
+[[nodiscard]] std::string paper_figure_csv(const PaperFigure& figure);
+/// A self-contained SVG line plot of the four curves (distance over y), with axes and legend.
+[[nodiscard]] std::string paper_figure_svg(const PaperFigure& figure);
+/// Markdown table: constraints per checkpoint and over the whole sweep for each method
+/// (GJK: n_rob · n_env; spheres: n_rob · n_env · N², every robot sphere against every environment sphere).
+[[nodiscard]] std::string paper_constraint_table(const PaperFigure& figure);
+
+}  // namespace cellmap::planning

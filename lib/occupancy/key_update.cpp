@@ -1,0 +1,490 @@
+#include "cellmap/occupancy/key_update.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <thread>
+
+#include "cellmap/common/error.hpp"
+
+// Written here rather than taken from OctoMap: OcTree::insertPointCloud walks every ray into a per-ray KeyRay
+// and inserts every step into an unordered_set (1.2 s per 640×480 frame at 2 cm); this walks only the
+// distinct endpoint voxels and marks steps in a dense bit set, on several threads.
+
+namespace cellmap {
+namespace {
+
+using Key = octomap::OcTreeKey;
+
+// Packs a key as z:y:x so that numeric order is the (z, y, x) order of the dense index.
+std::uint64_t pack(const Key& k) {
+  return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
+}
+Key unpack(std::uint64_t p) {
+  return Key(static_cast<std::uint16_t>(p & 0xffff), static_cast<std::uint16_t>((p >> 16) & 0xffff),
+             static_cast<std::uint16_t>(p >> 32));
+}
+
+// An axis-aligned box of keys (inclusive bounds) with a dense index, x fastest.
+struct KeyBox {
+  int lo[3] = {std::numeric_limits<int>::max(), std::numeric_limits<int>::max(),
+               std::numeric_limits<int>::max()};
+  int hi[3] = {-1, -1, -1};
+
+  void extend(const Key& k) {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], int{k[i]});
+      hi[i] = std::max(hi[i], int{k[i]});
+    }
+  }
+  void extend(const KeyBox& other) {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], other.lo[i]);
+      hi[i] = std::max(hi[i], other.hi[i]);
+    }
+  }
+  // One voxel of slack on each side: a ray walk never leaves the box of its end voxels, but rounding at voxel
+  // corners may step one voxel aside before it stops.
+  void grow() {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::max(lo[i] - 1, 0);
+      hi[i] = std::min(hi[i] + 1, 0xffff);
+    }
+  }
+  [[nodiscard]] bool empty() const { return hi[0] < lo[0]; }
+  [[nodiscard]] std::uint64_t size(int i) const { return static_cast<std::uint64_t>(hi[i] - lo[i] + 1); }
+  [[nodiscard]] std::uint64_t volume() const { return empty() ? 0 : size(0) * size(1) * size(2); }
+  [[nodiscard]] bool contains(const Key& k) const {
+    return k[0] >= lo[0] && k[0] <= hi[0] && k[1] >= lo[1] && k[1] <= hi[1] && k[2] >= lo[2] && k[2] <= hi[2];
+  }
+  [[nodiscard]] std::uint64_t index(const Key& k) const {
+    return (std::uint64_t(k[2] - lo[2]) * size(1) + std::uint64_t(k[1] - lo[1])) * size(0) +
+           std::uint64_t(k[0] - lo[0]);
+  }
+  [[nodiscard]] Key key(std::uint64_t index) const {
+    const std::uint64_t x = index % size(0);
+    const std::uint64_t yz = index / size(0);
+    return Key(static_cast<std::uint16_t>(lo[0] + x), static_cast<std::uint16_t>(lo[1] + yz % size(1)),
+               static_cast<std::uint16_t>(lo[2] + yz / size(1)));
+  }
+};
+
+// Boxes larger than this fall back to sorting packed keys (a 2^28-bit set is 32 MB).
+constexpr std::uint64_t kMaxDenseVoxels = std::uint64_t{1} << 28;
+constexpr int kBrickWords = KeyBrick::kVoxels / 64;
+
+// Spreads the 4 bits of v to bits 0, 3, 6, 9.
+constexpr std::array<std::uint16_t, 16> kSpread4 = [] {
+  std::array<std::uint16_t, 16> table{};
+  for (int v = 0; v < 16; ++v) {
+    int out = 0;
+    for (int b = 0; b < 4; ++b) out |= ((v >> b) & 1) << (3 * b);
+    table[std::size_t(v)] = static_cast<std::uint16_t>(out);
+  }
+  return table;
+}();
+
+// The 48-bit interleave of a key (x lowest in each triple): the OcTree's depth-first order.
+std::uint64_t morton(const Key& k) {
+  std::uint64_t out = 0;
+  for (int b = 0; b < 16; ++b) {
+    for (int axis = 0; axis < 3; ++axis) out |= std::uint64_t((k[axis] >> b) & 1) << (3 * b + axis);
+  }
+  return out;
+}
+
+Key brick_base(const Key& k) {
+  return Key(static_cast<std::uint16_t>(k[0] & ~0xf), static_cast<std::uint16_t>(k[1] & ~0xf),
+             static_cast<std::uint16_t>(k[2] & ~0xf));
+}
+
+// The bricks of a key box (aligned outwards to whole bricks) as one dense bit array: brick after brick in
+// (z, y, x) order, each brick's 4096 bits in KeyBrick order.
+struct BrickGrid {
+  int lo[3];     // key of the first brick's base
+  int count[3];  // bricks per axis
+
+  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that the ray
+  // walk pays three loads per voxel. Entries outside the box hold an index past the end.
+  std::vector<std::uint32_t> offset[3];  // 32 bits: dense grids have at most 2^28 bits
+
+  explicit BrickGrid(const KeyBox& box) {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = box.lo[i] & ~0xf;
+      count[i] = ((box.hi[i] | 0xf) - lo[i] + 1) / KeyBrick::kEdge;
+    }
+    const std::uint64_t stride[3] = {KeyBrick::kVoxels, std::uint64_t(count[0]) * KeyBrick::kVoxels,
+                                     std::uint64_t(count[0]) * count[1] * KeyBrick::kVoxels};
+    for (int i = 0; i < 3; ++i) {
+      offset[i].resize(std::size_t(count[i]) * KeyBrick::kEdge);
+      for (std::size_t v = 0; v < offset[i].size(); ++v) {
+        offset[i][v] =
+            static_cast<std::uint32_t>((v >> 4) * stride[i] + (std::uint64_t(kSpread4[v & 0xf]) << i));
+      }
+    }
+  }
+  static constexpr std::uint32_t kOutside = ~std::uint32_t{0};
+  // Index of key (x, y, z) (dense grids only), or kOutside outside the box.
+  [[nodiscard]] std::uint32_t index(int x, int y, int z) const {
+    const std::size_t dx = std::size_t(x - lo[0]);
+    const std::size_t dy = std::size_t(y - lo[1]);
+    const std::size_t dz = std::size_t(z - lo[2]);
+    if (dx >= offset[0].size() || dy >= offset[1].size() || dz >= offset[2].size()) return kOutside;
+    return offset[0][dx] + offset[1][dy] + offset[2][dz];
+  }
+  [[nodiscard]] std::uint64_t bricks() const { return std::uint64_t(count[0]) * count[1] * count[2]; }
+  [[nodiscard]] std::uint64_t bits() const { return bricks() * KeyBrick::kVoxels; }
+  [[nodiscard]] Key brick_base(std::uint64_t brick) const {
+    const std::uint64_t bx = brick % count[0];
+    const std::uint64_t byz = brick / count[0];
+    return Key(static_cast<std::uint16_t>(lo[0] + 16 * bx),
+               static_cast<std::uint16_t>(lo[1] + 16 * (byz % count[1])),
+               static_cast<std::uint16_t>(lo[2] + 16 * (byz / count[1])));
+  }
+};
+
+void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
+  words[i >> 6] |= std::uint64_t{1} << (i & 63);
+}
+
+void sort_depth_first(std::vector<KeyBrick>& bricks) {
+  std::sort(bricks.begin(), bricks.end(),
+            [](const KeyBrick& a, const KeyBrick& b) { return morton(a.base) < morton(b.base); });
+}
+
+std::vector<std::uint64_t> sorted_unique(std::vector<std::uint64_t> packed) {
+  std::sort(packed.begin(), packed.end());
+  packed.erase(std::unique(packed.begin(), packed.end()), packed.end());
+  return packed;
+}
+
+class BitSet {
+ public:
+  explicit BitSet(std::uint64_t bits) : words_((bits + 63) / 64, 0) {}
+  // Returns whether the bit was already set.
+  bool test_and_set(std::uint64_t i) {
+    std::uint64_t& word = words_[i >> 6];
+    const std::uint64_t mask = std::uint64_t{1} << (i & 63);
+    const bool was = (word & mask) != 0;
+    word |= mask;
+    return was;
+  }
+
+ private:
+  std::vector<std::uint64_t> words_;
+};
+
+std::vector<Key> keys_of(const std::vector<KeyBrick>& bricks, bool occupied) {
+  std::vector<std::uint64_t> packed;
+  for (const KeyBrick& brick : bricks) {
+    const auto& words = occupied ? brick.occupied : brick.free;
+    for (int w = 0; w < kBrickWords; ++w) {
+      for (std::uint64_t word = words[std::size_t(w)]; word != 0; word &= word - 1) {
+        const Key k = brick.key(w * 64 + __builtin_ctzll(word));
+        packed.push_back(std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32));
+      }
+    }
+  }
+  std::sort(packed.begin(), packed.end());  // z:y:x packing sorts by (z, y, x)
+  std::vector<Key> out;
+  out.reserve(packed.size());
+  for (const std::uint64_t p : packed) out.push_back(unpack(p));
+  return out;
+}
+
+// The sensor origin of one scan, as OctoMap sees it (single precision).
+struct Origin {
+  float p[3];
+  Key key;
+};
+
+// One ray: from its scan's origin to `end` (a voxel centre, or the max-range point of a farther one).
+struct Ray {
+  float end[3];
+  Key end_key;
+  std::uint32_t origin;
+};
+
+// Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic
+// (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
+// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `mark` instead
+// of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
+// nothing.
+template <class Mark>
+void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Mark&& mark) {
+  if (origin.key == ray.end_key) return;
+  mark(int{origin.key[0]}, int{origin.key[1]}, int{origin.key[2]});
+
+  float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
+  const float norm_sq =
+      direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
+  const float length = static_cast<float>(std::sqrt(static_cast<double>(norm_sq)));
+  for (float& d : direction) d /= length;
+
+  const double resolution = grid.getResolution();
+  int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
+  int step[3];
+  double t_max[3];
+  double t_delta[3];
+  for (int i = 0; i < 3; ++i) {
+    step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
+    if (step[i] != 0) {
+      double border = grid.keyToCoord(static_cast<octomap::key_type>(key[i]));
+      border += static_cast<float>(step[i] * resolution * 0.5);
+      t_max[i] = (border - origin.p[i]) / direction[i];
+      t_delta[i] = resolution / std::fabs(direction[i]);
+    } else {
+      t_max[i] = std::numeric_limits<double>::max();
+      t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+
+  // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
+  int steps_left = 3;
+  for (int i = 0; i < 3; ++i) steps_left += std::abs(int{ray.end_key[i]} - key[i]);
+  while (steps_left-- > 0) {
+    int dim;
+    if (t_max[0] < t_max[1]) {
+      dim = t_max[0] < t_max[2] ? 0 : 2;
+    } else {
+      dim = t_max[1] < t_max[2] ? 1 : 2;
+    }
+    key[dim] += step[dim];
+    t_max[dim] += t_delta[dim];
+    if (key[0] == ray.end_key[0] && key[1] == ray.end_key[1] && key[2] == ray.end_key[2]) return;
+    // Past the end point without entering its voxel (rounding at a corner): stop, as OctoMap does.
+    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
+    mark(key[0], key[1], key[2]);
+  }
+}
+
+constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+
+// The distinct packed keys of `keys` (kNoKey entries skipped), in first-seen order (a bit set over their box,
+// or sorting when the box is huge).
+std::vector<Key> distinct(const std::vector<std::uint64_t>& keys, const KeyBox& box) {
+  std::vector<Key> out;
+  if (box.volume() > kMaxDenseVoxels) {
+    std::vector<std::uint64_t> packed;
+    packed.reserve(keys.size());
+    for (const std::uint64_t p : keys) {
+      if (p != kNoKey) packed.push_back(p);
+    }
+    for (const std::uint64_t p : sorted_unique(std::move(packed))) out.push_back(unpack(p));
+    return out;
+  }
+  BitSet seen(box.volume());
+  for (const std::uint64_t p : keys) {
+    if (p == kNoKey) continue;
+    const Key k = unpack(p);
+    if (!seen.test_and_set(box.index(k))) out.push_back(k);
+  }
+  return out;
+}
+
+// Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
+template <class Fn>
+void run_parallel(int threads, std::size_t n, Fn&& fn) {
+  const std::size_t count = std::size_t(std::max(threads, 1));
+  const std::size_t chunk = (n + count - 1) / count;
+  std::vector<std::thread> workers;
+  for (std::size_t t = 1; t < count; ++t) {
+    workers.emplace_back([&, t] { fn(std::min(n, t * chunk), std::min(n, (t + 1) * chunk), t); });
+  }
+  fn(0, std::min(n, chunk), 0);
+  for (std::thread& w : workers) w.join();
+}
+
+}  // namespace
+
+int KeyBrick::local_index(const octomap::OcTreeKey& key) {
+  return kSpread4[key[0] & 0xf] | (kSpread4[key[1] & 0xf] << 1) | (kSpread4[key[2] & 0xf] << 2);
+}
+
+octomap::OcTreeKey KeyBrick::key(int index) const {
+  int offset[3] = {0, 0, 0};
+  for (int b = 0; b < 4; ++b) {
+    for (int axis = 0; axis < 3; ++axis) offset[axis] |= ((index >> (3 * b + axis)) & 1) << b;
+  }
+  return Key(static_cast<std::uint16_t>(base[0] + offset[0]), static_cast<std::uint16_t>(base[1] + offset[1]),
+             static_cast<std::uint16_t>(base[2] + offset[2]));
+}
+
+std::vector<octomap::OcTreeKey> KeyUpdate::occupied_keys() const {
+  return keys_of(bricks, true);
+}
+std::vector<octomap::OcTreeKey> KeyUpdate::free_keys() const {
+  return keys_of(bricks, false);
+}
+
+KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, double max_range, int threads) {
+  if (!(max_range > 0.0)) throw Error("occupancy: max_range must be > 0, got " + std::to_string(max_range));
+  threads = std::max(threads, 1);
+
+  // OctoMap's coordToKey arithmetic, inlined (it is out of line in the library and costs ~10 % here).
+  const double factor = 1.0 / grid.getResolution();
+  const int max_val = int(grid.coordToKey(0.0));  // the key of coordinate 0 is the tree's key offset
+  auto to_key = [factor, max_val](float x, float y, float z, Key& key) {
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return false;
+    const float c[3] = {x, y, z};
+    for (int i = 0; i < 3; ++i) {
+      const double scaled = std::floor(factor * double(c[i]));
+      if (!(scaled >= -max_val && scaled < max_val)) return false;
+      key[i] = static_cast<octomap::key_type>(int(scaled) + max_val);
+    }
+    return true;
+  };
+
+  // 1. Per scan: distinct endpoint voxels; those within range are hits, every one gets a ray.
+  std::vector<Origin> origins;
+  std::vector<Ray> rays;
+  std::vector<Key> hits;
+  KeyBox box;
+  for (std::size_t s = 0; s < sweep.scans.size(); ++s) {
+    const Scan& scan = sweep.scans[s];
+    Origin origin{};
+    for (int i = 0; i < 3; ++i) origin.p[i] = static_cast<float>(scan.origin_C[i]);
+    if (!scan.origin_C.allFinite() ||
+        !grid.coordToKeyChecked(origin.p[0], origin.p[1], origin.p[2], origin.key)) {
+      throw Error("occupancy: scan " + std::to_string(s) + " of the sweep has its origin outside the map");
+    }
+    origins.push_back(origin);
+    box.extend(origin.key);
+
+    // Points to keys on all threads; a point that is not finite or outside the map gets kNoKey.
+    const auto& points = scan.points_C.points;
+    std::vector<std::uint64_t> point_keys(points.size());
+    std::vector<KeyBox> thread_boxes(static_cast<std::size_t>(threads));
+    run_parallel(threads, points.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+      for (std::size_t i = begin; i < end; ++i) {
+        Key k;
+        if (to_key(points[i].x, points[i].y, points[i].z, k)) {
+          point_keys[i] = pack(k);
+          thread_boxes[t].extend(k);
+        } else {
+          point_keys[i] = kNoKey;
+        }
+      }
+    });
+    KeyBox scan_box;
+    for (const KeyBox& b : thread_boxes) {
+      if (!b.empty()) scan_box.extend(b);
+    }
+    if (scan_box.empty()) continue;
+
+    for (const Key& k : distinct(point_keys, scan_box)) {
+      Ray ray{};
+      const octomap::point3d centre = grid.keyToCoord(k);
+      float offset[3];
+      float norm_sq = 0.0f;
+      for (int i = 0; i < 3; ++i) {
+        offset[i] = centre(i) - origin.p[i];
+        norm_sq += offset[i] * offset[i];
+      }
+      const double distance = std::sqrt(static_cast<double>(norm_sq));
+      if (distance <= max_range) {
+        for (int i = 0; i < 3; ++i) ray.end[i] = centre(i);
+        ray.end_key = k;
+        hits.push_back(k);
+      } else {
+        // Clear free space up to max range only (the truncated end voxel itself is not cleared).
+        // Same rounding as OctoMap: normalize in single precision, then scale.
+        for (int i = 0; i < 3; ++i) {
+          ray.end[i] =
+              origin.p[i] + (offset[i] / static_cast<float>(distance)) * static_cast<float>(max_range);
+        }
+        if (!grid.coordToKeyChecked(ray.end[0], ray.end[1], ray.end[2], ray.end_key)) continue;
+      }
+      ray.origin = static_cast<std::uint32_t>(s);
+      box.extend(ray.end_key);
+      rays.push_back(ray);
+    }
+  }
+  KeyUpdate update;
+  if (rays.empty()) return update;
+  box.grow();
+
+  // 2. Walk the rays on `threads` threads, each into its own set; the union does not depend on the split.
+  const BrickGrid grid_bits(box);
+  const bool dense = grid_bits.bits() <= kMaxDenseVoxels;
+  std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
+  const std::uint64_t bits = grid_bits.bits();
+  run_parallel(threads, rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+    std::vector<std::uint64_t>& set = sets[t];
+    if (dense) {
+      set.assign(bits / 64, 0);
+      std::uint64_t* words = set.data();
+      for (std::size_t r = begin; r < end; ++r) {
+        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
+          const std::uint32_t i = grid_bits.index(x, y, z);
+          if (i < bits) words[i >> 6] |= std::uint64_t{1} << (i & 63);
+        });
+      }
+    } else {
+      for (std::size_t r = begin; r < end; ++r) {
+        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
+          set.push_back(std::uint64_t(x) | (std::uint64_t(y) << 16) | (std::uint64_t(z) << 32));
+        });
+      }
+    }
+  });
+
+  // 3. Union the threads' sets, remove the hits from the free voxels, and keep the non-empty bricks.
+  if (dense) {
+    std::vector<std::uint64_t> occupied(bits / 64, 0);
+    for (const Key& k : hits) set_bit(occupied, grid_bits.index(k[0], k[1], k[2]));
+    std::vector<std::uint64_t>& free = sets[0];
+    for (std::size_t t = 1; t < sets.size(); ++t) {
+      for (std::size_t w = 0; w < free.size(); ++w) free[w] |= sets[t][w];
+    }
+    for (std::uint64_t b = 0; b < grid_bits.bricks(); ++b) {
+      KeyBrick brick;
+      std::uint64_t any = 0;
+      for (int w = 0; w < kBrickWords; ++w) {
+        const std::size_t i = std::size_t(b) * kBrickWords + std::size_t(w);
+        brick.occupied[std::size_t(w)] = occupied[i];
+        brick.free[std::size_t(w)] = free[i] & ~occupied[i];
+        any |= occupied[i] | free[i];
+        update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
+        update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
+      }
+      if (any == 0) continue;
+      brick.base = grid_bits.brick_base(b);
+      update.bricks.push_back(brick);
+    }
+  } else {
+    std::vector<std::uint64_t> all;
+    for (auto& set : sets) all.insert(all.end(), set.begin(), set.end());
+    std::vector<std::uint64_t> packed_hits;
+    for (const Key& k : hits) packed_hits.push_back(pack(k));
+    const std::vector<std::uint64_t> occupied = sorted_unique(std::move(packed_hits));
+    const std::vector<std::uint64_t> crossed = sorted_unique(std::move(all));
+    std::map<std::uint64_t, KeyBrick> bricks;  // by packed brick base
+    auto brick_of = [&](const Key& k) -> KeyBrick& {
+      KeyBrick& brick = bricks[pack(brick_base(k))];
+      brick.base = brick_base(k);
+      return brick;
+    };
+    for (const std::uint64_t p : occupied) {
+      const Key k = unpack(p);
+      const int i = KeyBrick::local_index(k);
+      brick_of(k).occupied[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
+      ++update.occupied_count;
+    }
+    for (const std::uint64_t p : crossed) {
+      if (std::binary_search(occupied.begin(), occupied.end(), p)) continue;
+      const Key k = unpack(p);
+      const int i = KeyBrick::local_index(k);
+      brick_of(k).free[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
+      ++update.free_count;
+    }
+    for (auto& entry : bricks) update.bricks.push_back(entry.second);
+  }
+  sort_depth_first(update.bricks);
+  return update;
+}
+
+}  // namespace cellmap

@@ -1,0 +1,196 @@
+#include "cellmap/occupancy/occupancy_map.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+#include "cellmap/occupancy/key_update.hpp"
+
+namespace cellmap {
+namespace {
+
+bool zyx_less(const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
+  return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
+}
+
+// Applies a KeyUpdate to an OcTree brick by brick, descending each subtree once instead of once per voxel.
+// Written here because OctoMap has no batch update: per voxel, updateNode() searches the key from the root
+// and descends again (≈ 0.3 µs per voxel, ~1.6 M free voxels per 640×480 frame). This walk follows
+// updateNode(key, occupied, lazy_eval = true)'s rules exactly — the early abort for voxels already at the
+// clamp bound (it neither expands nor creates nodes for them), expanding pruned nodes, creating missing
+// children with log-odds 0, clamped log-odds updates — so every leaf ends as updateNode() would leave it.
+// Instead of one updateInnerOccupancy() over the whole tree, it refreshes the inner nodes it visited (the
+// others did not change) and prunes them as OctoMap's non-lazy insert does, so free space stays compact.
+class BatchApplier {
+ public:
+  BatchApplier(octomap::OcTree& tree, OccupancyUpdate& out)
+      : tree_(tree),
+        out_(out),
+        depth_(tree.getTreeDepth()),
+        hit_(tree.getProbHitLog()),
+        miss_(tree.getProbMissLog()),
+        clamp_min_(tree.getClampingThresMinLog()),
+        clamp_max_(tree.getClampingThresMaxLog()) {}
+
+  void apply(KeyBrick brick) {
+    if (tree_.getRoot() == nullptr) {
+      // The root can only be created through updateNode(); let it apply the brick's first voxel (non-lazy so
+      // that the path's inner values are right), then batch the rest.
+      const bool occupied = any(brick.occupied, 0, KeyBrick::kVoxels);
+      auto& words = occupied ? brick.occupied : brick.free;
+      const int first = first_bit(words);
+      const octomap::OcTreeKey key = brick.key(first);
+      words[std::size_t(first >> 6)] &= ~(std::uint64_t{1} << (first & 63));
+      const octomap::OcTreeNode* node = tree_.updateNode(key, occupied, false);
+      if (occupied && tree_.isNodeOccupied(node)) out_.appeared.push_back(key);
+    }
+    brick_ = &brick;
+    visit(tree_.getRoot(), 0, false, 0, KeyBrick::kVoxels);
+  }
+
+ private:
+  static constexpr unsigned kBrickDepthFromLeaf = 4;  // a brick is a subtree 4 levels above the leaves
+
+  static bool any(const std::array<std::uint64_t, KeyBrick::kVoxels / 64>& words, int begin, int count) {
+    if (count >= 64) {
+      for (int w = begin >> 6; w < (begin + count) >> 6; ++w) {
+        if (words[std::size_t(w)] != 0) return true;
+      }
+      return false;
+    }
+    const std::uint64_t mask = ((std::uint64_t{1} << count) - 1) << (begin & 63);
+    return (words[std::size_t(begin >> 6)] & mask) != 0;
+  }
+  static int first_bit(const std::array<std::uint64_t, KeyBrick::kVoxels / 64>& words) {
+    for (int w = 0;; ++w) {
+      if (words[std::size_t(w)] != 0) return w * 64 + __builtin_ctzll(words[std::size_t(w)]);
+    }
+  }
+
+  // Whether any voxel of the bit range would change a node holding `log_odds` (updateNode's early abort).
+  bool needs_update(float log_odds, int begin, int count) const {
+    return (log_odds < clamp_max_ && any(brick_->occupied, begin, count)) ||
+           (log_odds > clamp_min_ && any(brick_->free, begin, count));
+  }
+
+  void update_leaf(octomap::OcTreeNode* node, bool created, int index) {
+    const bool occupied = (brick_->occupied[std::size_t(index >> 6)] >> (index & 63)) & 1;
+    const bool was_occupied = !created && tree_.isNodeOccupied(node);
+    tree_.updateNodeLogOdds(node, occupied ? hit_ : miss_);
+    const bool now_occupied = tree_.isNodeOccupied(node);
+    if (now_occupied && !was_occupied) out_.appeared.push_back(brick_->key(index));
+    if (!now_occupied && was_occupied) out_.vanished.push_back(brick_->key(index));
+  }
+
+  // `node` covers bit range [begin, begin + count) of the brick at tree depth `depth`; above the brick's
+  // depth the range is the whole brick and only the path towards it is followed.
+  void visit(octomap::OcTreeNode* node, unsigned depth, bool created, int begin, int count) {
+    if (!created && !tree_.nodeHasChildren(node)) {
+      // An existing leaf or pruned block: where updateNode()'s search() stops.
+      if (!needs_update(node->getLogOdds(), begin, count)) return;
+      if (depth == depth_) {
+        update_leaf(node, false, begin);
+        return;
+      }
+      tree_.expandNode(node);
+    } else if (depth == depth_) {
+      update_leaf(node, created, begin);
+      return;
+    }
+    const unsigned brick_depth = depth_ - kBrickDepthFromLeaf;
+    if (depth < brick_depth) {
+      visit_child(node, octomap::computeChildIdx(brick_->base, int(depth_ - 1 - depth)), depth, begin, count);
+    } else {
+      const int part = count / 8;
+      for (unsigned pos = 0; pos < 8; ++pos) {
+        const int child_begin = begin + int(pos) * part;
+        if (any(brick_->occupied, child_begin, part) || any(brick_->free, child_begin, part)) {
+          visit_child(node, pos, depth, child_begin, part);
+        }
+      }
+    }
+    node->updateOccupancyChildren();
+    tree_.pruneNode(node);
+  }
+
+  void visit_child(octomap::OcTreeNode* node, unsigned pos, unsigned depth, int begin, int count) {
+    bool created = false;
+    if (!tree_.nodeChildExists(node, pos)) {
+      tree_.createNodeChild(node, pos);
+      created = true;
+    }
+    visit(tree_.getNodeChild(node, pos), depth + 1, created, begin, count);
+  }
+
+  octomap::OcTree& tree_;
+  OccupancyUpdate& out_;
+  const unsigned depth_;
+  const float hit_, miss_, clamp_min_, clamp_max_;
+  const KeyBrick* brick_ = nullptr;
+};
+
+}  // namespace
+
+void apply_sensor_model(const OccupancyConfig& config, octomap::OcTree& tree) {
+  tree.setProbHit(config.hit);
+  tree.setProbMiss(config.miss);
+  tree.setClampingThresMin(config.clamp_min);
+  tree.setClampingThresMax(config.clamp_max);
+  tree.setOccupancyThres(config.occupied_threshold);
+}
+
+OccupancyMap::OccupancyMap(const OccupancyConfig& config) : config_(config) {
+  config_.validate();
+  tree_ = std::make_unique<octomap::OcTree>(config_.resolution);
+  apply_sensor_model(config_, *tree_);
+}
+
+OccupancyUpdate OccupancyMap::integrate(const Sweep& sweep) {
+  const KeyUpdate keys = compute_key_update(sweep, *tree_, config_.max_range, config_.threads);
+  OccupancyUpdate update;
+  update.hit_voxels = keys.occupied_count;
+  update.free_voxels = keys.free_count;
+  BatchApplier applier(*tree_, update);
+  for (const KeyBrick& brick : keys.bricks) applier.apply(brick);
+  std::sort(update.appeared.begin(), update.appeared.end(), zyx_less);
+  std::sort(update.vanished.begin(), update.vanished.end(), zyx_less);
+  return update;
+}
+
+VoxelState OccupancyMap::state(const Eigen::Vector3d& p_C) const {
+  octomap::OcTreeKey key;
+  if (!p_C.allFinite() || !tree_->coordToKeyChecked(p_C.x(), p_C.y(), p_C.z(), key))
+    return VoxelState::unknown;
+  return state(key);
+}
+
+VoxelState OccupancyMap::state(const octomap::OcTreeKey& key) const {
+  const octomap::OcTreeNode* node = tree_->search(key);
+  if (node == nullptr) return VoxelState::unknown;
+  return tree_->isNodeOccupied(node) ? VoxelState::occupied : VoxelState::free;
+}
+
+Eigen::Vector3d OccupancyMap::centre(const octomap::OcTreeKey& key) const {
+  return {tree_->keyToCoord(key[0]), tree_->keyToCoord(key[1]), tree_->keyToCoord(key[2])};
+}
+
+std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
+  std::vector<octomap::OcTreeKey> keys;
+  const unsigned depth = tree_->getTreeDepth();
+  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+    if (!tree_->isNodeOccupied(*it)) continue;
+    if (it.getDepth() == depth) {
+      keys.push_back(it.getKey());
+      continue;
+    }
+    // A pruned leaf stands for a block of equal voxels: list each.
+    const int span = 1 << (depth - it.getDepth());
+    const octomap::OcTreeKey first = it.getIndexKey();
+    for (int z = 0; z < span; ++z)
+      for (int y = 0; y < span; ++y)
+        for (int x = 0; x < span; ++x) keys.emplace_back(first[0] + x, first[1] + y, first[2] + z);
+  }
+  std::sort(keys.begin(), keys.end(), zyx_less);
+  return keys;
+}
+
+}  // namespace cellmap

@@ -1,0 +1,149 @@
+#include "cellmap/planning/paper_figure.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "cellmap/collision/box_distance.hpp"
+#include "cellmap/collision/spheres.hpp"
+
+namespace cellmap::planning {
+
+using collision::Obb;
+using Eigen::Vector3d;
+
+std::vector<Obb> paper_row() {
+  const Vector3d half(0.1, 0.2, 0.1);
+  return {
+      Obb(Vector3d(0.4, -0.8, 0.1), half),
+      Obb(Vector3d(0.4, 0.0, 0.1), half, Eigen::AngleAxisd(M_PI / 6, Vector3d::UnitZ()).toRotationMatrix()),
+      Obb(Vector3d(0.4, 0.8, 0.1), half)};
+}
+
+Obb paper_cube(double y) {
+  return Obb(Vector3d(0.0, y, 0.1), Vector3d(0.1, 0.1, 0.1));
+}
+
+PaperFigure compute_paper_figure() {
+  PaperFigure figure;
+  const std::vector<Obb> row = paper_row();
+  figure.n_env = static_cast<int>(row.size());
+  std::vector<std::vector<collision::Sphere>> row_spheres[3];
+  for (int m = 0; m < 3; ++m) {
+    for (const Obb& box : row)
+      row_spheres[m].push_back(collision::sphere_cover(box, PaperFigure::kSphereCounts[m]));
+  }
+  for (int k = 0; k <= 300; ++k) {
+    const double y = -1.5 + 0.01 * k;
+    const Obb cube = paper_cube(y);
+    figure.y.push_back(y);
+    double gjk = std::numeric_limits<double>::infinity();
+    for (const Obb& box : row) gjk = std::min(gjk, collision::signed_distance(cube, box).distance);
+    figure.gjk.push_back(gjk);
+    for (int m = 0; m < 3; ++m) {
+      const auto cube_spheres = collision::sphere_cover(cube, PaperFigure::kSphereCounts[m]);
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& spheres : row_spheres[m])
+        best = std::min(best, collision::sphere_set_distance(cube_spheres, spheres));
+      figure.spheres[m].push_back(best);
+    }
+  }
+  return figure;
+}
+
+std::string paper_figure_csv(const PaperFigure& figure) {
+  std::ostringstream out;
+  out << "y;dist_gjk;dist_sphere_n1;dist_sphere_n2;dist_sphere_n6\n";
+  char line[160];
+  for (std::size_t k = 0; k < figure.y.size(); ++k) {
+    std::snprintf(line, sizeof line, "%.2f;%.9f;%.9f;%.9f;%.9f\n", figure.y[k], figure.gjk[k],
+                  figure.spheres[0][k], figure.spheres[1][k], figure.spheres[2][k]);
+    out << line;
+  }
+  return out.str();
+}
+
+std::string paper_figure_svg(const PaperFigure& figure) {
+  // Plot area in pixels and data ranges; the y range is padded to round 0.05 m steps.
+  const double width = 720, height = 420, left = 70, right = 170, top = 30, bottom = 50;
+  const double x0 = figure.y.front(), x1 = figure.y.back();
+  double lo = *std::min_element(figure.gjk.begin(), figure.gjk.end());
+  double hi = *std::max_element(figure.gjk.begin(), figure.gjk.end());
+  for (const auto& curve : figure.spheres) {
+    lo = std::min(lo, *std::min_element(curve.begin(), curve.end()));
+    hi = std::max(hi, *std::max_element(curve.begin(), curve.end()));
+  }
+  lo = std::floor(lo / 0.05) * 0.05;
+  hi = std::ceil(hi / 0.05) * 0.05;
+  const double plot_w = width - left - right, plot_h = height - top - bottom;
+  const auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * plot_w; };
+  const auto py = [&](double v) { return top + (hi - v) / (hi - lo) * plot_h; };
+  std::ostringstream svg;
+  char buffer[1024];
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+      << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  // Grid and tick labels.
+  for (double v = lo; v <= hi + 1e-9; v += 0.05) {
+    std::snprintf(buffer, sizeof buffer,
+                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>"
+                  "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
+                  left, py(v), left + plot_w, py(v), std::abs(v) < 1e-9 ? "#888" : "#e4e4e4", left - 6,
+                  py(v) + 4, v);
+    svg << buffer;
+  }
+  for (double x = x0; x <= x1 + 1e-9; x += 0.5) {
+    std::snprintf(buffer, sizeof buffer,
+                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>"
+                  "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%.1f</text>\n",
+                  px(x), top, px(x), top + plot_h, px(x), top + plot_h + 18, x);
+    svg << buffer;
+  }
+  std::snprintf(
+      buffer, sizeof buffer,
+      "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"black\"/>\n"
+      "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">cube centre y [m]</text>\n"
+      "<text x=\"16\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.1f)\">minimum "
+      "distance [m]</text>\n",
+      left, top, plot_w, plot_h, left + plot_w / 2, height - 10, top + plot_h / 2, top + plot_h / 2);
+  svg << buffer;
+  const std::vector<const std::vector<double>*> curves{&figure.gjk, &figure.spheres[0], &figure.spheres[1],
+                                                       &figure.spheres[2]};
+  const char* colours[] = {"#000000", "#d62728", "#1f77b4", "#2ca02c"};
+  const char* names[] = {"GJK (exact)", "spheres N = 1", "spheres N = 2", "spheres N = 6"};
+  for (std::size_t c = 0; c < curves.size(); ++c) {
+    svg << "<polyline fill=\"none\" stroke=\"" << colours[c] << "\" stroke-width=\"" << (c == 0 ? 2.0 : 1.5)
+        << "\" points=\"";
+    for (std::size_t k = 0; k < figure.y.size(); ++k) {
+      std::snprintf(buffer, sizeof buffer, "%.1f,%.1f ", px(figure.y[k]), py((*curves[c])[k]));
+      svg << buffer;
+    }
+    svg << "\"/>\n";
+    const double ly = top + 10 + 20.0 * c;
+    std::snprintf(buffer, sizeof buffer,
+                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"/>"
+                  "<text x=\"%.1f\" y=\"%.1f\">%s</text>\n",
+                  left + plot_w + 12, ly, left + plot_w + 36, ly, colours[c], left + plot_w + 42, ly + 4,
+                  names[c]);
+    svg << buffer;
+  }
+  svg << "</svg>\n";
+  return svg.str();
+}
+
+std::string paper_constraint_table(const PaperFigure& figure) {
+  const std::size_t checkpoints = figure.y.size();
+  const std::size_t pairs = static_cast<std::size_t>(figure.n_rob) * figure.n_env;
+  std::ostringstream out;
+  out << "| method | spheres per box | constraints per checkpoint | constraints for " << checkpoints
+      << " checkpoints |\n|---|---|---|---|\n";
+  out << "| GJK | - | " << pairs << " | " << pairs * checkpoints << " |\n";
+  for (int n : PaperFigure::kSphereCounts) {
+    const std::size_t per = pairs * n * n;
+    out << "| spheres | " << n << " | " << per << " | " << per * checkpoints << " |\n";
+  }
+  return out.str();
+}
+
+}  // namespace cellmap::planning

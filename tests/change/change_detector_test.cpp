@@ -1,0 +1,211 @@
+#include "cellmap/change/change_detector.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <random>
+#include <string>
+
+#include "cellmap/common/error.hpp"
+#include "occupancy/box_scene.hpp"
+
+namespace cellmap {
+namespace {
+
+using testing::AlignedBox;
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A table top (y down: its surface at y = 0.5) with a back wall, seen from 0.9 m above the table, looking
+// down.
+std::vector<AlignedBox> table_scene() {
+  return {{{-1.0, 0.5, 0.0}, {1.0, 0.6, 2.5}}, {{-1.0, -1.0, 2.2}, {1.0, 0.6, 2.3}}};
+}
+
+Eigen::Isometry3d camera_pose() {
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+  X_CS.translate(Eigen::Vector3d(0.003, -0.4, 0.007));
+  X_CS.rotate(Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX()));
+  return X_CS;
+}
+
+// Narrow-angle frames: rays about 1 cm apart on the table, so that every voxel there is crossed each sweep.
+PinholeIntrinsics small_camera(int width, int height, double focal) {
+  PinholeIntrinsics k = testing::kinect_intrinsics(width, height);
+  k.fx = k.fy = focal;
+  return k;
+}
+
+Sweep sweep_of(const std::vector<AlignedBox>& scene, const PinholeIntrinsics& camera,
+               double noise_sigma = 0.0, std::mt19937* rng = nullptr) {
+  Sweep sweep;
+  sweep.scans.push_back(testing::render_scan(scene, camera_pose(), camera, noise_sigma, rng));
+  return sweep;
+}
+
+TEST(ChangeConfigTest, ReadsKeysAndNamesBadOnes) {
+  YamlMap root =
+      YamlMap::parse("change:\n  persist_sweeps: 5\n  margin: 0.1\n  min_voxels: 3\n", "cell.yaml");
+  const ChangeConfig c = ChangeConfig::from_yaml(root.child("change"));
+  EXPECT_EQ(c.persist_sweeps, 5);
+  EXPECT_DOUBLE_EQ(c.margin, 0.1);
+  EXPECT_EQ(c.min_voxels, 3);
+  const ChangeConfig defaults;
+  EXPECT_EQ(defaults.persist_sweeps, 3);
+  EXPECT_DOUBLE_EQ(defaults.margin, 0.05);
+  auto parse = [](const std::string& text) {
+    YamlMap map = YamlMap::parse(text, "cell.yaml");
+    return ChangeConfig::from_yaml(map.child("change"));
+  };
+  EXPECT_EQ(error_of([&] { (void)parse("change:\n  persist: 2\n"); }),
+            "cell.yaml: change.persist: unknown key");
+  EXPECT_EQ(error_of([&] { (void)parse("change:\n  persist_sweeps: 0\n"); }),
+            "cell.yaml: change.persist_sweeps: must be an integer in [1, 1000], got 0");
+  EXPECT_EQ(error_of([&] { (void)parse("change:\n  margin: -0.1\n"); }),
+            "cell.yaml: change.margin: must be in [0, 10], got -0.1");
+  ChangeConfig bad;
+  bad.min_voxels = 0;
+  EXPECT_EQ(error_of([&] { ChangeDetector{bad}; }),
+            "change.min_voxels: must be an integer in [1, 1000000], got 0");
+}
+
+// Sensor noise alone must never produce a change region.
+TEST(ChangeDetectorTest, ThousandNoiseOnlySweepsGiveNoRegion) {
+  OccupancyMap map;
+  ChangeConfig config;
+  ChangeDetector detector(config);
+  std::mt19937 rng(7);
+  const double sigma = 0.004;  // Kinect-class depth noise at 1-1.5 m
+  const std::vector<AlignedBox> scene = [] {
+    std::vector<AlignedBox> s = table_scene();
+    s.push_back({{-0.15, 0.3, 1.2}, {0.1, 0.5, 1.45}});
+    return s;
+  }();
+  const PinholeIntrinsics camera = small_camera(48, 36, 90.0);
+  // The first sweeps show the scene itself, which is a change from the empty map.
+  std::size_t initial = 0;
+  for (int i = 0; i < config.persist_sweeps; ++i) {
+    initial += detector.update(map.integrate(sweep_of(scene, camera, sigma, &rng)), map).regions.size();
+  }
+  EXPECT_GE(initial, 1u);
+  std::size_t regions = 0, flips = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const OccupancyUpdate update = map.integrate(sweep_of(scene, camera, sigma, &rng));
+    flips += update.appeared.size() + update.vanished.size();
+    const ChangeSet changes = detector.update(update, map);
+    regions += changes.regions.size();
+    for (const ChangeRegion& r : changes.regions) {
+      ADD_FAILURE() << "sweep " << changes.sweep << ": region " << r.min_C.transpose() << " .. "
+                    << r.max_C.transpose() << " with " << r.appeared.size() << " appeared, "
+                    << r.vanished.size() << " vanished";
+    }
+  }
+  EXPECT_EQ(regions, 0u);
+  EXPECT_GT(flips, 0u) << "the noise should make some voxels flip, else this test proves nothing";
+  std::printf("noise-only: %zu voxel flips over 1000 sweeps, %zu regions\n", flips, regions);
+}
+
+TEST(ChangeDetectorTest, AddedAndRemovedBoxGiveOneRegionEach) {
+  OccupancyMap map;
+  ChangeConfig config;
+  ChangeDetector detector(config);
+  const PinholeIntrinsics camera = small_camera(120, 90, 220.0);
+  std::vector<AlignedBox> scene = table_scene();
+  for (int i = 0; i < 8; ++i) (void)detector.update(map.integrate(sweep_of(scene, camera)), map);
+
+  const AlignedBox box{{-0.15, 0.3, 1.21}, {0.1, 0.5, 1.45}};
+  scene.push_back(box);
+  // Its voxels were free at the lower clamp: occupied after sweeps_to_occupy() sweeps, reported
+  // persist_sweeps - 1 sweeps later, as one region around the box.
+  const int add_sweep = map.config().sweeps_to_occupy() + config.persist_sweeps - 1;  // 5 by default
+  std::vector<ChangeSet> after_add;
+  for (int i = 1; i <= add_sweep + 2; ++i)
+    after_add.push_back(detector.update(map.integrate(sweep_of(scene, camera)), map));
+  for (std::size_t i = 0; i < after_add.size(); ++i) {
+    ASSERT_EQ(after_add[i].regions.size(), int(i) + 1 == add_sweep ? 1u : 0u)
+        << "sweep " << i + 1 << " after adding";
+  }
+  const ChangeRegion& added = after_add[std::size_t(add_sweep) - 1].regions[0];
+  EXPECT_TRUE(added.contains(box.min_C)) << added.min_C.transpose();
+  EXPECT_TRUE(added.contains(box.max_C)) << added.max_C.transpose();
+  EXPECT_TRUE(added.vanished.empty());
+  EXPECT_GT(added.appeared.size(), 50u);
+  // Not much bigger than the box: its visible faces plus the margin.
+  EXPECT_LT((added.max_C - added.min_C - (box.max_C - box.min_C)).maxCoeff(), 2 * config.margin + 0.05);
+
+  // Let the box saturate, then take it away.
+  for (int i = 0; i < 6; ++i)
+    ASSERT_TRUE(detector.update(map.integrate(sweep_of(scene, camera)), map).empty());
+  scene.pop_back();
+  const int expected_sweep = map.config().sweeps_to_clear() + config.persist_sweeps - 1;  // 11 by default
+  for (int i = 1; i <= expected_sweep + 3; ++i) {
+    const ChangeSet changes = detector.update(map.integrate(sweep_of(scene, camera)), map);
+    if (i != expected_sweep) {
+      EXPECT_TRUE(changes.empty()) << "sweep " << i << " after removing";
+      continue;
+    }
+    ASSERT_EQ(changes.regions.size(), 1u);
+    const ChangeRegion& removed = changes.regions[0];
+    EXPECT_TRUE(removed.appeared.empty());
+    EXPECT_GT(removed.vanished.size(), 50u);
+    EXPECT_TRUE(removed.contains(box.min_C + Eigen::Vector3d(0, 0.02, 0)));
+    EXPECT_TRUE(removed.contains(box.max_C - Eigen::Vector3d(0, 0.02, 0)));
+  }
+  EXPECT_EQ(detector.pending(), 0u);
+}
+
+TEST(ChangeDetectorTest, FlipBackBeforePersistingIsForgotten) {
+  OccupancyMap map;
+  ChangeConfig config;
+  config.persist_sweeps = 2;
+  config.min_voxels = 1;
+  ChangeDetector detector(config);
+  // Synthetic flips: one voxel appears and vanishes again before it has persisted.
+  const octomap::OcTreeKey key = map.tree().coordToKey(0.5, 0.5, 0.5);
+  OccupancyUpdate appear, vanish, nothing;
+  appear.appeared.push_back(key);
+  vanish.vanished.push_back(key);
+  EXPECT_TRUE(detector.update(appear, map).empty());
+  EXPECT_EQ(detector.pending(), 1u);
+  EXPECT_TRUE(detector.update(vanish, map).empty());
+  EXPECT_EQ(detector.pending(), 0u);
+  EXPECT_TRUE(detector.update(nothing, map).empty());
+  // Persisting twice counts: one region of one voxel, bounds = voxel ± margin.
+  EXPECT_TRUE(detector.update(appear, map).empty());
+  const ChangeSet changes = detector.update(nothing, map);
+  ASSERT_EQ(changes.regions.size(), 1u);
+  EXPECT_EQ(changes.sweep, 5u);
+  const double lo = map.centre(key).x() - 0.01 - config.margin;
+  EXPECT_NEAR(changes.regions[0].min_C.x(), lo, 1e-9);
+  EXPECT_NEAR(changes.regions[0].max_C.x() - changes.regions[0].min_C.x(), 0.02 + 2 * config.margin, 1e-9);
+}
+
+TEST(ChangeDetectorTest, ConnectedVoxelsFormOneRegionSeparateOnesTwo) {
+  OccupancyMap map;
+  ChangeConfig config;
+  config.persist_sweeps = 1;
+  config.min_voxels = 1;
+  config.margin = 0.0;
+  ChangeDetector detector(config);
+  OccupancyUpdate update;
+  const auto& tree = map.tree();
+  for (const double x : {0.01, 0.03, 0.05})
+    update.appeared.push_back(tree.coordToKey(x, x, x));  // diagonal: 26-connected
+  update.appeared.push_back(tree.coordToKey(0.51, 0.01, 0.01));
+  const ChangeSet changes = detector.update(update, map);
+  ASSERT_EQ(changes.regions.size(), 2u);
+  EXPECT_EQ(changes.regions[0].appeared.size(), 3u);
+  EXPECT_NEAR(changes.regions[0].min_C.x(), 0.0, 1e-9);
+  EXPECT_NEAR(changes.regions[0].max_C.x(), 0.06, 1e-9);
+  EXPECT_EQ(changes.regions[1].appeared.size(), 1u);
+}
+
+}  // namespace
+}  // namespace cellmap

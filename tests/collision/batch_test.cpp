@@ -1,0 +1,115 @@
+#include "cellmap/collision/batch.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "cellmap/collision/box_tree.hpp"
+#include "cellmap/collision/robot_boxes.hpp"
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::collision {
+namespace {
+
+using Eigen::Vector3d;
+
+std::vector<Obb> random_boxes(int n, double spread, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<double> h(0.02, 0.3);
+  std::vector<Obb> boxes;
+  for (int i = 0; i < n; ++i) {
+    boxes.emplace_back(Vector3d(u(rng), u(rng), u(rng)) * spread, Vector3d(h(rng), h(rng), h(rng)),
+                       Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix());
+  }
+  return boxes;
+}
+
+TEST(BoxTreeTest, QueryFindsExactlyTheBoxesWithinTheCutoff) {
+  std::mt19937 rng(1);
+  const std::vector<Obb> boxes = random_boxes(500, 5.0, rng);
+  const BoxTree tree(boxes);
+  for (const Obb& probe : random_boxes(50, 5.0, rng)) {
+    for (const double cutoff : {0.0, 0.1, 1.0}) {
+      std::vector<int> found;
+      tree.query(probe.center, probe.aabb_half_extents(), cutoff, &found);
+      std::sort(found.begin(), found.end());
+      std::vector<int> expected;
+      for (int i = 0; i < static_cast<int>(boxes.size()); ++i) {
+        const Vector3d gap = (boxes[i].center - probe.center).cwiseAbs() - boxes[i].aabb_half_extents() -
+                             probe.aabb_half_extents();
+        const double g2 = gap.cwiseMax(0.0).squaredNorm();
+        if (g2 == 0.0 || g2 < cutoff * cutoff) expected.push_back(i);
+      }
+      EXPECT_EQ(found, expected);
+    }
+  }
+  std::vector<int> none;
+  BoxTree(std::vector<Obb>{}).query(Vector3d::Zero(), Vector3d::Ones(), 1.0, &none);
+  EXPECT_TRUE(none.empty());
+}
+
+TEST(BatchTest, DenseVectorHasThePaperCountAndExactEntries) {
+  std::mt19937 rng(2);
+  const std::vector<Obb> environment = random_boxes(7, 2.0, rng);
+  std::vector<std::vector<Obb>> robot;
+  for (int k = 0; k < 5; ++k) robot.push_back(random_boxes(3, 2.0, rng));
+  const ConstraintSet set = constraints(robot, environment);
+  EXPECT_EQ(set.n_constr(), 3u * 7u * 5u);
+  ASSERT_EQ(set.entries.size(), set.n_constr());
+  const Constraint& c = set.entries[2 * 21 + 1 * 7 + 4];
+  EXPECT_EQ(c.checkpoint, 2);
+  EXPECT_EQ(c.robot_box, 1);
+  EXPECT_EQ(c.env_box, 4);
+  EXPECT_EQ(c.result.distance, signed_distance(robot[2][1], environment[4]).distance);
+}
+
+TEST(BatchTest, BroadPhaseKeepsEveryPairCloserThanTheCutoff) {
+  std::mt19937 rng(3);
+  const std::vector<Obb> environment = random_boxes(200, 6.0, rng);
+  std::vector<std::vector<Obb>> robot;
+  for (int k = 0; k < 10; ++k) robot.push_back(random_boxes(4, 6.0, rng));
+  const ConstraintSet dense = constraints(robot, environment);
+  const BoxTree tree(environment);
+  const double cutoff = 0.5;
+  const ConstraintSet sparse = constraints(robot, environment, tree, cutoff);
+  EXPECT_EQ(sparse.n_constr(), dense.n_constr());
+  EXPECT_LT(sparse.entries.size(), dense.entries.size() / 4);  // the broad phase skips most pairs here
+  std::size_t near = 0;
+  for (const Constraint& c : dense.entries) {
+    if (c.result.distance >= cutoff) continue;
+    ++near;
+    const auto it = std::find_if(sparse.entries.begin(), sparse.entries.end(), [&](const Constraint& s) {
+      return s.checkpoint == c.checkpoint && s.robot_box == c.robot_box && s.env_box == c.env_box;
+    });
+    ASSERT_NE(it, sparse.entries.end());
+    EXPECT_EQ(it->result.distance, c.result.distance);
+  }
+  EXPECT_GT(near, 0u);
+  EXPECT_EQ(sparse.min_distance(), dense.min_distance());
+  EXPECT_EQ(sparse.clear(0.01), dense.clear(0.01));
+  EXPECT_FALSE(sparse.clear(cutoff));  // a margin beyond the cutoff cannot be certified
+}
+
+TEST(BatchTest, MismatchedCheckpointsAreRefused) {
+  std::mt19937 rng(4);
+  const std::vector<std::vector<Obb>> robot{random_boxes(2, 1, rng), random_boxes(3, 1, rng)};
+  EXPECT_THROW((void)constraints(robot, random_boxes(2, 1, rng)), Error);
+}
+
+TEST(RobotBoxesTest, GantryBoxesFollowTheJoints) {
+  const Robot gantry = Robot::gantry(Vector3d(0, 0, 0), Vector3d(4, 3, 1));
+  Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
+  X_LB.translation() = Vector3d(0, 0, -0.2);
+  const RobotBoxes robot(gantry,
+                         {{"ram", X_LB, Vector3d(0.1, 0.1, 0.2)}, {"bridge", {}, Vector3d(0.1, 2, 0.1)}});
+  const std::vector<Obb> at_zero = robot.place(Eigen::Vector3d(0, 0, 0));
+  const std::vector<Obb> moved = robot.place(Eigen::Vector3d(1.0, 0.5, 0.25));
+  EXPECT_LT((moved[0].center - at_zero[0].center - Vector3d(1.0, 0.5, 0.25)).norm(), 1e-12);
+  EXPECT_LT((moved[1].center - at_zero[1].center - Vector3d(1.0, 0, 0)).norm(),
+            1e-12);  // the bridge moves in x only
+  EXPECT_THROW(RobotBoxes(gantry, {{"wrist", {}, Vector3d::Ones()}}), Error);
+  EXPECT_THROW(RobotBoxes(gantry, {{"ram", {}, Vector3d(1, -1, 1)}}), Error);
+}
+
+}  // namespace
+}  // namespace cellmap::collision

@@ -1,0 +1,70 @@
+// Real frames: our sweep fusion against OctoMap's own insertPointCloud on the grabber sequence.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/occupancy/tree_agreement.hpp"
+
+namespace cellmap {
+namespace {
+
+std::vector<Scan> grabber_scans() {
+  const std::filesystem::path dir = std::filesystem::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
+  std::vector<std::filesystem::path> files;
+  if (std::filesystem::is_directory(dir)) {
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      if (entry.path().extension() == ".pcd") files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<Scan> scans;
+  for (const auto& file : files) {
+    Scan scan;  // camera frame = cell frame: identity pose, origin at the camera
+    if (pcl::io::loadPCDFile(file.string(), scan.points_C) != 0) ADD_FAILURE() << "cannot read " << file;
+    scans.push_back(std::move(scan));
+  }
+  return scans;
+}
+
+TEST(GrabberAgreementTest, SameOccupancyAsOctomapInsertPointCloud) {
+  const std::vector<Scan> scans = grabber_scans();
+  if (scans.empty()) GTEST_SKIP() << CELLMAP_SHARED_DATA << "/pcl/grabber_sequence is absent";
+  ASSERT_EQ(scans.size(), 3u);
+
+  const OccupancyConfig config;
+  OccupancyMap ours(config);
+  octomap::OcTree discretized(config.resolution), exact(config.resolution);
+  apply_sensor_model(config, discretized);
+  apply_sensor_model(config, exact);
+  for (const Scan& scan : scans) {
+    Sweep sweep;
+    sweep.scans.push_back(scan);
+    ours.integrate(sweep);
+    octomap::Pointcloud cloud;
+    for (const auto& p : scan.points_C.points) {
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud.push_back(p.x, p.y, p.z);
+    }
+    discretized.insertPointCloud(cloud, octomap::point3d(0, 0, 0), config.max_range, false, true);
+    exact.insertPointCloud(cloud, octomap::point3d(0, 0, 0), config.max_range, false, false);
+  }
+  const TreeAgreement vs_discretized = compare_trees(ours.tree(), discretized);
+  const TreeAgreement vs_exact = compare_trees(ours.tree(), exact);
+  RecordProperty("agreement_discretized", std::to_string(vs_discretized.fraction()));
+  RecordProperty("agreement_exact", std::to_string(vs_exact.fraction()));
+  std::printf("agreement vs insertPointCloud: discretized %.5f of %zu voxels, non-discretized %.5f of %zu\n",
+              vs_discretized.fraction(), vs_discretized.voxels, vs_exact.fraction(), vs_exact.voxels);
+  EXPECT_GT(vs_discretized.voxels, 10000u);
+  EXPECT_GE(vs_discretized.fraction(), 0.999);
+  // Snapping endpoints to voxel centres bends rays by up to half a voxel; measured 96.9 % here.
+  EXPECT_GE(vs_exact.fraction(), 0.95);
+  // Occupied voxels do not depend on the ray paths (every endpoint voxel is occupied in both).
+  EXPECT_EQ(vs_exact.occupied_a, vs_exact.occupied_b);
+  EXPECT_EQ(vs_exact.occupied_both, vs_exact.occupied_a);
+}
+
+}  // namespace
+}  // namespace cellmap

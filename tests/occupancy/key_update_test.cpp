@@ -1,0 +1,139 @@
+#include "cellmap/occupancy/key_update.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "cellmap/common/error.hpp"
+#include "occupancy/box_scene.hpp"
+
+namespace cellmap {
+namespace {
+
+using Keys = std::vector<octomap::OcTreeKey>;
+
+Keys sorted(const octomap::KeySet& set) {
+  Keys keys(set.begin(), set.end());
+  std::sort(keys.begin(), keys.end(), [](const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
+    return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
+  });
+  return keys;
+}
+
+octomap::Pointcloud to_octomap(const Scan& scan) {
+  octomap::Pointcloud cloud;
+  for (const auto& p : scan.points_C.points) cloud.push_back(p.x, p.y, p.z);
+  return cloud;
+}
+
+octomap::point3d origin_of(const Scan& scan) {
+  return octomap::point3d(float(scan.origin_C.x()), float(scan.origin_C.y()), float(scan.origin_C.z()));
+}
+
+// A camera 1.2 m above the floor of the box room, looking in along +z, tilted down and slightly yawed, at a
+// position that is not on a voxel corner.
+Eigen::Isometry3d tilted_pose() {
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+  X_CS.translate(Eigen::Vector3d(0.013, -0.2071, 0.0337));
+  X_CS.rotate(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()) *
+              Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()));
+  return X_CS;
+}
+
+Sweep one_scan(const Eigen::Isometry3d& X_CS, int width = 96, int height = 72) {
+  Sweep sweep;
+  sweep.scans.push_back(
+      testing::render_scan(testing::box_room(), X_CS, testing::kinect_intrinsics(width, height)));
+  return sweep;
+}
+
+TEST(KeyUpdateTest, EqualsOctomapsDiscreteUpdateForOneScan) {
+  octomap::OcTree tree(0.03);
+  for (const Eigen::Isometry3d& X_CS : {Eigen::Isometry3d::Identity(), tilted_pose()}) {
+    for (const double max_range : {5.0, 2.5}) {  // 2.5 m truncates the rays to the back wall
+      const Sweep sweep = one_scan(X_CS);
+      octomap::KeySet free, occupied;
+      tree.computeDiscreteUpdate(to_octomap(sweep.scans[0]), origin_of(sweep.scans[0]), free, occupied,
+                                 max_range);
+      const KeyUpdate ours = compute_key_update(sweep, tree, max_range, 2);
+      EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
+      EXPECT_EQ(ours.free_keys(), sorted(free));
+      EXPECT_EQ(ours.occupied_count, occupied.size());
+      EXPECT_EQ(ours.free_count, free.size());
+      EXPECT_GT(free.size(), 1000u);
+    }
+  }
+}
+
+TEST(KeyUpdateTest, ResultDoesNotDependOnThreads) {
+  octomap::OcTree tree(0.05);
+  const Sweep sweep = one_scan(tilted_pose());
+  const KeyUpdate one = compute_key_update(sweep, tree, 5.0, 1);
+  for (const int threads : {2, 3, 7}) {
+    const KeyUpdate many = compute_key_update(sweep, tree, 5.0, threads);
+    EXPECT_EQ(many.occupied_keys(), one.occupied_keys());
+    EXPECT_EQ(many.free_keys(), one.free_keys());
+  }
+}
+
+TEST(KeyUpdateTest, SeveralScansUniteWithOccupiedWinning) {
+  octomap::OcTree tree(0.02);
+  Sweep sweep = one_scan(Eigen::Isometry3d::Identity(), 80, 60);
+  sweep.scans.push_back(one_scan(tilted_pose(), 80, 60).scans[0]);
+  octomap::KeySet free, occupied;
+  for (const Scan& scan : sweep.scans) {
+    octomap::KeySet scan_free, scan_occupied;
+    tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), scan_free, scan_occupied, 5.0);
+    free.insert(scan_free.begin(), scan_free.end());
+    occupied.insert(scan_occupied.begin(), scan_occupied.end());
+  }
+  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 2);
+  EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
+  EXPECT_EQ(ours.free_keys(), sorted(free));
+}
+
+TEST(KeyUpdateTest, SkipsNonFinitePointsAndRejectsBadOrigins) {
+  octomap::OcTree tree(0.1);
+  Sweep sweep;
+  sweep.scans.emplace_back();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  sweep.scans[0].points_C.push_back(pcl::PointXYZ(nan, 0, 0));
+  sweep.scans[0].points_C.push_back(pcl::PointXYZ(1.05f, 0.05f, 0.05f));
+  sweep.scans[0].points_C.push_back(pcl::PointXYZ(1e9f, 0, 0));  // outside the key range
+  const KeyUpdate update = compute_key_update(sweep, tree, 5.0, 2);
+  // Origin voxel (0,0,0)..(0.1) and the 9 voxels up to x = 1.0 are free, the voxel at x = 1.05 is occupied.
+  ASSERT_EQ(update.occupied_keys().size(), 1u);
+  EXPECT_EQ(update.occupied_keys()[0], tree.coordToKey(1.05, 0.05, 0.05));
+  EXPECT_EQ(update.free_count, 10u);
+
+  sweep.scans[0].origin_C = Eigen::Vector3d(std::nan(""), 0, 0);
+  EXPECT_THROW((void)compute_key_update(sweep, tree, 5.0, 1), Error);
+  sweep.scans[0].origin_C = Eigen::Vector3d(1e7, 0, 0);
+  EXPECT_THROW((void)compute_key_update(sweep, tree, 5.0, 1), Error);
+  sweep.scans[0].origin_C = Eigen::Vector3d::Zero();
+  EXPECT_THROW((void)compute_key_update(sweep, tree, 0.0, 1), Error);
+}
+
+TEST(KeyUpdateTest, BrickIndexRoundTrips) {
+  KeyBrick brick;
+  brick.base = octomap::OcTreeKey(32768, 32752, 16);
+  for (int x = 0; x < 16; x += 5) {
+    for (int y = 0; y < 16; y += 3) {
+      for (int z = 0; z < 16; z += 7) {
+        const octomap::OcTreeKey key(32768 + x, 32752 + y, 16 + z);
+        EXPECT_EQ(brick.key(KeyBrick::local_index(key)), key);
+      }
+    }
+  }
+  // x is the lowest bit of each triple, z the highest: OctoMap's child order.
+  EXPECT_EQ(KeyBrick::local_index(octomap::OcTreeKey(1, 0, 0)), 1);
+  EXPECT_EQ(KeyBrick::local_index(octomap::OcTreeKey(0, 1, 0)), 2);
+  EXPECT_EQ(KeyBrick::local_index(octomap::OcTreeKey(0, 0, 1)), 4);
+  EXPECT_EQ(KeyBrick::local_index(octomap::OcTreeKey(8, 0, 0)), 512);
+}
+
+}  // namespace
+}  // namespace cellmap

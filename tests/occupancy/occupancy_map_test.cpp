@@ -1,0 +1,132 @@
+#include "cellmap/occupancy/occupancy_map.hpp"
+
+#include <gtest/gtest.h>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/occupancy/tree_agreement.hpp"
+#include "occupancy/box_scene.hpp"
+
+namespace cellmap {
+namespace {
+
+using testing::AlignedBox;
+
+octomap::Pointcloud to_octomap(const Scan& scan) {
+  octomap::Pointcloud cloud;
+  for (const auto& p : scan.points_C.points) cloud.push_back(p.x, p.y, p.z);
+  return cloud;
+}
+
+Eigen::Isometry3d camera_at(const Eigen::Vector3d& p_C, double pitch) {
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+  X_CS.translate(p_C);
+  X_CS.rotate(Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX()));
+  return X_CS;
+}
+
+Sweep sweep_of(const std::vector<AlignedBox>& scene, const std::vector<Eigen::Isometry3d>& poses,
+               int width = 120, int height = 90) {
+  Sweep sweep;
+  for (const Eigen::Isometry3d& X_CS : poses) {
+    sweep.scans.push_back(testing::render_scan(scene, X_CS, testing::kinect_intrinsics(width, height)));
+  }
+  return sweep;
+}
+
+TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
+  OccupancyConfig config;
+  config.resolution = 0.03;
+  OccupancyMap map(config);
+  octomap::OcTree reference(config.resolution);
+  apply_sensor_model(config, reference);
+  const std::vector<Eigen::Isometry3d> poses = {camera_at({0.011, -0.2, 0.02}, -0.25),
+                                                camera_at({0.4, -0.3, 0.3}, -0.35),
+                                                camera_at({-0.37, -0.1, 0.21}, -0.1)};
+  std::vector<AlignedBox> scene = testing::box_room();
+  for (int sweep = 0; sweep < 5; ++sweep) {
+    if (sweep == 3) scene.pop_back();  // box B leaves: its voxels get free-space evidence from then on
+    const Scan scan = testing::render_scan(scene, poses[std::size_t(sweep) % poses.size()],
+                                           testing::kinect_intrinsics(96, 72));
+    Sweep one;
+    one.scans.push_back(scan);
+    map.integrate(one);
+    const octomap::point3d origin(float(scan.origin_C.x()), float(scan.origin_C.y()),
+                                  float(scan.origin_C.z()));
+    reference.insertPointCloud(to_octomap(scan), origin, config.max_range, false, true);
+  }
+  const TreeAgreement agreement = compare_trees(map.tree(), reference);
+  EXPECT_GT(agreement.voxels, 20000u);
+  EXPECT_GE(agreement.fraction(), 0.999);
+  EXPECT_EQ(agreement.same, agreement.voxels);  // measured: identical, voxel for voxel
+  EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
+}
+
+TEST(OccupancyMapTest, ReportsFlipsAndStates) {
+  OccupancyMap map;
+  const std::vector<AlignedBox> scene = {{{-1, -1, 2.0}, {1, 1, 2.1}}};  // a wall 2 m ahead
+  const Sweep sweep = sweep_of(scene, {Eigen::Isometry3d::Identity()});
+  const OccupancyUpdate first = map.integrate(sweep);
+  EXPECT_GT(first.hit_voxels, 0u);
+  EXPECT_EQ(first.appeared.size(), first.hit_voxels);  // unknown → occupied
+  EXPECT_TRUE(first.vanished.empty());
+  EXPECT_EQ(map.occupied_keys(), first.appeared);
+  EXPECT_EQ(map.state(Eigen::Vector3d(0.01, 0.01, 2.01)), VoxelState::occupied);
+  EXPECT_EQ(map.state(Eigen::Vector3d(0.01, 0.01, 1.0)), VoxelState::free);
+  EXPECT_EQ(map.state(Eigen::Vector3d(0.01, 0.01, 3.0)), VoxelState::unknown);
+  EXPECT_EQ(map.state(Eigen::Vector3d(std::nan(""), 0, 0)), VoxelState::unknown);
+  const OccupancyUpdate second = map.integrate(sweep);
+  EXPECT_TRUE(second.appeared.empty());
+  EXPECT_TRUE(second.vanished.empty());
+}
+
+// A removed object vanishes after exactly config.sweeps_to_clear() sweeps that see through it.
+TEST(OccupancyMapTest, RemovedBoxClearsAfterDocumentedSweeps) {
+  OccupancyMap map;
+  const AlignedBox box{{-0.2, 0.6, 1.51}, {0.2, 1.0, 1.9}};
+  std::vector<AlignedBox> scene = {{{-2, 1.0, 0}, {2, 1.1, 4}}, {{-2, -1.5, 3.0}, {2, 1.1, 3.1}}, box};
+  const std::vector<Eigen::Isometry3d> poses = {camera_at({0, -0.3, 0}, -0.35)};  // looking down
+  // 320 × 240: rays dense enough (< 1 cm apart at 2 m) that every voxel of the box is crossed once it is
+  // gone; coarser frames leave voxels that no discretized ray crosses, which then never clear.
+  auto sweep = [&] { return sweep_of(scene, poses, 320, 240); };
+  // Saturate: a voxel hit in every sweep reaches the upper clamp after 5 sweeps (5 · 0.85 > 3.5).
+  for (int i = 0; i < 6; ++i) map.integrate(sweep());
+  const Eigen::Vector3d front_C(0.01, 0.81, 1.515);  // in the voxel of the box's front face
+  ASSERT_EQ(map.state(front_C), VoxelState::occupied);
+
+  scene.pop_back();
+  const int n = map.config().sweeps_to_clear();
+  ASSERT_EQ(n, 9);
+  std::size_t vanished = 0;
+  for (int i = 1; i <= n; ++i) {
+    const OccupancyUpdate update = map.integrate(sweep());
+    vanished += update.vanished.size();
+    if (i < n) {
+      EXPECT_EQ(map.state(front_C), VoxelState::occupied) << "sweep " << i;
+      EXPECT_EQ(vanished, 0u) << "sweep " << i;
+    }
+  }
+  EXPECT_EQ(map.state(front_C), VoxelState::free);
+  EXPECT_GT(vanished, 50u);
+  for (const octomap::OcTreeKey& key : map.occupied_keys()) {
+    const Eigen::Vector3d p_C = map.centre(key);
+    const bool inside_box = (p_C.array() > box.min_C.array() - 0.02).all() &&
+                            (p_C.array() < box.max_C.array() + 0.02).all() && p_C.y() < 0.98;
+    EXPECT_FALSE(inside_box) << "voxel at " << p_C.transpose() << " still occupied";
+  }
+}
+
+TEST(OccupancyMapTest, RejectsBadConfigAndOrigins) {
+  OccupancyConfig config;
+  config.miss = 0.6;
+  EXPECT_THROW(OccupancyMap{config}, Error);
+  OccupancyMap map;
+  Sweep sweep;
+  sweep.scans.emplace_back();
+  sweep.scans[0].origin_C = Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0, 0);
+  sweep.scans[0].points_C.push_back(pcl::PointXYZ(1, 0, 0));
+  EXPECT_THROW(map.integrate(sweep), Error);
+  EXPECT_EQ(map.tree().size(), 0u);
+}
+
+}  // namespace
+}  // namespace cellmap

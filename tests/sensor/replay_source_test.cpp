@@ -1,0 +1,211 @@
+// Depth image files and replay directories, on files the test writes itself.
+#include "cellmap/sensor/replay_source.hpp"
+
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+#include "cellmap/sensor/depth_io.hpp"
+
+namespace cellmap {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag)
+      : path_(fs::temp_directory_path() / ("cellmap_" + tag + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+  [[nodiscard]] std::string operator/(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+RawDepth ramp(int width, int height) {
+  RawDepth image;
+  image.width = width;
+  image.height = height;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u)
+      image.depth.push_back(static_cast<std::uint16_t>(u == 0 ? 0 : 1000 + 300 * v + u));
+  }
+  return image;
+}
+
+TEST(DepthIoTest, PngRoundTripKeepsEverySixteenBitValue) {
+  TempDir dir("png");
+  RawDepth image = ramp(5, 3);
+  image.depth[1] = 65535;  // high byte and low byte both matter
+  image.depth[2] = 256;
+  write_depth_png(dir / "d.png", image);
+  const RawDepth back = read_depth_image(dir / "d.png");
+  EXPECT_EQ(back.width, 5);
+  EXPECT_EQ(back.height, 3);
+  EXPECT_EQ(back.depth, image.depth);
+}
+
+TEST(DepthIoTest, RefusesWhatIsNotSixteenBitDepth) {
+  TempDir dir("bad");
+  write_file_atomically(dir / "noise.png", "not a png at all");
+  EXPECT_THROW((void)read_depth_image(dir / "noise.png"), Error);
+  write_file_atomically(dir / "noise.tiff", "II*\0garbage");
+  EXPECT_THROW((void)read_depth_image(dir / "noise.tiff"), Error);
+  EXPECT_THROW((void)read_depth_image(dir / "missing.png"), Error);
+  EXPECT_THROW((void)read_depth_image(dir / "depth.jpg"), Error);
+  RawDepth wrong = ramp(4, 2);
+  wrong.depth.pop_back();
+  EXPECT_THROW(write_depth_png(dir / "w.png", wrong), Error);
+  try {
+    (void)read_depth_image(dir / "noise.png");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("noise.png"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DepthIoTest, IntrinsicsYamlIsStrict) {
+  TempDir dir("yaml");
+  write_file_atomically(dir / "k.yaml",
+                        "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\ndepth_scale: 0.0001\n");
+  const PinholeIntrinsics k = read_intrinsics_yaml(dir / "k.yaml");
+  EXPECT_EQ(k.width, 4);
+  EXPECT_DOUBLE_EQ(k.depth_scale, 0.0001);
+  write_file_atomically(dir / "typo.yaml", "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nfocal: 3\n");
+  EXPECT_THROW((void)read_intrinsics_yaml(dir / "typo.yaml"), Error);
+  write_file_atomically(dir / "nofx.yaml", "width: 4\nheight: 3\nfy: 2\ncx: 1.5\ncy: 1\n");
+  EXPECT_THROW((void)read_intrinsics_yaml(dir / "nofx.yaml"), Error);
+}
+
+// A replay directory: two PNG depth frames with intrinsics.yaml and one PCD frame.
+struct Recording {
+  TempDir dir{"replay"};
+  std::vector<ReplayEntry> entries;
+  Recording() {
+    write_file_atomically(dir / "intrinsics.yaml", "width: 6\nheight: 4\nfx: 3\nfy: 3\ncx: 2.5\ncy: 1.5\n");
+    write_depth_png(dir / "f0.png", ramp(6, 4));
+    write_depth_png(dir / "f1.png", ramp(6, 4));
+    Cloud cloud;
+    cloud.push_back(pcl::PointXYZ(0.1f, 0.2f, 1.0f));
+    cloud.push_back(pcl::PointXYZ(std::nanf(""), 0.f, 0.f));
+    cloud.push_back(pcl::PointXYZ(-0.1f, 0.0f, 2.0f));
+    pcl::io::savePCDFileBinary(dir / "f2.pcd", cloud);
+    for (int i = 0; i < 3; ++i) {
+      ReplayEntry entry;
+      entry.file = i < 2 ? "f" + std::to_string(i) + ".png" : "f2.pcd";
+      entry.stamp = 100.0 + 0.05 * i;
+      entry.X_CE = Eigen::Translation3d(i, 0, 1) * Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d::UnitY());
+      entries.push_back(entry);
+    }
+    write_replay_poses(dir / "poses.csv", entries);
+  }
+};
+
+TEST(ReplayPosesTest, RoundTripAndStrictParsing) {
+  Recording recording;
+  const std::vector<ReplayEntry> back = read_replay_poses(recording.dir / "poses.csv");
+  ASSERT_EQ(back.size(), 3u);
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].file, recording.entries[i].file);
+    EXPECT_DOUBLE_EQ(back[i].stamp, recording.entries[i].stamp);
+    EXPECT_TRUE(back[i].X_CE.isApprox(recording.entries[i].X_CE, 1e-12));
+  }
+  const std::string header = "file,stamp,x,y,z,qw,qx,qy,qz\n";
+  write_file_atomically(recording.dir / "a.csv", "file,stamp,x,y,z,qx,qy,qz,qw\nf0.png,1,0,0,0,1,0,0,0\n");
+  EXPECT_THROW((void)read_replay_poses(recording.dir / "a.csv"), Error);  // wrong header
+  write_file_atomically(recording.dir / "b.csv", header + "f0.png,1,0,0,0,2,0,0,0\n");
+  EXPECT_THROW((void)read_replay_poses(recording.dir / "b.csv"), Error);  // not a unit quaternion
+  write_file_atomically(recording.dir / "c.csv", header + "f0.png,1,0,0,0,1,0,0,0\nf1.png,1,0,0,0,1,0,0,0\n");
+  EXPECT_THROW((void)read_replay_poses(recording.dir / "c.csv"), Error);  // stamp not increasing
+  write_file_atomically(recording.dir / "d.csv", header + "f0.png,1,0,nan,0,1,0,0,0\n");
+  try {
+    (void)read_replay_poses(recording.dir / "d.csv");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("d.csv:2: y"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ReplaySourceTest, PlaysDepthImagesAndCloudsInOrder) {
+  Recording recording;
+  ReplayConfig config;
+  config.name = "desk";
+  config.directory = recording.dir.path().string();
+  config.playback = ReplayConfig::Playback::kFastest;
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
+  EXPECT_EQ(source.poses().size(), 3u);
+
+  auto f0 = source.next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(f0.has_value());
+  EXPECT_EQ(f0->sensor, "desk");
+  EXPECT_DOUBLE_EQ(f0->stamp, 100.0);
+  ASSERT_TRUE(f0->depth.has_value());
+  EXPECT_EQ(f0->points_S.size(), 6u * 4u - 4u);  // column 0 holds no return
+  // Pixel (1, 0): z = 1.001 m, x = (1 - 2.5) z / 3.
+  EXPECT_FLOAT_EQ(f0->points_S[0].z, 1.001f);
+  EXPECT_FLOAT_EQ(f0->points_S[0].x, static_cast<float>(-1.5 * 1.001 / 3));
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(10)).has_value());
+  auto f2 = source.next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(f2.has_value());
+  EXPECT_FALSE(f2->depth.has_value());
+  EXPECT_EQ(f2->points_S.size(), 2u);  // the NaN point is skipped
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(10)).has_value());
+  EXPECT_EQ(source.status().state, SourceState::kEnded);
+  EXPECT_EQ(source.status().frames, 3u);
+}
+
+TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
+  Recording recording;
+  ReplayConfig config;
+  config.directory = recording.dir.path().string();
+  config.playback = ReplayConfig::Playback::kFixed;
+  config.rate_hz = 20.0;  // 50 ms apart
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected);
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
+  // The second frame is due 50 ms after the start: a 1 ms wait returns nothing.
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(50));
+}
+
+TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {
+  Recording recording;
+  ReplayConfig config;
+  config.directory = (recording.dir.path() / "absent").string();
+  ReplaySource missing(config);
+  EXPECT_EQ(missing.open().state, SourceState::kError);
+  EXPECT_NE(missing.status().reason.find("no such replay directory"), std::string::npos);
+  EXPECT_FALSE(missing.next(std::chrono::milliseconds(1)).has_value());
+
+  fs::remove(recording.dir.path() / "f1.png");
+  config.directory = recording.dir.path().string();
+  ReplaySource lost_frame(config);
+  EXPECT_EQ(lost_frame.open().state, SourceState::kError);
+  EXPECT_NE(lost_frame.status().reason.find("f1.png: no such frame"), std::string::npos)
+      << lost_frame.status().reason;
+
+  fs::remove(recording.dir.path() / "intrinsics.yaml");
+  write_depth_png(recording.dir / "f1.png", ramp(6, 4));
+  ReplaySource no_intrinsics(config);
+  ASSERT_EQ(no_intrinsics.open().state, SourceState::kConnected);
+  EXPECT_THROW((void)no_intrinsics.load(0), Error);
+  EXPECT_FALSE(no_intrinsics.next(std::chrono::milliseconds(1)).has_value());
+  EXPECT_EQ(no_intrinsics.status().state, SourceState::kError);
+  EXPECT_NE(no_intrinsics.status().reason.find("no intrinsics"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cellmap
