@@ -108,7 +108,10 @@ BoxSet box_set_from_json(const std::string& text, const std::string& source) {
     const Eigen::Vector4d q = reader.numbers<4>(reader.field(item, "rotation", where), where + ".rotation");
     if (std::abs(q.norm() - 1.0) > 1e-6)
       reader.fail(where + ".rotation", "must be a unit quaternion [w, x, y, z]");
-    box.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+    box.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    // Re-normalizing a quaternion that is unit to rounding would change its last bits, and a box read back
+    // from disk must equal the one written (or a restart reports it as modified).
+    if (std::abs(box.rotation.norm() - 1.0) > 1e-14) box.rotation.normalize();
     box.points = reader.count(reader.field(item, "points", where), where + ".points");
     set.boxes.push_back(box);
   }

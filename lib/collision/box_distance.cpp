@@ -447,34 +447,41 @@ bool certify_axis(const Vector3d& ha, const Vector3d& hb, const Relative& rel, c
   return true;
 }
 
-// Second certificate: a vertex extreme along the axis and the closest point of the other box to it, when
-// each is the other's closest point (mutually closest points of two convex sets are a closest pair: the
-// direction between them lies in both normal cones). Covers vertex-vertex and vertex-edge contacts.
+// Second certificate: start at a vertex extreme along the axis and alternate closest-point projections
+// between the boxes (a few steps); when a point maps back onto itself the two points are mutually closest,
+// and mutually closest points of two convex sets are a closest pair (the direction between them lies in both
+// normal cones). Covers vertex-vertex, vertex-edge and many edge-face contacts.
 bool certify_vertex(const Vector3d& ha, const Vector3d& hb, const Relative& rel, const SatResult& sat,
                     Vector3d* pa, Vector3d* pb) {
   const Matrix3d& R = rel.R;
   const Vector3d& t = rel.t;
   const double tolerance2 = 1e-26 * (ha.squaredNorm() + hb.squaredNorm() + t.squaredNorm());
-  // B's vertex extreme towards A, A's closest point to it, B's closest point to that.
+  constexpr int kSteps = 3;
+  // From B's vertex extreme towards A: p = closest point of A, q = closest point of B to p, and so on.
   const Vector3d L_B = R.transpose() * sat.axis;
-  const Vector3d v_B(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
-  const Vector3d v = t + R * v_B;
-  const Vector3d p = v.cwiseMax(-ha).cwiseMin(ha);
-  const Vector3d p_B = R.transpose() * (p - t);
-  if ((p_B.cwiseMax(-hb).cwiseMin(hb) - v_B).squaredNorm() <= tolerance2) {
-    *pa = p;
-    *pb = v;
-    return true;
+  Vector3d q_B(sign_of(-L_B[0]) * hb[0], sign_of(-L_B[1]) * hb[1], sign_of(-L_B[2]) * hb[2]);
+  for (int step = 0; step < kSteps; ++step) {
+    const Vector3d q = t + R * q_B;
+    const Vector3d p = q.cwiseMax(-ha).cwiseMin(ha);
+    const Vector3d next_B = (R.transpose() * (p - t)).cwiseMax(-hb).cwiseMin(hb);
+    if ((next_B - q_B).squaredNorm() <= tolerance2) {
+      *pa = p;
+      *pb = q;
+      return true;
+    }
+    q_B = next_B;
   }
-  // A's vertex extreme towards B, symmetric.
-  const Vector3d u(sign_of(sat.axis[0]) * ha[0], sign_of(sat.axis[1]) * ha[1], sign_of(sat.axis[2]) * ha[2]);
-  const Vector3d u_B = R.transpose() * (u - t);
-  const Vector3d q_B = u_B.cwiseMax(-hb).cwiseMin(hb);
-  const Vector3d q = t + R * q_B;
-  if ((q.cwiseMax(-ha).cwiseMin(ha) - u).squaredNorm() <= tolerance2) {
-    *pa = u;
-    *pb = q;
-    return true;
+  // From A's vertex extreme towards B, symmetric.
+  Vector3d p(sign_of(sat.axis[0]) * ha[0], sign_of(sat.axis[1]) * ha[1], sign_of(sat.axis[2]) * ha[2]);
+  for (int step = 0; step < kSteps; ++step) {
+    const Vector3d q = t + R * (R.transpose() * (p - t)).cwiseMax(-hb).cwiseMin(hb);
+    const Vector3d next = q.cwiseMax(-ha).cwiseMin(ha);
+    if ((next - p).squaredNorm() <= tolerance2) {
+      *pa = p;
+      *pb = q;
+      return true;
+    }
+    p = next;
   }
   return false;
 }

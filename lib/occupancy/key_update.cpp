@@ -11,8 +11,9 @@
 #include "cellmap/common/error.hpp"
 
 // Written here rather than taken from OctoMap: OcTree::insertPointCloud walks every ray into a per-ray KeyRay
-// and inserts every step into an unordered_set (1.2 s per 640×480 frame at 2 cm); this walks only the
-// distinct endpoint voxels and marks steps in a dense bit set, on several threads.
+// and inserts every step into an unordered_set (about 1 s per 640×480 frame at 2 cm); this walks one ray per
+// distinct endpoint voxel and marks its steps in a bit set laid out in tree-aligned bricks, on several
+// threads.
 
 namespace cellmap {
 namespace {
@@ -57,18 +58,9 @@ struct KeyBox {
   [[nodiscard]] bool empty() const { return hi[0] < lo[0]; }
   [[nodiscard]] std::uint64_t size(int i) const { return static_cast<std::uint64_t>(hi[i] - lo[i] + 1); }
   [[nodiscard]] std::uint64_t volume() const { return empty() ? 0 : size(0) * size(1) * size(2); }
-  [[nodiscard]] bool contains(const Key& k) const {
-    return k[0] >= lo[0] && k[0] <= hi[0] && k[1] >= lo[1] && k[1] <= hi[1] && k[2] >= lo[2] && k[2] <= hi[2];
-  }
   [[nodiscard]] std::uint64_t index(const Key& k) const {
     return (std::uint64_t(k[2] - lo[2]) * size(1) + std::uint64_t(k[1] - lo[1])) * size(0) +
            std::uint64_t(k[0] - lo[0]);
-  }
-  [[nodiscard]] Key key(std::uint64_t index) const {
-    const std::uint64_t x = index % size(0);
-    const std::uint64_t yz = index / size(0);
-    return Key(static_cast<std::uint16_t>(lo[0] + x), static_cast<std::uint16_t>(lo[1] + yz % size(1)),
-               static_cast<std::uint16_t>(lo[2] + yz / size(1)));
   }
 };
 
@@ -107,8 +99,8 @@ struct BrickGrid {
   int lo[3];     // key of the first brick's base
   int count[3];  // bricks per axis
 
-  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that the ray
-  // walk pays three loads per voxel. Entries outside the box hold an index past the end.
+  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that a ray
+  // walk step (one axis) costs one table lookup.
   std::vector<std::uint32_t> offset[3];  // 32 bits: dense grids have at most 2^28 bits
 
   explicit BrickGrid(const KeyBox& box) {
@@ -144,6 +136,52 @@ struct BrickGrid {
                static_cast<std::uint16_t>(lo[1] + 16 * (byz % count[1])),
                static_cast<std::uint16_t>(lo[2] + 16 * (byz / count[1])));
   }
+};
+
+// Walk cursor over a BrickGrid's bit array (local copies of the tables, so the walk keeps them in registers).
+class DenseCursor {
+ public:
+  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : words_(words) {
+    for (int i = 0; i < 3; ++i) {
+      lo_[i] = grid.lo[i];
+      size_[i] = grid.offset[i].size();
+      table_[i] = grid.offset[i].data();
+    }
+  }
+  bool move(int x, int y, int z) {
+    const std::size_t dx = std::size_t(x - lo_[0]), dy = std::size_t(y - lo_[1]),
+                      dz = std::size_t(z - lo_[2]);
+    if ((dx >= size_[0]) | (dy >= size_[1]) | (dz >= size_[2])) return false;
+    index_ = table_[0][dx] + table_[1][dy] + table_[2][dz];
+    return true;
+  }
+  void mark() { words_[index_ >> 6] |= std::uint64_t{1} << (index_ & 63); }
+
+ private:
+  std::uint64_t* words_;
+  int lo_[3];
+  std::size_t size_[3];
+  const std::uint32_t* table_[3];
+  std::uint32_t index_ = 0;
+};
+
+// Walk cursor that lists packed keys (for boxes too large for a dense bit array).
+class SparseCursor {
+ public:
+  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
+  bool move(int x, int y, int z) {
+    key_[0] = x;
+    key_[1] = y;
+    key_[2] = z;
+    return x >= 0 && y >= 0 && z >= 0 && x <= 0xffff && y <= 0xffff && z <= 0xffff;
+  }
+  void mark() {
+    out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
+  }
+
+ private:
+  std::vector<std::uint64_t>& out_;
+  int key_[3] = {0, 0, 0};
 };
 
 void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
@@ -210,13 +248,16 @@ struct Ray {
 
 // Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic
 // (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
-// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `mark` instead
+// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `cursor` instead
 // of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
-// nothing.
-template <class Mark>
-void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Mark&& mark) {
+// nothing. The cursor follows the walk one axis step at a time (move(axis, key) returns false when the walk
+// leaves its grid; the walk then stops, as it never comes back on that axis) and marks the current voxel.
+template <class Cursor>
+void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
   if (origin.key == ray.end_key) return;
-  mark(int{origin.key[0]}, int{origin.key[1]}, int{origin.key[2]});
+  const int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
+  if (!cursor.move(key[0], key[1], key[2])) return;
+  cursor.mark();
 
   float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
   const float norm_sq =
@@ -225,7 +266,6 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   for (float& d : direction) d /= length;
 
   const double resolution = grid.getResolution();
-  int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
   int step[3];
   double t_max[3];
   double t_delta[3];
@@ -241,23 +281,33 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
-
+  // The axis whose voxel border comes next (OctoMap's tie-breaking: the later axis wins ties).
+  // The loop keeps everything in scalars and chooses the axis with selects rather than branches: the choice
+  // is unpredictable, and a mispredicted branch (or an array indexed by it) per voxel costs more than the
+  // rest.
+  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
+  int kx = key[0], ky = key[1], kz = key[2];
+  const int ex = ray.end_key[0], ey = ray.end_key[1], ez = ray.end_key[2];
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
-  int steps_left = 3;
-  for (int i = 0; i < 3; ++i) steps_left += std::abs(int{ray.end_key[i]} - key[i]);
+  int steps_left = 3 + std::abs(ex - kx) + std::abs(ey - ky) + std::abs(ez - kz);
   while (steps_left-- > 0) {
-    int dim;
-    if (t_max[0] < t_max[1]) {
-      dim = t_max[0] < t_max[2] ? 0 : 2;
-    } else {
-      dim = t_max[1] < t_max[2] ? 1 : 2;
-    }
-    key[dim] += step[dim];
-    t_max[dim] += t_delta[dim];
-    if (key[0] == ray.end_key[0] && key[1] == ray.end_key[1] && key[2] == ray.end_key[2]) return;
+    // OctoMap's tie-breaking: the later axis wins ties.
+    const bool x_before_y = tx < ty;
+    const double t_xy = x_before_y ? tx : ty;
+    const bool z_axis = !(t_xy < tz);
+    const bool x_axis = !z_axis && x_before_y;
+    const bool y_axis = !z_axis && !x_before_y;
+    kx += x_axis ? step[0] : 0;
+    ky += y_axis ? step[1] : 0;
+    kz += z_axis ? step[2] : 0;
+    tx = x_axis ? tx + t_delta[0] : tx;
+    ty = y_axis ? ty + t_delta[1] : ty;
+    tz = z_axis ? tz + t_delta[2] : tz;
+    if (kx == ex && ky == ey && kz == ez) return;
     // Past the end point without entering its voxel (rounding at a corner): stop, as OctoMap does.
-    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
-    mark(key[0], key[1], key[2]);
+    if (std::min(std::min(tx, ty), tz) > length) return;
+    if (!cursor.move(kx, ky, kz)) return;
+    cursor.mark();
   }
 }
 
@@ -416,19 +466,11 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     std::vector<std::uint64_t>& set = sets[t];
     if (dense) {
       set.assign(bits / 64, 0);
-      std::uint64_t* words = set.data();
-      for (std::size_t r = begin; r < end; ++r) {
-        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
-          const std::uint32_t i = grid_bits.index(x, y, z);
-          if (i < bits) words[i >> 6] |= std::uint64_t{1} << (i & 63);
-        });
-      }
+      DenseCursor cursor(grid_bits, set.data());
+      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
     } else {
-      for (std::size_t r = begin; r < end; ++r) {
-        walk_ray(origins[rays[r].origin], rays[r], grid, [&](int x, int y, int z) {
-          set.push_back(std::uint64_t(x) | (std::uint64_t(y) << 16) | (std::uint64_t(z) << 32));
-        });
-      }
+      SparseCursor cursor(set);
+      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
     }
   });
 

@@ -1,8 +1,13 @@
 #include "cellmap/occupancy/occupancy_map.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <istream>
+#include <ostream>
+#include <string>
 #include <tuple>
 
+#include "cellmap/common/error.hpp"
 #include "cellmap/occupancy/key_update.hpp"
 
 namespace cellmap {
@@ -173,11 +178,15 @@ Eigen::Vector3d OccupancyMap::centre(const octomap::OcTreeKey& key) const {
   return {tree_->keyToCoord(key[0]), tree_->keyToCoord(key[1]), tree_->keyToCoord(key[2])};
 }
 
-std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
-  std::vector<octomap::OcTreeKey> keys;
-  const unsigned depth = tree_->getTreeDepth();
-  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (!tree_->isNodeOccupied(*it)) continue;
+namespace {
+
+// Appends the leaf keys of the occupied leaves (pruned ones expanded) that `begin`..`end` visit.
+template <class Iterator>
+void append_occupied(const octomap::OcTree& tree, Iterator begin, Iterator end,
+                     std::vector<octomap::OcTreeKey>& keys) {
+  const unsigned depth = tree.getTreeDepth();
+  for (auto it = begin; it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
     if (it.getDepth() == depth) {
       keys.push_back(it.getKey());
       continue;
@@ -190,7 +199,92 @@ std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
         for (int x = 0; x < span; ++x) keys.emplace_back(first[0] + x, first[1] + y, first[2] + z);
   }
   std::sort(keys.begin(), keys.end(), zyx_less);
+}
+
+}  // namespace
+
+std::vector<octomap::OcTreeKey> OccupancyMap::occupied_keys() const {
+  std::vector<octomap::OcTreeKey> keys;
+  append_occupied(*tree_, tree_->begin_leafs(), tree_->end_leafs(), keys);
   return keys;
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres_in(const Eigen::Vector3d& min_C,
+                                                               const Eigen::Vector3d& max_C) const {
+  std::vector<Eigen::Vector3d> centres;
+  if (!min_C.allFinite() || !max_C.allFinite() || (min_C.array() > max_C.array()).any()) return centres;
+  const octomap::point3d lo(float(min_C.x()), float(min_C.y()), float(min_C.z()));
+  const octomap::point3d hi(float(max_C.x()), float(max_C.y()), float(max_C.z()));
+  std::vector<octomap::OcTreeKey> keys;
+  append_occupied(*tree_, tree_->begin_leafs_bbx(lo, hi), tree_->end_leafs_bbx(), keys);
+  for (const octomap::OcTreeKey& key : keys) {
+    const Eigen::Vector3d c = centre(key);
+    if ((c.array() >= min_C.array()).all() && (c.array() <= max_C.array()).all()) centres.push_back(c);
+  }
+  return centres;
+}
+
+}  // namespace cellmap
+
+namespace cellmap {
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres(const std::vector<Region>& regions) const {
+  std::vector<octomap::OcTreeKey> keys;
+  for (const Region& region : regions) {
+    if (region.volume() <= 0) continue;
+    const octomap::point3d min(static_cast<float>(region.min.x()), static_cast<float>(region.min.y()),
+                               static_cast<float>(region.min.z()));
+    const octomap::point3d max(static_cast<float>(region.max.x()), static_cast<float>(region.max.y()),
+                               static_cast<float>(region.max.z()));
+    for (auto it = tree_->begin_leafs_bbx(min, max), end = tree_->end_leafs_bbx(); it != end; ++it) {
+      if (!tree_->isNodeOccupied(*it)) continue;
+      // Pruned leaves stand for several voxels: enumerate the leaf-level keys they cover.
+      const int span = 1 << (tree_->getTreeDepth() - it.getDepth());
+      const octomap::OcTreeKey base = it.getIndexKey();
+      for (int dz = 0; dz < span; ++dz) {
+        for (int dy = 0; dy < span; ++dy) {
+          for (int dx = 0; dx < span; ++dx) {
+            const octomap::OcTreeKey key(base[0] + dx, base[1] + dy, base[2] + dz);
+            if (region.contains(centre(key))) keys.push_back(key);
+          }
+        }
+      }
+    }
+  }
+  const auto zyx = [](const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
+    return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+  };
+  std::sort(keys.begin(), keys.end(), zyx);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(keys.size());
+  for (const auto& key : keys) centres.push_back(centre(key));
+  return centres;
+}
+
+void OccupancyMap::write(std::ostream& out) const {
+  out.precision(17);
+  out << "cellmap-occupancy resolution " << config_.resolution << "\n";
+  tree_->writeData(out);
+  if (!out) throw Error("occupancy map: writing the map failed");
+}
+
+void OccupancyMap::read(std::istream& in) {
+  std::string magic, word;
+  double resolution = 0;
+  if (!(in >> magic >> word >> resolution) || magic != "cellmap-occupancy" || word != "resolution" ||
+      in.get() != '\n') {
+    throw Error("occupancy map: not a saved cellmap occupancy map");
+  }
+  if (std::abs(resolution - config_.resolution) > 1e-12) {
+    throw Error("occupancy map: the saved map has resolution " + std::to_string(resolution) +
+                " m, the config says " + std::to_string(config_.resolution) + " m");
+  }
+  auto tree = std::make_unique<octomap::OcTree>(config_.resolution);
+  apply_sensor_model(config_, *tree);
+  tree->readData(in);
+  if (!in) throw Error("occupancy map: the saved map is truncated");
+  tree_ = std::move(tree);
 }
 
 }  // namespace cellmap

@@ -227,9 +227,12 @@ std::optional<Frame> OpenNI2Source::next(std::chrono::milliseconds timeout) {
   }
   openni::VideoStream* streams[] = {&device_->stream};
   int ready = -1;
+  const auto waited_since = std::chrono::steady_clock::now();
   const openni::Status waited =
       openni::OpenNI::waitForAnyStream(streams, 1, &ready, static_cast<int>(timeout.count()));
   if (waited != openni::STATUS_OK) {
+    // A failing device can return at once; wait out the timeout so callers never spin.
+    if (waited != openni::STATUS_TIME_OUT) std::this_thread::sleep_until(waited_since + timeout);
     if (reconnector_.check(steady_seconds())) {
       if (device_->frame_count >= 0) {
         ended_ = true;  // an .oni file that stops delivering has been played to its end
@@ -288,27 +291,66 @@ void OpenNI2Source::close() {
   ended_ = false;
 }
 
+namespace {
+
+// Opens `uri` and reads its depth modes; nullopt with `reason` set when it does not open.
+std::string vendor_and_name(const char* vendor, const char* name) {
+  const std::string a = vendor ? vendor : "";
+  const std::string b = name ? name : "";
+  return a.empty() ? b : b.empty() ? a : a + " " + b;
+}
+
+std::optional<DepthDeviceInfo> describe_device(const std::string& uri, std::string& reason) {
+  openni::Device device;
+  if (device.open(uri.c_str()) != openni::STATUS_OK) {
+    reason = openni_error();
+    return std::nullopt;
+  }
+  DepthDeviceInfo info;
+  info.driver = "openni2";
+  info.uri = uri;
+  const openni::DeviceInfo& about = device.getDeviceInfo();
+  info.name = vendor_and_name(about.getVendor(), about.getName());
+  if (const openni::SensorInfo* sensor = device.getSensorInfo(openni::SENSOR_DEPTH)) {
+    const openni::Array<openni::VideoMode>& modes = sensor->getSupportedVideoModes();
+    for (int m = 0; m < modes.getSize(); ++m) info.modes.push_back(to_mode(modes[m]));
+  }
+  device.close();
+  return info;
+}
+
+}  // namespace
+
 std::vector<DepthDeviceInfo> list_openni2_devices() {
   ensure_openni();
   openni::Array<openni::DeviceInfo> found;
   openni::OpenNI::enumerateDevices(&found);
   std::vector<DepthDeviceInfo> devices;
   for (int i = 0; i < found.getSize(); ++i) {
-    DepthDeviceInfo info;
-    info.driver = "openni2";
-    info.uri = found[i].getUri();
-    info.name = std::string(found[i].getVendor()) + " " + found[i].getName();
-    openni::Device device;
-    if (device.open(found[i].getUri()) == openni::STATUS_OK) {
-      if (const openni::SensorInfo* sensor = device.getSensorInfo(openni::SENSOR_DEPTH)) {
-        const openni::Array<openni::VideoMode>& modes = sensor->getSupportedVideoModes();
-        for (int m = 0; m < modes.getSize(); ++m) info.modes.push_back(to_mode(modes[m]));
-      }
-      device.close();
+    std::string reason;
+    if (auto info = describe_device(found[i].getUri(), reason)) {
+      devices.push_back(std::move(*info));
+    } else {
+      // Listed by the driver but busy or gone: still show it, without modes.
+      DepthDeviceInfo listed;
+      listed.driver = "openni2";
+      listed.uri = found[i].getUri();
+      listed.name =
+          std::string(found[i].getVendor()) + " " + found[i].getName() + " (cannot open: " + reason + ")";
+      devices.push_back(std::move(listed));
     }
-    devices.push_back(std::move(info));
   }
   return devices;
+}
+
+DepthDeviceInfo probe_openni2_device(const std::string& uri) {
+  if (is_oni_file(uri) && !std::filesystem::is_regular_file(uri))
+    throw Error("openni2 " + uri + ": no such recording");
+  ensure_openni();
+  std::string reason;
+  std::optional<DepthDeviceInfo> info = describe_device(uri, reason);
+  if (!info) throw Error("openni2 " + uri + ": " + reason);
+  return std::move(*info);
 }
 
 }  // namespace cellmap

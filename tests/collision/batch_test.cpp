@@ -111,5 +111,47 @@ TEST(RobotBoxesTest, GantryBoxesFollowTheJoints) {
   EXPECT_THROW(RobotBoxes(gantry, {{"ram", {}, Vector3d(1, -1, 1)}}), Error);
 }
 
+// A two-link arm: shoulder revolute about z at 0.5 m height, a 0.6 m upper arm with a box along its x axis.
+constexpr const char* kArm = R"(<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.4 0.4 0.5"/></geometry></collision></link>
+  <link name="upper_arm">
+    <collision><origin xyz="0.3 0 0" rpy="0 0 0"/><geometry><box size="0.6 0.1 0.1"/></geometry></collision>
+  </link>
+  <link name="flange"/>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="upper_arm"/><origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="tip" type="fixed"><parent link="upper_arm"/><child link="flange"/><origin xyz="0.6 0 0"/></joint>
+</robot>)";
+
+TEST(RobotBoxesTest, UrdfBoxGeometryFollowsTheJoints) {
+  const Robot arm = Robot::from_urdf_string(kArm, "flange");
+  const std::vector<LinkBox> boxes = link_boxes_from_urdf(kArm, arm, "arm.urdf");
+  ASSERT_EQ(boxes.size(), 2u);
+  const RobotBoxes robot(arm, boxes);
+  // Shoulder at 90 degrees: the upper arm box points along +y, centred 0.3 m out at 0.5 m height.
+  const std::vector<Obb> placed = robot.place(Eigen::VectorXd::Constant(1, M_PI / 2));
+  EXPECT_LT((placed[0].center - Vector3d(0, 0, 0.25)).norm(), 1e-12);
+  EXPECT_LT((placed[1].center - Vector3d(0, 0.3, 0.5)).norm(), 1e-12);
+  EXPECT_LT((placed[1].aabb_half_extents() - Vector3d(0.05, 0.3, 0.05)).norm(), 1e-12);
+  // An obstacle 0.2 m beyond the arm's tip along y: the constraint reports exactly that.
+  const Obb obstacle(Vector3d(0, 0.9, 0.5), Vector3d(0.1, 0.1, 0.1));
+  EXPECT_NEAR(signed_distance(placed[1], obstacle).distance, 0.2, 1e-12);
+
+  std::string sphere_arm = kArm;
+  const std::string upper_box = "<box size=\"0.6 0.1 0.1\"/>";
+  sphere_arm.replace(sphere_arm.find(upper_box), upper_box.size(), "<sphere radius=\"0.1\"/>");
+  ASSERT_NO_THROW((void)Robot::from_urdf_string(sphere_arm, "flange"));  // still a valid URDF
+  try {
+    (void)link_boxes_from_urdf(sphere_arm, arm, "arm.urdf");
+    ADD_FAILURE() << "a sphere must be refused";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "arm.urdf: link 'upper_arm' collision 0: only box geometry is supported");
+  }
+  EXPECT_THROW((void)link_boxes_from_urdf("<robot", arm, "bad.urdf"), Error);
+}
+
 }  // namespace
 }  // namespace cellmap::collision

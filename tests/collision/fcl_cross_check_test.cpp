@@ -152,6 +152,9 @@ TEST(FclCrossCheckTest, HundredThousandRandomBoxPairs) {
       const SignedDistance epa = epa_penetration(a, b);
       worst_epa = std::max(worst_epa, std::abs(epa.distance - ours.distance));
       ASSERT_NEAR(epa.distance, ours.distance, 1e-9) << "pair " << i;
+      // FCL's depth comes from fcl::collide (its box-box routine), not from its signed distance: that one
+      // runs EPA, which throws on nearly touching boxes (fcl#445/#493) and aborts on an assertion for
+      // touching ones.
       fcl::CollisionRequestd request(1, true);
       request.gjk_solver_type = fcl::GST_INDEP;
       fcl::CollisionResultd result;
@@ -178,6 +181,27 @@ TEST(FclCrossCheckTest, HundredThousandRandomBoxPairs) {
       fcl_depth_agrees, fcl_face_preference, worst_epa);
   EXPECT_GT(separated, kPairs / 5);
   EXPECT_GT(overlapping, kPairs / 5);
+}
+
+TEST(FclCrossCheckTest, KnownFclLibccdBug508) {
+  // Unit cubes 4 apart on y: the answer is 3. FCL's default libccd solver answers sqrt(10) = 3.16228
+  // (fcl#508); GST_INDEP gets it right. Should a later FCL fix it, the libccd answer becomes 3 and this still
+  // passes.
+  const Obb a(Vector3d::Zero(), Vector3d(0.5, 0.5, 0.5));
+  const Obb b(Vector3d(0, 4, 0), Vector3d(0.5, 0.5, 0.5));
+  EXPECT_NEAR(signed_distance(a, b).distance, 3.0, 1e-12);
+  const fcl::Boxd box(1, 1, 1);
+  for (const auto solver : {fcl::GST_LIBCCD, fcl::GST_INDEP}) {
+    fcl::DistanceRequestd request(true, false);
+    request.gjk_solver_type = solver;
+    fcl::DistanceResultd result;
+    const double theirs = fcl::distance(&box, fcl_pose(a), &box, fcl_pose(b), request, result);
+    std::printf("FCL %s: %.6f\n", solver == fcl::GST_LIBCCD ? "libccd" : "indep", theirs);
+    if (std::abs(theirs - 3.0) > 1e-6) {
+      EXPECT_EQ(solver, fcl::GST_LIBCCD);
+      EXPECT_NEAR(theirs, std::sqrt(10.0), 1e-4);
+    }
+  }
 }
 
 }  // namespace

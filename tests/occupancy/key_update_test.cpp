@@ -50,7 +50,7 @@ Sweep one_scan(const Eigen::Isometry3d& X_CS, int width = 96, int height = 72) {
 }
 
 TEST(KeyUpdateTest, EqualsOctomapsDiscreteUpdateForOneScan) {
-  octomap::OcTree tree(0.03);
+  octomap::OcTree tree(0.04);
   for (const Eigen::Isometry3d& X_CS : {Eigen::Isometry3d::Identity(), tilted_pose()}) {
     for (const double max_range : {5.0, 2.5}) {  // 2.5 m truncates the rays to the back wall
       const Sweep sweep = one_scan(X_CS);
@@ -79,7 +79,7 @@ TEST(KeyUpdateTest, ResultDoesNotDependOnThreads) {
 }
 
 TEST(KeyUpdateTest, SeveralScansUniteWithOccupiedWinning) {
-  octomap::OcTree tree(0.02);
+  octomap::OcTree tree(0.04);
   Sweep sweep = one_scan(Eigen::Isometry3d::Identity(), 80, 60);
   sweep.scans.push_back(one_scan(tilted_pose(), 80, 60).scans[0]);
   octomap::KeySet free, occupied;
@@ -93,6 +93,34 @@ TEST(KeyUpdateTest, SeveralScansUniteWithOccupiedWinning) {
   const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 2);
   EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
   EXPECT_EQ(ours.free_keys(), sorted(free));
+}
+
+// Scans 150 m apart span more than 2^28 voxels: the sorted-key fallback must give the same result.
+TEST(KeyUpdateTest, HugeSweepBoxFallsBackToSortingWithSameResult) {
+  octomap::OcTree tree(0.01);
+  Sweep sweep;
+  for (const double offset : {0.0, 150.0}) {
+    Scan scan;
+    scan.origin_C = Eigen::Vector3d(offset + 0.003, offset - 0.002, 0.001);
+    for (int i = 0; i < 20; ++i) {
+      scan.points_C.push_back(
+          pcl::PointXYZ(float(offset + 0.5 + 0.01 * i), float(offset + 0.2 - 0.03 * i), 0.1f));
+    }
+    sweep.scans.push_back(scan);
+  }
+  octomap::KeySet free, occupied;
+  for (const Scan& scan : sweep.scans) {
+    octomap::KeySet scan_free, scan_occupied;
+    tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), scan_free, scan_occupied, 5.0);
+    free.insert(scan_free.begin(), scan_free.end());
+    occupied.insert(scan_occupied.begin(), scan_occupied.end());
+  }
+  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 2);
+  EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
+  EXPECT_EQ(ours.free_keys(), sorted(free));
+  EXPECT_EQ(ours.occupied_count, occupied.size());
+  EXPECT_GT(free.size(), 100u);
 }
 
 TEST(KeyUpdateTest, SkipsNonFinitePointsAndRejectsBadOrigins) {

@@ -9,6 +9,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include <unistd.h>
+
+#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 #include "cellmap/sensor/pose_buffer.hpp"
@@ -156,6 +159,41 @@ TEST(GrabberSequenceTest, ReplayGivesEachFrameItsRecordedPose) {
   EXPECT_NEAR(origin.x(), 0.2 - s * 0.05, 1e-12);
   EXPECT_NEAR(origin.y(), c * 0.05, 1e-12);
   EXPECT_NEAR(origin.z(), 1.6, 1e-12);
+  fs::remove_all(dir);
+}
+
+TEST(GrabberSequenceTest, PngReplayOfTheRealDepthGivesTheSamePoints) {
+  SKIP_WITHOUT_DATA();
+  // The replay format a simulator or recorder writes (16-bit PNG + intrinsics.yaml), filled with a real
+  // frame, must reproduce the points of the original TIFF exactly.
+  const std::string stem = frame_stems().front();
+  const RawDepth raw = read_depth_image((kSequence / (stem + "_depth.tiff")).string());
+  const fs::path dir = fs::temp_directory_path() / ("cellmap_png_replay_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_depth_png((dir / "f0.png").string(), raw);
+  write_file_atomically((dir / "intrinsics.yaml").string(),
+                        "width: 640\nheight: 480\nfx: 525\nfy: 525\ncx: 320\ncy: 240\ndepth_scale: 0.001\n");
+  write_replay_poses((dir / "poses.csv").string(),
+                     {ReplayEntry{"f0.png", 1.0, Eigen::Isometry3d::Identity()}});
+  ReplayConfig config;
+  config.directory = dir.string();
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
+  const Frame from_png = source.load(0);
+
+  DepthImage image;
+  image.intrinsics = read_pcl_intrinsics_xml((kSequence / (stem + ".xml")).string());
+  image.intrinsics.width = raw.width;
+  image.intrinsics.height = raw.height;
+  image.depth = raw.depth;
+  const Cloud from_tiff = depth_to_points(image);
+  ASSERT_TRUE(from_png.depth.has_value());
+  EXPECT_EQ(from_png.depth->depth, raw.depth);
+  ASSERT_EQ(from_png.points_S.size(), from_tiff.size());
+  for (std::size_t i = 0; i < from_tiff.size(); ++i) {
+    ASSERT_EQ(from_png.points_S[i].getVector3fMap(), from_tiff[i].getVector3fMap()) << "point " << i;
+  }
   fs::remove_all(dir);
 }
 

@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/robot/robot.hpp"
@@ -101,6 +103,30 @@ TEST(PoseBufferTest, JointVectorsGoThroughTheRobotsKinematics) {
   ASSERT_EQ(r.status, PoseLookup::kFound);
   EXPECT_LT(max_difference(r.X_CE, Eigen::Translation3d(1.1, 0.5, 0.8) * X_CE_zero), 1e-12);
   EXPECT_THROW(buffer.push_joints(5.03, gantry, Eigen::Vector2d(1, 2)), Error);
+}
+
+TEST(PoseBufferTest, ReaderSeesConsistentPosesWhileAWriterPushes) {
+  // The robot feeder and the sensor loop run on different threads: every pose a reader gets must lie on the
+  // straight path being pushed (x = stamp, y = 2 stamp), never a torn or half-written sample.
+  PoseBuffer buffer(0.02, 256);
+  buffer.push(0.0, pose(0, 0, 0, 0));
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    for (int i = 1; i <= 20000; ++i) buffer.push(i * 0.01, pose(i * 0.01, i * 0.02, 0, 0));
+    done = true;
+  });
+  while (!done) {
+    for (double t : {0.005, 10.005, 50.0, 150.015}) {
+      const PoseBuffer::Result r = buffer.at(t);
+      if (r.status != PoseLookup::kFound) continue;
+      ASSERT_NEAR(r.X_CE.translation().x(), t, 1e-9);
+      ASSERT_NEAR(r.X_CE.translation().y(), 2 * t, 1e-9);
+    }
+  }
+  writer.join();
+  EXPECT_EQ(buffer.size(), 256u);
+  EXPECT_EQ(buffer.at(199.995).status, PoseLookup::kFound);
+  EXPECT_EQ(buffer.at(0.005).status, PoseLookup::kMissing);  // long dropped from the buffer
 }
 
 TEST(SensorPoserTest, ComposesTheHandEyeExtrinsicAndCountsDrops) {

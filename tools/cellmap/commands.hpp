@@ -8,10 +8,13 @@
 namespace cellmap::cli {
 
 // void add_<name>_command(CLI::App& app);  -- one line per subcommand, in the order of `cellmap --help`.
-void add_bench_command(CLI::App& app);
-void add_distance_command(CLI::App& app);
-void add_sensors_command(CLI::App& app);
+void add_segment_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_sensors_command(CLI::App& app);
+void add_echo_command(CLI::App& app);
+void add_inject_command(CLI::App& app);
+void add_distance_command(CLI::App& app);
 void add_paper_figure_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace cellmap::cli

@@ -8,11 +8,14 @@ int main(int argc, char** argv) {
   CLI::App app{"cellmap: keeps a robot cell's collision environment up to date (tools over the library)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "cellmap 0.1.0");
-  cellmap::cli::add_bench_command(app);
-  cellmap::cli::add_distance_command(app);
-  cellmap::cli::add_sensors_command(app);
+  cellmap::cli::add_segment_command(app);
   cellmap::cli::add_simulate_command(app);
+  cellmap::cli::add_sensors_command(app);
+  cellmap::cli::add_echo_command(app);
+  cellmap::cli::add_inject_command(app);
+  cellmap::cli::add_distance_command(app);
   cellmap::cli::add_paper_figure_command(app);
+  cellmap::cli::add_bench_command(app);
 
   try {
     app.parse(argc, argv);

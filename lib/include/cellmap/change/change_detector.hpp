@@ -39,9 +39,10 @@ struct ChangeConfig final {
 struct ChangeRegion final {
   Eigen::Vector3d min_C;  ///< lower corner of the changed voxels' extent minus the margin, metres, cell frame
   Eigen::Vector3d max_C;  ///< upper corner plus the margin
-  std::vector<octomap::OcTreeKey>
-      appeared;  ///< voxels now occupied that were free or unknown, sorted (z, y, x)
-  std::vector<octomap::OcTreeKey> vanished;  ///< voxels now free that were occupied, sorted (z, y, x)
+  /// Voxels (leaf keys of the map's tree) now occupied that were free or unknown, sorted (z, y, x).
+  std::vector<octomap::OcTreeKey> appeared;
+  /// Voxels now free that were occupied, sorted (z, y, x).
+  std::vector<octomap::OcTreeKey> vanished;
 
   /// Whether p_C lies inside the bounds.
   [[nodiscard]] bool contains(const Eigen::Vector3d& p_C) const;

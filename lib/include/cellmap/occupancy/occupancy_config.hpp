@@ -11,16 +11,23 @@ namespace cellmap {
 /// [log-odds(clamp_min), log-odds(clamp_max)]; a voxel is occupied when its probability is >=
 /// occupied_threshold. The defaults are OctoMap's own defaults at 2 cm.
 struct OccupancyConfig final {
-  double resolution = 0.02;   ///< voxel edge, metres (YAML `occupancy.resolution`)
-  double hit = 0.7;           ///< P(occupied | point in voxel), in (0.5, 1) (`occupancy.hit`)
-  double miss = 0.4;          ///< P(occupied | ray crosses voxel), in (0, 0.5) (`occupancy.miss`)
-  double clamp_min = 0.1192;  ///< lower probability clamp (`occupancy.clamp_min`)
-  double clamp_max = 0.971;   ///< upper probability clamp (`occupancy.clamp_max`)
-  double occupied_threshold =
-      0.5;  ///< probability at or above which a voxel is occupied (`occupancy.occupied_threshold`)
-  double max_range = 5.0;  ///< metres from the sensor origin; a farther point only clears free space up
-                           ///< to this range and marks nothing occupied (`occupancy.max_range`)
-  int threads = 2;         ///< ray-casting threads (`occupancy.threads`); results do not depend on it
+  /// Voxel edge, metres (YAML `occupancy.resolution`).
+  double resolution = 0.02;
+  /// P(occupied | point in voxel), in (0.5, 1) (`occupancy.hit`).
+  double hit = 0.7;
+  /// P(occupied | ray crosses voxel), in (0, 0.5) (`occupancy.miss`).
+  double miss = 0.4;
+  /// Lower probability clamp (`occupancy.clamp_min`).
+  double clamp_min = 0.1192;
+  /// Upper probability clamp (`occupancy.clamp_max`).
+  double clamp_max = 0.971;
+  /// Probability at or above which a voxel is occupied (`occupancy.occupied_threshold`).
+  double occupied_threshold = 0.5;
+  /// Metres from the sensor origin; a farther point only clears free space up to this range and marks nothing
+  /// occupied (`occupancy.max_range`).
+  double max_range = 5.0;
+  /// Ray-casting threads (`occupancy.threads`); the result does not depend on it.
+  int threads = 2;
 
   /// @throws Error naming the field if a value is out of range: resolution in [0.001, 1] m; 0.5 < hit < 1;
   /// 0 < miss < 0.5; 0 < clamp_min < occupied_threshold < clamp_max < 1; max_range in (0, 100] m;

@@ -7,8 +7,10 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <iosfwd>
 #include <vector>
 
+#include "cellmap/common/region.hpp"
 #include "cellmap/occupancy/occupancy_config.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
@@ -55,6 +57,23 @@ class OccupancyMap final {
   [[nodiscard]] Eigen::Vector3d centre(const octomap::OcTreeKey& key) const;
   /// Leaf keys of all occupied voxels, sorted by (z, y, x).
   [[nodiscard]] std::vector<octomap::OcTreeKey> occupied_keys() const;
+  /// Centres (metres, cell frame) of the occupied voxels whose centre lies in the box [min_C, max_C], sorted
+  /// by key (z, y, x) — the occupied evidence inside a change region. Cost: the tree's leaves overlapping the
+  /// box.
+  [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres_in(const Eigen::Vector3d& min_C,
+                                                                 const Eigen::Vector3d& max_C) const;
+
+  /// Centres of the occupied leaf voxels inside any of `regions` (metres, cell frame), each voxel once, in
+  /// (z, y, x) key order. Cost: a bounding-box walk of the tree per region.
+  [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres(const std::vector<Region>& regions) const;
+
+  /// Writes the whole map, log-odds included, to `out` (a resolution line, then OctoMap's node data), so a
+  /// restarted daemon continues with the same evidence. Silent (OctoMap's .bt writer prints to stderr).
+  /// @throws Error if the stream fails.
+  void write(std::ostream& out) const;
+  /// Replaces the map with one written by write() at the same resolution.
+  /// @throws Error if the stream is not such a map or its resolution differs from the config's.
+  void read(std::istream& in);
 
   /// The OcTree itself (for queries, writing .bt files, or comparison); its parameters are the config's.
   [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }

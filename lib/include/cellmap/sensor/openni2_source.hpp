@@ -75,4 +75,9 @@ class OpenNI2Source final : public DepthSource {
 /// @throws Error if OpenNI2 cannot initialise (its reason, e.g. no drivers found).
 [[nodiscard]] std::vector<DepthDeviceInfo> list_openni2_devices();
 
+/// Opens one OpenNI2 URI that enumeration does not list (an .oni recording, a driver's named virtual device
+/// such as "Dummy") and reports its depth modes. @throws Error "openni2 <uri>: <OpenNI2's reason>" if it does
+/// not open.
+[[nodiscard]] DepthDeviceInfo probe_openni2_device(const std::string& uri);
+
 }  // namespace cellmap

@@ -1,31 +1,31 @@
 #pragma once
 // Replay of recorded frames from a directory: reproduces a field problem on a desk.
 //
+// clang-format off
 // Replay directory format (version 1):
 //
-//   DIR/poses.csv     one row per frame, in time order, after one header line that must read exactly
-//                       file,stamp,x,y,z,qw,qx,qy,qz
-//                     file   the frame, relative to DIR (or absolute):
-//                            - a depth image: single-channel 16-bit grayscale PNG (.png) or TIFF
-//                            (.tif/.tiff),
-//                              raw sensor units (0 = no return), converted with the intrinsics below; or
-//                            - a point cloud (.pcd, any PCL point type with x y z), already in the sensor
-//                            frame
-//                              (metres, x right, y down, z forward); NaN points are skipped.
-//                     stamp  seconds, strictly increasing (any epoch; frames keep it as Frame::stamp)
-//                     x,y,z  position of the END-EFFECTOR (tool) in the cell frame, metres: X_CE
-//                     qw..qz its orientation, unit quaternion [w, x, y, z]
-//                     Blank lines and lines starting with '#' are skipped. A recorder that knows sensor poses
-//                     instead writes X_CS here and configures the sensor with an identity hand-eye extrinsic.
-//   Intrinsics of a depth image, first found of:
-//     DIR/<image stem without a trailing "_depth">.xml   PCL grabber format (<depth><focal_length_x> …
-//                                                        <z_multiplication_factor>), as PCL's ImageGrabber
-//                                                        writes beside frame_<time>_depth.tiff
-//     DIR/intrinsics.yaml                                width, height, fx, fy, cx, cy, depth_scale
-//                                                        [, min_range, max_range] (see read_intrinsics_yaml)
+//   DIR/poses.csv   one row per frame, in time order, after one header line that must read exactly
+//                     file,stamp,x,y,z,qw,qx,qy,qz
+//                   Blank lines and lines starting with '#' are skipped.
+//     file    the frame, relative to DIR (or absolute), one of
+//             - a depth image: single-channel 16-bit grayscale PNG (.png) or TIFF (.tif, .tiff), raw sensor
+//               units (0 = no return), converted with the intrinsics below;
+//             - a point cloud (.pcd, any PCL point type with x y z) already in the sensor frame (metres,
+//               x right, y down, z forward); NaN points are skipped.
+//     stamp   seconds, strictly increasing, any epoch (frames keep it as Frame::stamp)
+//     x,y,z   position of the END-EFFECTOR (tool) in the cell frame, metres: X_CE
+//     qw..qz  its orientation, unit quaternion [w, x, y, z]
+//             A recorder that knows sensor poses instead writes X_CS here and configures the sensor with an
+//             identity hand-eye extrinsic.
+//   Intrinsics of a depth image, the first found of
+//     <image folder>/<image stem without a trailing "_depth">.xml
+//             PCL grabber format (<depth><focal_length_x> … <z_multiplication_factor>), as PCL's
+//             ImageGrabber writes beside frame_<time>_depth.tiff;
+//     DIR/intrinsics.yaml
+//             width, height, fx, fy, cx, cy, depth_scale [, min_range, max_range] (read_intrinsics_yaml).
 //
-// Example: pcl/grabber_sequence (frame_<t>_depth.tiff + frame_<t>.xml) plus a poses.csv is a replay
-// directory.
+// Example: pcl/grabber_sequence (frame_<t>_depth.tiff + frame_<t>.xml) plus a poses.csv is a replay folder.
+// clang-format on
 
 #include <Eigen/Geometry>
 

@@ -1,16 +1,18 @@
-// OpenNI2 and V4L2 sources on this machine. No camera is plugged in here, so the tests check the no-device
-// path (a clear reason, a clean disconnected status, retries with back-off). The OpenNI2 driver path itself
-// runs on the "Dummy" device of Debian's OpenNI2 (libDummyDevice.so, a real OpenNI2 driver that streams a
-// synthetic 320×240 DEPTH_1_MM image at 30 fps: row 0 at 2000 mm and a moving disc near 1000 mm).
+// OpenNI2 source on this machine. No camera is plugged in here, so the tests check the no-device path (a
+// clear reason, a clean disconnected status, retries with back-off). The OpenNI2 driver path itself runs on
+// the "Dummy" device of Debian's OpenNI2 (libDummyDevice.so, a real OpenNI2 driver that streams a synthetic
+// 320×240 DEPTH_1_MM image at 30 fps: row 0 at 2000 mm and a moving disc near 1000 mm).
+#include "cellmap/sensor/openni2_source.hpp"
+
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <chrono>
+
 #include <cstdio>
-#include <filesystem>
 #include <thread>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/sensor/openni2_source.hpp"
 #include "cellmap/sensor/v4l2_source.hpp"
 
 namespace cellmap {
@@ -160,51 +162,46 @@ TEST(OpenNI2SourceTest, DeviceWithoutFieldOfViewNeedsConfiguredIntrinsics) {
   EXPECT_NE(status.reason.find("reports no field of view"), std::string::npos) << status.reason;
 }
 
-TEST(V4l2SourceTest, MissingDeviceIsACleanDisconnectedStatusNamingIt) {
-  V4l2Config config;
-  config.device = "/dev/video_cellmap_absent";
-  config.reconnect = fast_retries();
-  V4l2Source source(config);
-  const SourceStatus status = source.open();
-  EXPECT_EQ(status.state, SourceState::kDisconnected);
-  EXPECT_EQ(status.reason, "v4l2 /dev/video_cellmap_absent: cannot open: No such file or directory");
-  const auto until = std::chrono::steady_clock::now() + milliseconds(200);
-  while (std::chrono::steady_clock::now() < until) EXPECT_FALSE(source.next(milliseconds(20)).has_value());
-  EXPECT_EQ(source.status().state, SourceState::kDisconnected);
-  EXPECT_GE(source.status().attempts, 2u);
-}
-
-TEST(V4l2SourceTest, NodeThatIsNotACameraIsAnError) {
-  V4l2Config config;
-  config.device = "/dev/null";
-  V4l2Source source(config);
-  const SourceStatus status = source.open();
-  EXPECT_EQ(status.state, SourceState::kError);
-  EXPECT_EQ(status.reason, "v4l2 /dev/null: not a streaming video capture device");
-}
-
-TEST(V4l2SourceTest, ConfigNeedsZ16AndKnownIntrinsics) {
-  V4l2Config config;
-  config.mode.format = "YUYV";
-  EXPECT_THROW(V4l2Source{config}, Error);
-  config = V4l2Config{};
-  config.mode = DepthMode{424, 240, 30, "Z16"};  // no D435 default for this size
-  EXPECT_THROW(V4l2Source{config}, Error);
-}
-
-TEST(V4l2ListTest, FolderWithoutVideoDevicesListsNothing) {
-  EXPECT_TRUE(list_v4l2_devices("/nonexistent").empty());
-  EXPECT_TRUE(list_v4l2_devices(std::filesystem::temp_directory_path().string()).empty());
-}
-
-TEST(SensorsCommandTest, ListsAndExitsZero) {
-  const std::string command = std::string(CELLMAP_TOOL) + " sensors 2>&1";
+// Runs `cellmap sensors ARGS`; returns the exit status and stdout + stderr.
+std::pair<int, std::string> run_sensors_command(const std::string& args) {
+  const std::string command = std::string(CELLMAP_TOOL) + " sensors " + args + " 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
+  if (!pipe) return {-1, "popen failed"};
   std::string output;
   char buffer[256];
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
   const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+TEST(ProbeOpenNI2DeviceTest, ListsTheModesOfANamedDevice) {
+  const DepthDeviceInfo info = probe_openni2_device("Dummy");
+  EXPECT_EQ(info.driver, "openni2");
+  EXPECT_EQ(info.uri, "Dummy");
+  EXPECT_EQ(describe_modes(info.modes), "320x240@30 DEPTH_1_MM");
+  try {
+    (void)probe_openni2_device("/nonexistent/sweep.oni");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "openni2 /nonexistent/sweep.oni: no such recording");
+  }
+}
+
+TEST(SensorsCommandTest, ProbesAUriAndFailsInOneLine) {
+  const auto [status, output] = run_sensors_command("--openni2-uri Dummy");
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("OpenNI2 devices opened by URI: 1 device\n  Dummy  Table Tennis"), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("    320x240@30 DEPTH_1_MM\n"), std::string::npos) << output;
+  EXPECT_EQ(output.find("No depth sensors found."), std::string::npos) << output;
+  const auto [bad_status, bad_output] = run_sensors_command("--openni2-uri /nonexistent/sweep.oni");
+  EXPECT_EQ(bad_status, 1);
+  EXPECT_EQ(bad_output.rfind("cellmap: openni2 /nonexistent/sweep.oni: no such recording\n", 0), 0u)
+      << bad_output;
+}
+
+TEST(SensorsCommandTest, ListsAndExitsZero) {
+  const auto [status, output] = run_sensors_command("");
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("OpenNI2 depth devices:"), std::string::npos) << output;
   EXPECT_NE(output.find("V4L2 depth devices (Z16) in /dev:"), std::string::npos) << output;

@@ -1,0 +1,248 @@
+// cellmap bench dds: what a one-box change costs a planner over DDS, ours (a delta through the planner client
+// library) against the anchor (the full 200-box snapshot each version, read by a plain snapshot reader),
+// measured in the same run with the subscriber in a second process on loopback.
+//
+// Latency is one way, publisher write -> subscriber callback, on the shared CLOCK_MONOTONIC; each change is
+// published once the previous one arrived (no queueing). Bytes are the serialized sample (wire_size).
+#include <benchmark/benchmark.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cellmap/transport/environment_publisher.hpp"
+#include "cellmap/transport/environment_subscriber.hpp"
+#include "cellmap/transport/wire_size.hpp"
+#include "ratio_report.hpp"
+#include "wire.hpp"  // lib/transport's private wire types: the anchor writes raw snapshots
+
+namespace {
+
+using namespace cellmap;
+using Clock = std::chrono::steady_clock;  // CLOCK_MONOTONIC on Linux: comparable across processes
+
+constexpr int kBoxes = 200;
+constexpr const char* kCell = "bench";
+// Loopback unicast only, as in the tests; used when the caller did not configure Cyclone.
+constexpr const char* kLoopbackConfig =
+    "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface "
+    "address=\"127.0.0.1\"/></Interfaces>"
+    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+    "<Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+// What the subscriber process reports for each version it received.
+struct Arrival {
+  std::uint64_t version;
+  std::int64_t received_ns;
+};
+
+void report(std::uint64_t version) {
+  const Arrival arrival{version, now_ns()};
+  if (::write(STDOUT_FILENO, &arrival, sizeof arrival) != sizeof arrival) std::_Exit(3);
+}
+
+Environment cell_with_boxes(std::uint64_t version) {
+  std::vector<Box> boxes;
+  for (int i = 0; i < kBoxes; ++i) {
+    Box box;
+    box.id = static_cast<std::uint64_t>(i + 1);
+    box.center = {0.1 * (i % 20), 0.1 * (i / 20), 0.5};
+    box.half_extents = {0.04, 0.04, 0.2};
+    box.points = 500;
+    boxes.push_back(box);
+  }
+  return Environment(kCell, version, 0, boxes);
+}
+
+// The next version: one box moved by a millimetre.
+Environment one_box_moved(const Environment& env) {
+  std::vector<Box> boxes = env.boxes();
+  boxes[env.version() % boxes.size()].center.z() += 0.001;
+  return Environment(kCell, env.version() + 1, 0, std::move(boxes));
+}
+
+// --- the subscriber process -------------------------------------------------------------------------------
+
+int run_delta_subscriber(std::uint32_t domain) {
+  const dds::Participant participant(domain);
+  transport::EnvironmentSubscriber subscriber(
+      participant, kCell, [](const Environment& env, const EnvironmentDelta&) { report(env.version()); });
+  ::pause();  // killed by the parent
+  return 0;
+}
+
+int run_snapshot_subscriber(std::uint32_t domain) {
+  const dds::Participant participant(domain);
+  const dds::Topic topic(participant, &cellmap_msg_Environment_desc, transport::kEnvironmentTopic);
+  const dds::Reader reader(participant, topic, transport::environment_qos());
+  dds::WaitSet waitset(participant);
+  waitset.attach(reader);
+  for (;;) {
+    waitset.wait(std::chrono::seconds(1));
+    reader.take_all([](const void* sample, const dds_sample_info_t&) {
+      // Converted as a planner would before using it.
+      const Environment env =
+          transport::wire::from_wire(*static_cast<const cellmap_msg_Environment*>(sample));
+      report(env.version());
+    });
+  }
+}
+
+// --- the publisher side -----------------------------------------------------------------------------------
+
+class SubscriberProcess {
+ public:
+  SubscriberProcess(const char* mode, std::uint32_t domain) {
+    int fds[2];
+    if (::pipe(fds) != 0) std::abort();
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(fds[1], STDOUT_FILENO);
+      ::close(fds[0]);
+      ::close(fds[1]);
+      const std::string domain_text = std::to_string(domain);
+      ::execl("/proc/self/exe", "cellmap-bench-dds", "--subscriber", mode, domain_text.c_str(), nullptr);
+      std::_Exit(127);
+    }
+    ::close(fds[1]);
+    in_ = fds[0];
+  }
+  ~SubscriberProcess() {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    ::close(in_);
+  }
+  /// The next arrival at or past `version`, or nullopt after 10 s.
+  std::optional<Arrival> wait_for(std::uint64_t version) {
+    for (;;) {
+      pollfd p{in_, POLLIN, 0};
+      if (::poll(&p, 1, 10'000) <= 0) return std::nullopt;
+      Arrival arrival;
+      if (::read(in_, &arrival, sizeof arrival) != sizeof arrival) return std::nullopt;
+      if (arrival.version >= version) return arrival;
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+  int in_ = -1;
+};
+
+// p50 and p99 one-way latency (us) of each benchmark, kept for the ratio lines printed after the run:
+// on a shared machine the mean time per change is dominated by scheduling outliers, the median is not.
+std::map<std::string, std::pair<double, double>>& percentiles() {
+  static std::map<std::string, std::pair<double, double>> by_benchmark;
+  return by_benchmark;
+}
+
+void set_percentiles(benchmark::State& state, const std::string& name, std::vector<double> latencies_us) {
+  if (latencies_us.empty()) return;
+  std::sort(latencies_us.begin(), latencies_us.end());
+  auto at = [&](double q) { return latencies_us[static_cast<std::size_t>(q * (latencies_us.size() - 1))]; };
+  state.counters["p50_us"] = at(0.50);
+  state.counters["p99_us"] = at(0.99);
+  percentiles()[name] = {at(0.50), at(0.99)};
+}
+
+// Runs the timed loop: publish(next) then wait until the subscriber reports it.
+template <class Publish>
+void measure(benchmark::State& state, const std::string& name, SubscriberProcess& subscriber, Environment env,
+             Publish publish) {
+  std::vector<double> latencies_us;
+  for (auto _ : state) {
+    const Environment next = one_box_moved(env);
+    const std::int64_t sent = now_ns();
+    publish(env, next);
+    const std::optional<Arrival> arrival = subscriber.wait_for(next.version());
+    if (!arrival) {
+      state.SkipWithError("the subscriber did not report the version within 10 s");
+      return;
+    }
+    latencies_us.push_back(static_cast<double>(arrival->received_ns - sent) / 1e3);
+    env = next;
+  }
+  set_percentiles(state, name, latencies_us);
+}
+
+void BM_DeltaOneBoxChange(benchmark::State& state) {
+  SubscriberProcess subscriber("delta", 140);
+  const dds::Participant participant(140);
+  transport::EnvironmentPublisher publisher(participant, kCell);
+  const Environment first = cell_with_boxes(1);
+  publisher.publish(first);
+  if (!subscriber.wait_for(1)) return state.SkipWithError("the subscriber never got version 1");
+  measure(state, "BM_DeltaOneBoxChange", subscriber, first,
+          [&](const Environment& before, const Environment& after) {
+            publisher.publish(after, diff(before, after));
+          });
+  state.counters["bytes_per_change"] =
+      static_cast<double>(transport::wire_size(diff(first, one_box_moved(first))));
+}
+
+void BM_FullSnapshotEachChange(benchmark::State& state) {
+  SubscriberProcess subscriber("snapshot", 141);
+  const dds::Participant participant(141);
+  const dds::Topic topic(participant, &cellmap_msg_Environment_desc, transport::kEnvironmentTopic);
+  dds::Qos qos = transport::environment_qos();
+  qos.autodispose(false);
+  const dds::Writer writer(participant, topic, qos);
+  const Environment first = cell_with_boxes(1);
+  writer.write(transport::wire::EnvironmentSample(first).get());
+  if (!subscriber.wait_for(1)) return state.SkipWithError("the subscriber never got version 1");
+  measure(state, "BM_FullSnapshotEachChange", subscriber, first,
+          [&](const Environment&, const Environment& after) {
+            writer.write(transport::wire::EnvironmentSample(after).get());
+          });
+  state.counters["bytes_per_change"] = static_cast<double>(transport::wire_size(first));
+}
+
+BENCHMARK(BM_DeltaOneBoxChange)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FullSnapshotEachChange)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::setenv("CYCLONEDDS_URI", kLoopbackConfig, 0);  // keep the caller's configuration if there is one
+  if (argc == 4 && std::strcmp(argv[1], "--subscriber") == 0) {
+    try {
+      const auto domain = static_cast<std::uint32_t>(std::stoul(argv[3]));
+      return std::strcmp(argv[2], "delta") == 0 ? run_delta_subscriber(domain)
+                                                : run_snapshot_subscriber(domain);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "cellmap-bench-dds subscriber: %s\n", e.what());
+      return 1;
+    }
+  }
+  const int status = cellmap::bench::run_and_report(
+      argc, argv,
+      {{"dds one-box change latency", "BM_DeltaOneBoxChange/iterations:3000/real_time",
+        "BM_FullSnapshotEachChange/iterations:3000/real_time"}});
+  const Environment first = cell_with_boxes(1);
+  const std::size_t delta_bytes = transport::wire_size(diff(first, one_box_moved(first)));
+  const std::size_t snapshot_bytes = transport::wire_size(first);
+  const auto ours = percentiles().find("BM_DeltaOneBoxChange");
+  const auto anchor = percentiles().find("BM_FullSnapshotEachChange");
+  if (ours != percentiles().end() && anchor != percentiles().end()) {
+    std::printf("ratio dds one-box change latency p50: %.2fx (ours %.1f us, anchor %.1f us)\n",
+                anchor->second.first / ours->second.first, ours->second.first, anchor->second.first);
+    std::printf("ratio dds one-box change latency p99: %.2fx (ours %.1f us, anchor %.1f us)\n",
+                anchor->second.second / ours->second.second, ours->second.second, anchor->second.second);
+  }
+  std::printf("ratio dds bytes per one-box change (%d boxes): %.2fx (delta %zu B, snapshot %zu B)\n", kBoxes,
+              static_cast<double>(snapshot_bytes) / static_cast<double>(delta_bytes), delta_bytes,
+              snapshot_bytes);
+  return status;
+}

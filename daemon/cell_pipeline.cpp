@@ -1,0 +1,126 @@
+#include "cell_pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::daemon {
+namespace {
+
+constexpr const char* kStateMagic = "cellmap-map-state 1";
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A point anywhere inside a voxel of edge r around a fitted centre lies within r/2 · ‖a‖₁ of it along a unit
+// box axis a, so growing each half extent by that covers the whole voxel.
+void grow_by_voxel(Box& box, double resolution) {
+  const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+  for (int axis = 0; axis < 3; ++axis) box.half_extents[axis] += 0.5 * resolution * R.col(axis).lpNorm<1>();
+}
+
+}  // namespace
+
+CellPipeline::CellPipeline(const DaemonConfig& config, std::vector<Box> boxes, std::uint64_t next_box_id,
+                           const std::optional<std::string>& map_state)
+    : config_(config),
+      map_(config.occupancy),
+      detector_(config.change),
+      boxes_(std::move(boxes)),
+      next_box_id_(next_box_id) {
+  if (!map_state) return;
+  std::istringstream in(*map_state);
+  std::string magic;
+  std::getline(in, magic);
+  std::uint64_t stored_next_id = 0;
+  if (magic != kStateMagic || !(in >> stored_next_id) || in.get() != '\n') {
+    throw Error("map state: not a cellmap map state (bad header)");
+  }
+  next_box_id_ = std::max(next_box_id_, stored_next_id);
+  map_.read(in);
+}
+
+std::string CellPipeline::map_state() const {
+  std::ostringstream out;
+  out << kStateMagic << "\n" << next_box_id_ << "\n";
+  map_.write(out);
+  return out.str();
+}
+
+SweepReport CellPipeline::process(const Sweep& sweep) {
+  SweepReport report;
+  report.points = sweep.point_count();
+  if (!sweep.scans.empty()) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Scan& scan : sweep.scans) sum += scan.origin_C;
+    viewpoint_C_ = sum / static_cast<double>(sweep.scans.size());
+  }
+
+  auto start = std::chrono::steady_clock::now();
+  const OccupancyUpdate update = map_.integrate(sweep);
+  report.t_fuse = seconds_since(start);
+  report.hit_voxels = update.hit_voxels;
+  report.free_voxels = update.free_voxels;
+  report.flipped = update.appeared.size() + update.vanished.size();
+
+  start = std::chrono::steady_clock::now();
+  const ChangeSet changes = detector_.update(update, map_);
+  report.t_change = seconds_since(start);
+  report.regions = changes.regions.size();
+  report.boxes = boxes_.size();
+  if (changes.empty()) return report;
+
+  start = std::chrono::steady_clock::now();
+  std::vector<Region> area;
+  for (const ChangeRegion& region : changes.regions) area.push_back({region.min_C, region.max_C});
+  const std::vector<std::uint64_t> scope = boxes_in_scope(boxes_, area, config_.reconcile);
+  std::vector<Box> kept;
+  for (const Box& box : boxes_) {
+    if (std::find(scope.begin(), scope.end(), box.id) != scope.end()) {
+      area.push_back(bounds_of(box).grown(config_.change.margin));
+    } else {
+      kept.push_back(box);
+    }
+  }
+  const std::vector<Box> fitted = fit_boxes(area, kept);
+  report.evidence = 0;
+  for (const Box& box : fitted) report.evidence += box.points;
+  Reconciled reconciled = reconcile(boxes_, scope, fitted, next_box_id_, config_.reconcile);
+  report.t_segment = seconds_since(start);
+  next_box_id_ = reconciled.next_id;
+  if (reconciled.changed()) {
+    boxes_ = reconciled.boxes;
+    report.change = std::move(reconciled);
+  }
+  report.boxes = boxes_.size();
+  return report;
+}
+
+std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area,
+                                         const std::vector<Box>& kept) const {
+  Cloud cloud;
+  for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
+    // Evidence a kept box already covers needs no new box (e.g. the table around a new object).
+    const bool covered =
+        std::any_of(kept.begin(), kept.end(), [&](const Box& box) { return box.contains(c); });
+    if (!covered) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
+  }
+  if (cloud.empty()) return {};
+  cloud.sensor_origin_ = Eigen::Vector4f(viewpoint_C_.x(), viewpoint_C_.y(), viewpoint_C_.z(), 0.0f);
+  SegmentResult result = segment_cloud(cloud, config_.segment);
+  for (Box& box : result.boxes.boxes) grow_by_voxel(box, map_.config().resolution);
+  return std::move(result.boxes.boxes);
+}
+
+std::vector<Box> CellPipeline::segment_everything() const {
+  const octomap::OcTree& tree = map_.tree();
+  double x0, y0, z0, x1, y1, z1;
+  tree.getMetricMin(x0, y0, z0);
+  tree.getMetricMax(x1, y1, z1);
+  return fit_boxes({Region{{x0, y0, z0}, {x1, y1, z1}}.grown(tree.getResolution())}, {});
+}
+
+}  // namespace cellmap::daemon

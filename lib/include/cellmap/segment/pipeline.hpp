@@ -1,0 +1,80 @@
+#pragma once
+// The paper's batch pipeline on one cloud: crop → neighbourhoods and features (eq. 1, 2) → outlier removal →
+// region growing → leftovers → convex merge → VCCS split → boxes.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cellmap/boxes/box.hpp"
+#include "cellmap/boxes/fit.hpp"
+#include "cellmap/common/cloud.hpp"
+#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/preprocess/outlier_removal.hpp"
+#include "cellmap/preprocess/workspace.hpp"
+#include "cellmap/segment/convex_merge.hpp"
+#include "cellmap/segment/region_growing.hpp"
+#include "cellmap/segment/supervoxel_split.hpp"
+
+namespace cellmap {
+
+/// Every parameter of the pipeline. The defaults here are the documented ones of config/segment.yaml.
+struct SegmentConfig final {
+  int k = 40;  ///< neighbours per point (eq. 1, 2, normals, region growing)
+  OutlierMode outlier_mode = OutlierMode::kTwoSided;
+  double outlier_u = 3.0;  ///< σ multiplier of the outlier test
+  RegionGrowingParams region_growing;
+  int leftover_min_points = 3;  ///< smaller leftover groups are dropped (counted)
+  bool merge = true;            ///< convex merging on/off
+  ConvexMergeParams merge_params;
+  SplitParams split;
+  BoxKind box_kind = BoxKind::kOriented;
+  std::optional<Workspace> workspace;  ///< crop region; none = no crop
+};
+
+/// Reads a config document (keys as in config/segment.yaml; every key optional, missing = default).
+/// @throws Error naming the key for unknown keys, wrong types and out-of-range values.
+[[nodiscard]] SegmentConfig segment_config_from_yaml(YamlMap root);
+/// Loads a config file. @throws Error naming the file and key.
+[[nodiscard]] SegmentConfig load_segment_config(const std::string& path);
+
+/// Counters and timings of one run. Every input point is in exactly one of: a box, or one of the drop
+/// counters (outside_workspace, outliers_sparse, outliers_dense, isolated).
+struct SegmentStats final {
+  std::size_t points_in = 0;
+  std::size_t outside_workspace = 0;
+  std::size_t outliers_sparse = 0;  ///< mean neighbour distance above μ + u·σ
+  std::size_t outliers_dense = 0;   ///< below μ − u·σ (two-sided mode)
+  std::size_t regions = 0;          ///< segments after region growing (of at least min_cluster_size)
+  LeftoverStats leftovers;
+  MergeStats merge;
+  std::size_t merged_segments = 0;  ///< segments after merging
+  std::size_t split_segments = 0;   ///< segments that VCCS split
+  std::size_t boxes = 0;
+  /// Seconds per stage.
+  double t_crop = 0, t_outliers = 0, t_features = 0, t_grow = 0, t_leftovers = 0, t_merge = 0, t_split = 0,
+         t_boxes = 0;
+  [[nodiscard]] double t_total() const {
+    return t_crop + t_outliers + t_features + t_grow + t_leftovers + t_merge + t_split + t_boxes;
+  }
+  [[nodiscard]] std::size_t dropped() const {
+    return outside_workspace + outliers_sparse + outliers_dense + leftovers.isolated;
+  }
+};
+
+struct SegmentResult final {
+  BoxSet boxes;  ///< version 1, frame "cell", ids 1..n
+  /// For each input point: the index into boxes.boxes of the box fitted to it, or -1 if it was dropped.
+  std::vector<int> box_of_point;
+  SegmentStats stats;
+};
+
+/// Runs the pipeline on finite points (e.g. from load_cloud_file); normals are oriented toward
+/// `points.sensor_origin_`. Every point fitted to a box lies inside it. Thread-safe (no shared state).
+/// @throws Error if a point is not finite or the config is invalid.
+[[nodiscard]] SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config);
+
+/// One line: points in, drops per rule, segments per step, boxes, time per stage.
+[[nodiscard]] std::string summary(const SegmentStats& stats);
+
+}  // namespace cellmap

@@ -1,0 +1,135 @@
+#pragma once
+// A small RAII layer over the Cyclone DDS 0.10 C API: each class owns one DDS entity and deletes it (and so
+// its children) when destroyed. Every call's return code is checked; failures throw cellmap::Error with
+// Cyclone's reason (dds_strretcode). Entities are move-only: a copy would delete the entity twice.
+//
+// Thread safety: Cyclone's calls are thread-safe; these wrappers add no state of their own, except that one
+// object must not be moved or destroyed while another thread uses it.
+
+#include <dds/dds.h>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cellmap::dds {
+
+/// Throws Error("<what>: <Cyclone's reason>") when `rc` is negative; returns `rc` otherwise.
+dds_return_t check(dds_return_t rc, const std::string& what);
+
+/// Converts a timeout; negative or huge values mean "forever".
+[[nodiscard]] dds_duration_t to_duration(std::chrono::nanoseconds timeout);
+
+/// An owned QoS object.
+class Qos final {
+ public:
+  Qos();
+  ~Qos();
+  Qos(const Qos& other);
+  Qos& operator=(const Qos& other);
+  /// RELIABLE (max blocking time 1 s), `transient_local` or VOLATILE durability, KEEP_LAST `depth` (0 means
+  /// KEEP_ALL).
+  static Qos make(bool transient_local, std::uint32_t depth);
+  /// Writers only: when false, deleting the writer (a daemon restart) unregisters its instances without
+  /// disposing them, so readers keep the data instead of seeing it removed.
+  Qos& autodispose(bool on);
+  [[nodiscard]] const dds_qos_t* get() const { return qos_; }
+
+ private:
+  dds_qos_t* qos_;
+};
+
+/// Owns one entity handle; deleting it deletes its children too.
+class Entity {
+ public:
+  Entity() = default;
+  explicit Entity(dds_entity_t handle) : handle_(handle) {}
+  ~Entity();
+  Entity(Entity&& other) noexcept;
+  Entity& operator=(Entity&& other) noexcept;
+  Entity(const Entity&) = delete;
+  Entity& operator=(const Entity&) = delete;
+  [[nodiscard]] dds_entity_t get() const { return handle_; }
+  [[nodiscard]] explicit operator bool() const { return handle_ > 0; }
+  /// Deletes the entity now (no-op when empty).
+  void reset();
+
+ private:
+  dds_entity_t handle_ = 0;
+};
+
+/// A domain participant. The configuration comes from CYCLONEDDS_URI as usual.
+class Participant final : public Entity {
+ public:
+  /// @throws Error if the domain cannot be joined (bad id, bad CYCLONEDDS_URI, no usable interface).
+  explicit Participant(std::uint32_t domain);
+};
+
+/// A topic of one generated type (its idlc descriptor, e.g. &cellmap_msg_Environment_desc).
+class Topic final : public Entity {
+ public:
+  Topic(const Participant& participant, const dds_topic_descriptor_t* type, const std::string& name);
+  [[nodiscard]] const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+};
+
+class Writer final : public Entity {
+ public:
+  Writer(const Participant& participant, const Topic& topic, const Qos& qos);
+  /// Writes one sample of the topic's generated type. @throws Error naming the topic on failure (e.g. the
+  /// reliable history stayed full for the max blocking time).
+  void write(const void* sample) const;
+  /// How many readers are matched right now.
+  [[nodiscard]] std::uint32_t matched_readers() const;
+  /// Blocks until at least `count` readers matched or the timeout passed; true when they did.
+  bool wait_for_readers(std::uint32_t count, std::chrono::nanoseconds timeout) const;
+  /// Blocks until every matched reader acknowledged everything written; true when they did in time.
+  bool wait_for_acks(std::chrono::nanoseconds timeout) const;
+
+ private:
+  std::string topic_;
+};
+
+class Reader final : public Entity {
+ public:
+  Reader(const Participant& participant, const Topic& topic, const Qos& qos);
+  /// Takes every sample available now and calls `on_sample` with each one carrying data (a pointer to the
+  /// topic's generated type, valid during the call, and its sample info). Samples without data (instance
+  /// disposed, writer gone) are taken and skipped. Returns how many samples carried data.
+  std::size_t take_all(
+      const std::function<void(const void* sample, const dds_sample_info_t& info)>& on_sample) const;
+  /// How many writers are matched right now.
+  [[nodiscard]] std::uint32_t matched_writers() const;
+
+ private:
+  std::string topic_;
+};
+
+/// Waits for data on several readers at once, interruptible from another thread through wake().
+class WaitSet final {
+ public:
+  explicit WaitSet(const Participant& participant);
+  /// Wakes the waiter whenever `reader` holds samples. The reader must stay alive until detach().
+  void attach(const Reader& reader);
+  void detach(const Reader& reader);
+  /// Blocks until a reader attached has samples, wake() was called or the timeout passed. Returns false on
+  /// timeout. A wake() is consumed by the wait it ends.
+  bool wait(std::chrono::nanoseconds timeout);
+  /// Makes the current or next wait() return; callable from any thread.
+  void wake();
+
+ private:
+  struct Attached {
+    dds_entity_t reader;
+    Entity condition;
+  };
+  Entity waitset_;
+  Entity guard_;
+  std::vector<Attached> attached_;
+};
+
+}  // namespace cellmap::dds

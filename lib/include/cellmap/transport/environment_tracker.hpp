@@ -1,0 +1,60 @@
+#pragma once
+// The planner side's bookkeeping, free of DDS so it can be tested sample by sample: a local copy of one
+// cell's environment kept current from snapshots and deltas arriving in any order.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cellmap/environment/environment.hpp"
+
+namespace cellmap::transport {
+
+/// One step of the local copy: the environment after it and the delta from the previous local version (for
+/// the first snapshot: from the empty version 0, everything added).
+struct EnvironmentUpdate final {
+  Environment environment;
+  EnvironmentDelta delta;
+  bool from_snapshot = false;  ///< true when reached by a snapshot (first copy or resync), not a delta
+};
+
+struct TrackerStats final {
+  std::uint64_t deltas_applied = 0;
+  std::uint64_t snapshots_applied = 0;  ///< the first copy plus every resync
+  std::uint64_t gaps = 0;               ///< deltas that did not start at the local version (missed versions)
+  std::uint64_t rejected = 0;           ///< deltas that did not fit the local copy (apply() threw)
+};
+
+/// Keeps a local copy of `cell`. Deltas are applied in version order; a delta that does not start at the
+/// local version is a gap: it is held, and the copy waits for a snapshot at least as new (needs_snapshot()).
+/// A delta from version 0 carries the whole environment (every box added) and counts as a snapshot once a
+/// local copy exists (before, the snapshot itself is awaited, so a late joiner jumps straight to the newest).
+/// Older or duplicate samples are ignored; samples of other cells too. Not thread-safe.
+class EnvironmentTracker final {
+ public:
+  explicit EnvironmentTracker(std::string cell);
+
+  /// Feeds one snapshot; returns the updates it caused (none, or the jump to it plus held deltas after it).
+  std::vector<EnvironmentUpdate> on_snapshot(const Environment& snapshot);
+  /// Feeds one delta; returns the updates it caused (it and any held deltas it connects).
+  std::vector<EnvironmentUpdate> on_delta(const EnvironmentDelta& delta);
+
+  /// True while there is no local copy yet or a gap is open: only a snapshot can help.
+  [[nodiscard]] bool needs_snapshot() const { return !current_ || out_of_sync_ || !held_.empty(); }
+  [[nodiscard]] const std::optional<Environment>& environment() const { return current_; }
+  [[nodiscard]] const TrackerStats& stats() const { return stats_; }
+  [[nodiscard]] const std::string& cell() const { return cell_; }
+
+ private:
+  void drain(std::vector<EnvironmentUpdate>& updates);
+
+  std::string cell_;
+  std::optional<Environment> current_;
+  std::map<std::uint64_t, EnvironmentDelta> held_;  // by from_version, all above the local version
+  bool out_of_sync_ = false;                        // a delta failed to apply: trust only a snapshot
+  TrackerStats stats_;
+};
+
+}  // namespace cellmap::transport

@@ -1,0 +1,41 @@
+#pragma once
+// Value types for the status and scene-edit topics (the environment ones are cellmap::Environment and
+// cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside lib/transport.
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cellmap::transport {
+
+struct SensorStatus final {
+  std::string name;
+  std::string state;  ///< e.g. "streaming", "no device", "error: <reason>"
+};
+
+/// cellmap/status: one cell daemon's health.
+struct CellStatus final {
+  std::string cell;
+  std::string state;  ///< e.g. "starting", "running", "degraded", "stopping"
+  std::vector<SensorStatus> sensors;
+  std::int64_t last_sweep_ns = 0;  ///< end of the last sweep, ns since the Unix epoch; 0 before the first
+  std::uint64_t sweeps = 0;
+  std::uint64_t dropped_frames = 0;
+  std::uint64_t boxes = 0;
+  std::uint64_t version = 0;
+};
+
+/// cellmap/sim/scene_edits: one edit of a simulated scene (what `cellmap inject` sends).
+struct SceneEdit final {
+  enum class Kind { kAddBox, kRemove, kMove };
+  std::string cell;  ///< empty: every simulated cell on the domain
+  Kind kind = Kind::kAddBox;
+  std::string name;                                        ///< the obstacle's name
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();        ///< p_CB, metres (add-box, move)
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< metres (add-box)
+  double yaw = 0.0;                                        ///< about the cell's z axis, radians (add-box)
+};
+
+}  // namespace cellmap::transport

@@ -1,0 +1,49 @@
+#pragma once
+// cellmap/sim/scene_edits: how `cellmap inject` edits the simulated scene of a running daemon.
+
+#include <chrono>
+#include <vector>
+
+#include "cellmap/transport/dds.hpp"
+#include "cellmap/transport/messages.hpp"
+
+namespace cellmap::transport {
+
+/// Sends scene edits. The topic is volatile (a restarted daemon must not replay old edits), so a short-lived
+/// sender waits for the daemon's reader before writing and for its acknowledgement before exiting.
+/// `participant` must outlive it.
+class SceneEditWriter final {
+ public:
+  explicit SceneEditWriter(const dds::Participant& participant);
+  /// True once at least one scene-edit reader (a simulating daemon) matched, false on timeout.
+  bool wait_for_reader(std::chrono::nanoseconds timeout) const;
+  /// @throws Error if the edit has no name or the write fails.
+  void write(const SceneEdit& edit) const;
+  /// True once every matched reader acknowledged everything written, false on timeout.
+  bool wait_for_acks(std::chrono::nanoseconds timeout) const;
+
+ private:
+  dds::Topic topic_;
+  dds::Writer writer_;
+};
+
+/// Receives scene edits (the simulator side). `participant` must outlive it. Not thread-safe.
+class SceneEditReader final {
+ public:
+  explicit SceneEditReader(const dds::Participant& participant);
+  ~SceneEditReader();
+  SceneEditReader(const SceneEditReader&) = delete;
+  SceneEditReader& operator=(const SceneEditReader&) = delete;
+  /// Waits up to `timeout` (zero: just looks) and returns the edits received, oldest first. Malformed edits
+  /// are skipped and counted in rejected().
+  std::vector<SceneEdit> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
+  [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
+
+ private:
+  dds::Topic topic_;
+  dds::Reader reader_;
+  dds::WaitSet waitset_;
+  std::uint64_t rejected_ = 0;
+};
+
+}  // namespace cellmap::transport

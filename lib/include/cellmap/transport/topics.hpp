@@ -1,0 +1,28 @@
+#pragma once
+// cellmap's DDS topics and their QoS, exactly as ARCHITECTURE.md states them. Writers and readers both use
+// these, so a reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
+
+#include <cstdint>
+
+#include "cellmap/transport/dds.hpp"
+
+namespace cellmap::transport {
+
+inline constexpr const char* kEnvironmentTopic = "cellmap/environment";
+inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta";
+inline constexpr const char* kStatusTopic = "cellmap/status";
+inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
+
+/// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
+inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
+
+/// cellmap/environment: RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1 (a late joiner gets the current snapshot).
+[[nodiscard]] dds::Qos environment_qos();
+/// cellmap/environment_delta: RELIABLE, TRANSIENT_LOCAL, KEEP_LAST `depth` (>= 1).
+[[nodiscard]] dds::Qos environment_delta_qos(std::uint32_t depth);
+/// cellmap/status: RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1 (a late joiner sees the last health report).
+[[nodiscard]] dds::Qos status_qos();
+/// cellmap/sim/scene_edits: RELIABLE, VOLATILE (a restarted daemon must not replay old edits), KEEP_ALL.
+[[nodiscard]] dds::Qos scene_edit_qos();
+
+}  // namespace cellmap::transport

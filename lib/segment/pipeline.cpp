@@ -1,0 +1,212 @@
+#include "cellmap/segment/pipeline.hpp"
+
+#include <chrono>
+#include <cstdio>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/preprocess/neighbourhoods.hpp"
+
+namespace cellmap {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+class Stopwatch {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+Eigen::Vector3d vector3(YamlMap& map, const std::string& key) {
+  const YAML::Node node = map.node(key);
+  if (!node || !node.IsSequence() || node.size() != 3) map.fail(key, "must be a list of 3 numbers");
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    try {
+      v[i] = node[i].as<double>();
+    } catch (const YAML::Exception&) {
+      map.fail(key, "must be a list of 3 numbers");
+    }
+    if (!std::isfinite(v[i]) || std::abs(v[i]) > 1e6) map.fail(key, "values must be finite metres");
+  }
+  return v;
+}
+
+Cloud subset(const Cloud& cloud, const std::vector<int>& indices) {
+  Cloud out;
+  out.reserve(indices.size());
+  for (int i : indices) out.push_back(cloud[i]);
+  out.sensor_origin_ = cloud.sensor_origin_;
+  out.sensor_orientation_ = cloud.sensor_orientation_;
+  return out;
+}
+
+}  // namespace
+
+SegmentConfig segment_config_from_yaml(YamlMap root) {
+  SegmentConfig c;
+  {
+    YamlMap m = root.child("neighbours");
+    c.k = static_cast<int>(m.integer("k", c.k, 3, 200));
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("outliers");
+    const std::string mode = m.get<std::string>("mode", "two_sided");
+    if (mode == "two_sided") {
+      c.outlier_mode = OutlierMode::kTwoSided;
+    } else if (mode == "one_sided") {
+      c.outlier_mode = OutlierMode::kOneSided;
+    } else if (mode == "off") {
+      c.outlier_mode = OutlierMode::kOff;
+    } else {
+      m.fail("mode", "must be two_sided, one_sided or off, got '" + mode + "'");
+    }
+    c.outlier_u = m.number("u", c.outlier_u, 0.0, 100.0);
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("region_growing");
+    RegionGrowingParams& r = c.region_growing;
+    r.gap = m.number("gap", r.gap, 1e-4, 1.0);
+    r.max_curvature = m.number("max_curvature", r.max_curvature, 0.0, 1.0 / 3.0);
+    r.max_angle = m.number("max_angle", r.max_angle, 0.0, kPi);
+    r.min_cluster_size = static_cast<int>(m.integer("min_cluster_size", r.min_cluster_size, 1, 100000000));
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("leftovers");
+    c.leftover_min_points = static_cast<int>(m.integer("min_points", c.leftover_min_points, 1, 1000000));
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("merge");
+    ConvexMergeParams& p = c.merge_params;
+    c.merge = m.get<bool>("enabled", c.merge);
+    p.patch_radius = m.number("patch_radius", p.patch_radius, 1e-4, 1.0);
+    p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, kPi);
+    p.min_boundary_points =
+        static_cast<int>(m.integer("min_boundary_points", p.min_boundary_points, 1, 1000000));
+    p.samples_per_boundary =
+        static_cast<int>(m.integer("samples_per_boundary", p.samples_per_boundary, 1, 100000));
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("split");
+    SplitParams& s = c.split;
+    s.max_extent = m.number("max_extent", s.max_extent, 1e-3, 1e3);
+    s.voxel_resolution = m.number("voxel_resolution", s.voxel_resolution, 1e-4, 1.0);
+    s.seed_resolution = m.number("seed_resolution", s.seed_resolution, 1e-3, 10.0);
+    if (s.seed_resolution < s.voxel_resolution) m.fail("seed_resolution", "must be >= voxel_resolution");
+    m.expect_all_read();
+  }
+  {
+    YamlMap m = root.child("boxes");
+    const std::string kind = m.get<std::string>("kind", to_string(c.box_kind));
+    c.box_kind =
+        box_kind_from_string(kind, (m.source().empty() ? "" : m.source() + ": ") + m.key_path("kind"));
+    m.expect_all_read();
+  }
+  if (root.has("workspace")) {
+    YamlMap m = root.child("workspace");
+    const Eigen::Vector3d lower = vector3(m, "lower");
+    const Eigen::Vector3d upper = vector3(m, "upper");
+    const double envelope = m.number("envelope", 0.0, 0.0, 100.0);
+    if ((lower.array() > upper.array()).any()) m.fail("upper", "must be >= lower on every axis");
+    c.workspace = Workspace::box(lower.array() - envelope, upper.array() + envelope);
+    m.expect_all_read();
+  }
+  c.merge_params.gap = c.region_growing.gap;
+  root.expect_all_read();
+  return c;
+}
+
+SegmentConfig load_segment_config(const std::string& path) {
+  return segment_config_from_yaml(YamlMap::load(path));
+}
+
+SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
+  SegmentResult result;
+  SegmentStats& stats = result.stats;
+  stats.points_in = points.size();
+  result.box_of_point.assign(points.size(), -1);
+  result.boxes.version = 1;
+  result.boxes.frame = "cell";
+  Stopwatch clock;
+
+  // Crop. `index` maps the current working cloud back to the input.
+  std::vector<int> index;
+  if (config.workspace) {
+    index = crop_to_workspace(points, *config.workspace);
+  } else {
+    index.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) index[i] = static_cast<int>(i);
+  }
+  stats.outside_workspace = points.size() - index.size();
+  Cloud cropped = subset(points, index);
+  stats.t_crop = clock.lap();
+  const Eigen::Vector3f viewpoint = points.sensor_origin_.head<3>();
+
+  // One kd-tree search serves both outlier removal (eq. 1) and the features (eq. 2) of the survivors; their
+  // normals thus include the removed points' few contributions (sparse outliers are rarely anyone's
+  // neighbour).
+  const Neighbourhoods all = compute_neighbourhoods(cropped, config.k, true, viewpoint);
+  stats.t_features = clock.lap();
+  const OutlierResult outliers = remove_outliers(all, config.outlier_u, config.outlier_mode);
+  stats.outliers_sparse = outliers.removed_sparse;
+  stats.outliers_dense = outliers.removed_dense;
+  const Neighbourhoods nb = subset_neighbourhoods(all, outliers.kept);
+  std::vector<int> kept_index(outliers.kept.size());
+  for (std::size_t i = 0; i < outliers.kept.size(); ++i) kept_index[i] = index[outliers.kept[i]];
+  index = std::move(kept_index);
+  const Cloud cloud = subset(cropped, outliers.kept);
+  stats.t_outliers = clock.lap();
+
+  Segments segments = grow_regions(nb, config.region_growing);
+  stats.regions = static_cast<std::size_t>(segments.count);
+  stats.t_grow = clock.lap();
+
+  stats.leftovers =
+      cover_leftovers(cloud, nb, segments, config.region_growing.gap, config.leftover_min_points);
+  stats.t_leftovers = clock.lap();
+
+  if (config.merge) segments = merge_convex(cloud, nb, segments, config.merge_params, &stats.merge);
+  stats.merged_segments = static_cast<std::size_t>(segments.count);
+  stats.t_merge = clock.lap();
+
+  segments = split_large_segments(cloud, segments, config.split, &stats.split_segments);
+  stats.t_split = clock.lap();
+
+  for (const std::vector<int>& members : segments.members()) {
+    if (members.empty()) continue;
+    Box box = fit_box(cloud, members, config.box_kind);
+    box.id = result.boxes.boxes.size() + 1;
+    for (int i : members) result.box_of_point[index[i]] = static_cast<int>(result.boxes.boxes.size());
+    result.boxes.boxes.push_back(box);
+  }
+  stats.boxes = result.boxes.boxes.size();
+  stats.t_boxes = clock.lap();
+  return result;
+}
+
+std::string summary(const SegmentStats& s) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "points %zu, dropped: outside workspace %zu, outliers sparse %zu dense %zu, isolated %zu; "
+                "regions %zu, leftovers attached %zu own segments %zu, merged to %zu, split %zu; boxes %zu; "
+                "time %.3f s (features %.3f, outliers %.3f, grow %.3f, merge %.3f, split %.3f)",
+                s.points_in, s.outside_workspace, s.outliers_sparse, s.outliers_dense, s.leftovers.isolated,
+                s.regions, s.leftovers.attached, s.leftovers.own_segments, s.merged_segments,
+                s.split_segments, s.boxes, s.t_total(), s.t_features, s.t_outliers, s.t_grow, s.t_merge,
+                s.t_split);
+  return line;
+}
+
+}  // namespace cellmap

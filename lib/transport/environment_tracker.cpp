@@ -1,0 +1,80 @@
+#include "cellmap/transport/environment_tracker.hpp"
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+// Deltas held across a gap are few (the writer keeps at most its history depth); cap them anyway so a
+// publisher that never sends a snapshot cannot grow this without bound.
+constexpr std::size_t kMaxHeld = 256;
+
+}  // namespace
+
+EnvironmentTracker::EnvironmentTracker(std::string cell) : cell_(std::move(cell)) {}
+
+std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment& snapshot) {
+  std::vector<EnvironmentUpdate> updates;
+  if (snapshot.cell() != cell_) return updates;
+  if (current_ && (snapshot.version() < current_->version() ||
+                   (snapshot.version() == current_->version() && !out_of_sync_))) {
+    return updates;
+  }
+  const Environment before =
+      current_ && current_->version() < snapshot.version() ? *current_ : Environment(cell_);
+  EnvironmentDelta delta = diff(before, snapshot);
+  current_ = snapshot;
+  out_of_sync_ = false;
+  ++stats_.snapshots_applied;
+  updates.push_back({snapshot, std::move(delta), true});
+  drain(updates);
+  return updates;
+}
+
+std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDelta& delta) {
+  std::vector<EnvironmentUpdate> updates;
+  if (delta.cell != cell_ || delta.to_version <= delta.from_version) return updates;
+  if (delta.from_version == 0 && current_) {
+    // From nothing: the whole environment (a restarted publisher's first version). Without a local copy yet
+    // it is held like any delta: the snapshot topic brings the current version, not a replay of history.
+    try {
+      return on_snapshot(Environment(delta.cell, delta.to_version, delta.stamp_ns, delta.added));
+    } catch (const Error&) {
+      ++stats_.rejected;  // repeated box ids
+      return updates;
+    }
+  }
+  if (current_ && delta.to_version <= current_->version()) return updates;
+  if (current_ && delta.from_version != current_->version()) ++stats_.gaps;
+  held_[delta.from_version] = delta;
+  while (held_.size() > kMaxHeld) held_.erase(held_.begin());
+  drain(updates);
+  return updates;
+}
+
+void EnvironmentTracker::drain(std::vector<EnvironmentUpdate>& updates) {
+  if (!current_) return;
+  // Drop what the local copy already passed, then apply while the next delta starts where we are.
+  while (!held_.empty() && held_.begin()->second.to_version <= current_->version())
+    held_.erase(held_.begin());
+  while (!out_of_sync_) {
+    const auto next = held_.find(current_->version());
+    if (next == held_.end()) break;
+    EnvironmentDelta delta = std::move(next->second);
+    held_.erase(next);
+    try {
+      current_ = apply(*current_, delta);
+    } catch (const Error&) {
+      // The delta contradicts the local copy (e.g. adds an id we already have): only a snapshot can tell.
+      ++stats_.rejected;
+      out_of_sync_ = true;
+      break;
+    }
+    ++stats_.deltas_applied;
+    updates.push_back({*current_, std::move(delta), false});
+    while (!held_.empty() && held_.begin()->second.to_version <= current_->version())
+      held_.erase(held_.begin());
+  }
+}
+
+}  // namespace cellmap::transport

@@ -1,0 +1,55 @@
+#include "cellmap/transport/scene_edits.hpp"
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/topics.hpp"
+#include "wire.hpp"
+
+namespace cellmap::transport {
+
+SceneEditWriter::SceneEditWriter(const dds::Participant& participant)
+    : topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
+      writer_(participant, topic_, scene_edit_qos()) {}
+
+bool SceneEditWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
+  return writer_.wait_for_readers(1, timeout);
+}
+
+void SceneEditWriter::write(const SceneEdit& edit) const {
+  if (edit.name.empty()) throw Error(std::string(kSceneEditTopic) + ": name: must not be empty");
+  const wire::SceneEditSample sample(edit);
+  writer_.write(sample.get());
+}
+
+bool SceneEditWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
+  return writer_.wait_for_acks(timeout);
+}
+
+SceneEditReader::SceneEditReader(const dds::Participant& participant)
+    : topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
+      reader_(participant, topic_, scene_edit_qos()),
+      waitset_(participant) {
+  waitset_.attach(reader_);
+}
+
+SceneEditReader::~SceneEditReader() {
+  try {
+    waitset_.detach(reader_);
+  } catch (const Error&) {
+    // Deleting the reader detaches it anyway.
+  }
+}
+
+std::vector<SceneEdit> SceneEditReader::take(std::chrono::nanoseconds timeout) {
+  if (timeout.count() > 0) waitset_.wait(timeout);
+  std::vector<SceneEdit> edits;
+  reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
+    try {
+      edits.push_back(wire::from_wire(*static_cast<const cellmap_msg_SceneEdit*>(sample)));
+    } catch (const Error&) {
+      ++rejected_;
+    }
+  });
+  return edits;
+}
+
+}  // namespace cellmap::transport

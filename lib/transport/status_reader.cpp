@@ -1,0 +1,37 @@
+#include "cellmap/transport/status_reader.hpp"
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/topics.hpp"
+#include "wire.hpp"
+
+namespace cellmap::transport {
+
+StatusReader::StatusReader(const dds::Participant& participant)
+    : topic_(participant, &cellmap_msg_Status_desc, kStatusTopic),
+      reader_(participant, topic_, status_qos()),
+      waitset_(participant) {
+  waitset_.attach(reader_);
+}
+
+StatusReader::~StatusReader() {
+  try {
+    waitset_.detach(reader_);
+  } catch (const Error&) {
+    // Deleting the reader detaches it anyway.
+  }
+}
+
+std::vector<CellStatus> StatusReader::take(std::chrono::nanoseconds timeout) {
+  if (timeout.count() > 0) waitset_.wait(timeout);
+  std::vector<CellStatus> reports;
+  reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
+    try {
+      reports.push_back(wire::from_wire(*static_cast<const cellmap_msg_Status*>(sample)));
+    } catch (const Error&) {
+      // A report without a cell cannot be attributed; skip it.
+    }
+  });
+  return reports;
+}
+
+}  // namespace cellmap::transport

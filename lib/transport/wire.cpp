@@ -1,0 +1,206 @@
+#include "wire.hpp"
+
+#include <cmath>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/topics.hpp"
+
+namespace cellmap::transport::wire {
+namespace {
+
+// The generated structs take non-const char*; Cyclone only reads them when writing.
+char* text(const std::string& s) {
+  return const_cast<char*>(s.c_str());
+}
+
+template <class Sequence, class T>
+Sequence sequence_of(std::vector<T>& items) {
+  Sequence seq{};
+  seq._maximum = seq._length = static_cast<uint32_t>(items.size());
+  seq._buffer = items.data();
+  seq._release = false;
+  return seq;
+}
+
+cellmap_msg_Box to_msg(const Box& box) {
+  cellmap_msg_Box msg{};
+  msg.id = box.id;
+  for (int i = 0; i < 3; ++i) {
+    msg.center[i] = box.center[i];
+    msg.half_extents[i] = box.half_extents[i];
+  }
+  msg.rotation[0] = box.rotation.w();
+  msg.rotation[1] = box.rotation.x();
+  msg.rotation[2] = box.rotation.y();
+  msg.rotation[3] = box.rotation.z();
+  msg.points = box.points;
+  return msg;
+}
+
+std::vector<cellmap_msg_Box> to_msgs(const std::vector<Box>& boxes) {
+  std::vector<cellmap_msg_Box> out;
+  out.reserve(boxes.size());
+  for (const Box& box : boxes) out.push_back(to_msg(box));
+  return out;
+}
+
+void require_finite(const double* values, int n, const std::string& where) {
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(values[i])) throw Error(where + ": not a finite number");
+  }
+}
+
+Box from_msg(const cellmap_msg_Box& msg, const std::string& where) {
+  require_finite(msg.center, 3, where + ".center");
+  require_finite(msg.half_extents, 3, where + ".half_extents");
+  require_finite(msg.rotation, 4, where + ".rotation");
+  Box box;
+  box.id = msg.id;
+  box.center = {msg.center[0], msg.center[1], msg.center[2]};
+  box.half_extents = {msg.half_extents[0], msg.half_extents[1], msg.half_extents[2]};
+  if (box.half_extents.minCoeff() < 0) throw Error(where + ".half_extents: must not be negative");
+  // Kept bit for bit (no re-normalisation), so a box compares equal to the one the publisher sent.
+  box.rotation = Eigen::Quaterniond(msg.rotation[0], msg.rotation[1], msg.rotation[2], msg.rotation[3]);
+  if (std::abs(box.rotation.norm() - 1.0) > 1e-6) throw Error(where + ".rotation: must be a unit quaternion");
+  box.points = msg.points;
+  return box;
+}
+
+std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::string& where) {
+  std::vector<Box> boxes;
+  boxes.reserve(seq._length);
+  for (uint32_t i = 0; i < seq._length; ++i) {
+    boxes.push_back(from_msg(seq._buffer[i], where + "[" + std::to_string(i) + "]"));
+  }
+  return boxes;
+}
+
+std::string cell_of(const char* cell, const char* topic) {
+  if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
+  return cell;
+}
+
+}  // namespace
+
+EnvironmentSample::EnvironmentSample(const Environment& env)
+    : cell_(env.cell()), boxes_(to_msgs(env.boxes())) {
+  msg_.cell = text(cell_);
+  msg_.version = env.version();
+  msg_.stamp_ns = env.stamp_ns();
+  msg_.boxes = sequence_of<dds_sequence_cellmap_msg_Box>(boxes_);
+}
+
+DeltaSample::DeltaSample(const EnvironmentDelta& delta)
+    : cell_(delta.cell),
+      added_(to_msgs(delta.added)),
+      modified_(to_msgs(delta.modified)),
+      removed_(delta.removed) {
+  msg_.cell = text(cell_);
+  msg_.from_version = delta.from_version;
+  msg_.to_version = delta.to_version;
+  msg_.stamp_ns = delta.stamp_ns;
+  msg_.added = sequence_of<dds_sequence_cellmap_msg_Box>(added_);
+  msg_.modified = sequence_of<dds_sequence_cellmap_msg_Box>(modified_);
+  msg_.removed = sequence_of<dds_sequence_uint64>(removed_);
+}
+
+StatusSample::StatusSample(const CellStatus& status) : status_(status) {
+  for (const SensorStatus& sensor : status_.sensors)
+    sensors_.push_back({text(sensor.name), text(sensor.state)});
+  msg_.cell = text(status_.cell);
+  msg_.state = text(status_.state);
+  msg_.sensors = sequence_of<dds_sequence_cellmap_msg_SensorState>(sensors_);
+  msg_.last_sweep_ns = status_.last_sweep_ns;
+  msg_.sweeps = status_.sweeps;
+  msg_.dropped_frames = status_.dropped_frames;
+  msg_.boxes = status_.boxes;
+  msg_.version = status_.version;
+}
+
+SceneEditSample::SceneEditSample(const SceneEdit& edit) : edit_(edit) {
+  msg_.cell = text(edit_.cell);
+  switch (edit_.kind) {
+    case SceneEdit::Kind::kAddBox:
+      msg_.kind = cellmap_msg_SCENE_EDIT_ADD_BOX;
+      break;
+    case SceneEdit::Kind::kRemove:
+      msg_.kind = cellmap_msg_SCENE_EDIT_REMOVE;
+      break;
+    case SceneEdit::Kind::kMove:
+      msg_.kind = cellmap_msg_SCENE_EDIT_MOVE;
+      break;
+  }
+  msg_.name = text(edit_.name);
+  for (int i = 0; i < 3; ++i) {
+    msg_.center[i] = edit_.center[i];
+    msg_.half_extents[i] = edit_.half_extents[i];
+  }
+  msg_.yaw = edit_.yaw;
+}
+
+Environment from_wire(const cellmap_msg_Environment& msg) {
+  const std::string where = std::string(kEnvironmentTopic) + " version " + std::to_string(msg.version);
+  return Environment(cell_of(msg.cell, kEnvironmentTopic), msg.version, msg.stamp_ns,
+                     from_msgs(msg.boxes, where + ": boxes"));
+}
+
+EnvironmentDelta from_wire(const cellmap_msg_EnvironmentDelta& msg) {
+  const std::string where = std::string(kEnvironmentDeltaTopic) + " " + std::to_string(msg.from_version) +
+                            " -> " + std::to_string(msg.to_version);
+  EnvironmentDelta delta;
+  delta.cell = cell_of(msg.cell, kEnvironmentDeltaTopic);
+  delta.from_version = msg.from_version;
+  delta.to_version = msg.to_version;
+  delta.stamp_ns = msg.stamp_ns;
+  delta.added = from_msgs(msg.added, where + ": added");
+  delta.modified = from_msgs(msg.modified, where + ": modified");
+  delta.removed.assign(msg.removed._buffer, msg.removed._buffer + msg.removed._length);
+  return delta;
+}
+
+CellStatus from_wire(const cellmap_msg_Status& msg) {
+  CellStatus status;
+  status.cell = cell_of(msg.cell, kStatusTopic);
+  status.state = msg.state ? msg.state : "";
+  for (uint32_t i = 0; i < msg.sensors._length; ++i) {
+    const cellmap_msg_SensorState& s = msg.sensors._buffer[i];
+    status.sensors.push_back({s.name ? s.name : "", s.state ? s.state : ""});
+  }
+  status.last_sweep_ns = msg.last_sweep_ns;
+  status.sweeps = msg.sweeps;
+  status.dropped_frames = msg.dropped_frames;
+  status.boxes = msg.boxes;
+  status.version = msg.version;
+  return status;
+}
+
+SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
+  const std::string where = std::string(kSceneEditTopic) + " '" + (msg.name ? msg.name : "") + "'";
+  SceneEdit edit;
+  edit.cell = msg.cell ? msg.cell : "";
+  switch (msg.kind) {
+    case cellmap_msg_SCENE_EDIT_ADD_BOX:
+      edit.kind = SceneEdit::Kind::kAddBox;
+      break;
+    case cellmap_msg_SCENE_EDIT_REMOVE:
+      edit.kind = SceneEdit::Kind::kRemove;
+      break;
+    case cellmap_msg_SCENE_EDIT_MOVE:
+      edit.kind = SceneEdit::Kind::kMove;
+      break;
+    default:
+      throw Error(where + ": kind: unknown value " + std::to_string(static_cast<int>(msg.kind)));
+  }
+  edit.name = msg.name ? msg.name : "";
+  if (edit.name.empty()) throw Error(where + ": name: must not be empty");
+  require_finite(msg.center, 3, where + ": center");
+  require_finite(msg.half_extents, 3, where + ": half_extents");
+  require_finite(&msg.yaw, 1, where + ": yaw");
+  edit.center = {msg.center[0], msg.center[1], msg.center[2]};
+  edit.half_extents = {msg.half_extents[0], msg.half_extents[1], msg.half_extents[2]};
+  if (edit.half_extents.minCoeff() < 0) throw Error(where + ": half_extents: must not be negative");
+  edit.yaw = msg.yaw;
+  return edit;
+}
+
+}  // namespace cellmap::transport::wire

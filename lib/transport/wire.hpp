@@ -1,0 +1,66 @@
+#pragma once
+// Conversions between cellmap's value types and the idlc-generated wire types (private to lib/transport).
+// Outgoing: a *Sample object builds the C struct pointing into its own storage (nothing is dds_alloc'ed), so
+// it must outlive the write. Incoming: from_wire() copies out of Cyclone's loaned sample and validates it.
+
+#include <vector>
+
+#include "cellmap.h"
+#include "cellmap/environment/environment.hpp"
+#include "cellmap/transport/messages.hpp"
+
+namespace cellmap::transport::wire {
+
+class EnvironmentSample {
+ public:
+  explicit EnvironmentSample(const Environment& env);
+  [[nodiscard]] const cellmap_msg_Environment* get() const { return &msg_; }
+
+ private:
+  std::string cell_;
+  std::vector<cellmap_msg_Box> boxes_;
+  cellmap_msg_Environment msg_{};
+};
+
+class DeltaSample {
+ public:
+  explicit DeltaSample(const EnvironmentDelta& delta);
+  [[nodiscard]] const cellmap_msg_EnvironmentDelta* get() const { return &msg_; }
+
+ private:
+  std::string cell_;
+  std::vector<cellmap_msg_Box> added_;
+  std::vector<cellmap_msg_Box> modified_;
+  std::vector<std::uint64_t> removed_;
+  cellmap_msg_EnvironmentDelta msg_{};
+};
+
+class StatusSample {
+ public:
+  explicit StatusSample(const CellStatus& status);
+  [[nodiscard]] const cellmap_msg_Status* get() const { return &msg_; }
+
+ private:
+  CellStatus status_;
+  std::vector<cellmap_msg_SensorState> sensors_;
+  cellmap_msg_Status msg_{};
+};
+
+class SceneEditSample {
+ public:
+  explicit SceneEditSample(const SceneEdit& edit);
+  [[nodiscard]] const cellmap_msg_SceneEdit* get() const { return &msg_; }
+
+ private:
+  SceneEdit edit_;
+  cellmap_msg_SceneEdit msg_{};
+};
+
+/// @throws Error naming the topic and field if a number is not finite, a half extent is negative, a rotation
+/// is not a unit quaternion, the cell is empty or box ids repeat.
+[[nodiscard]] Environment from_wire(const cellmap_msg_Environment& msg);
+[[nodiscard]] EnvironmentDelta from_wire(const cellmap_msg_EnvironmentDelta& msg);
+[[nodiscard]] CellStatus from_wire(const cellmap_msg_Status& msg);
+[[nodiscard]] SceneEdit from_wire(const cellmap_msg_SceneEdit& msg);
+
+}  // namespace cellmap::transport::wire

@@ -1,0 +1,270 @@
+#include "cellmap/environment/version_store.hpp"
+
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <random>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh directory under the system temp folder, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "cellmap-store-XXXXXX").string();
+    path_ = ::mkdtemp(pattern.data());
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// A rotation that reads back bit for bit: box_set_from_json re-normalises quaternions, so use one that
+// normalisation leaves unchanged.
+Eigen::Quaterniond stable_rotation(double yaw) {
+  Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  while (!(q.normalized().coeffs() == q.coeffs())) q.normalize();
+  return q;
+}
+
+// The content of version v: known from v alone, so a reload can be checked field by field.
+Environment content(std::uint64_t version) {
+  std::vector<Box> boxes;
+  for (std::uint64_t id = 1; id <= 1 + version % 7; ++id) {
+    Box box;
+    box.id = id;
+    box.center = {0.1 * id, 0.001 * version, 1.0 / 3.0};
+    box.half_extents = {0.05, 0.1, 0.2};
+    box.rotation = stable_rotation(0.01 * version);
+    box.points = version * 10 + id;
+    boxes.push_back(box);
+  }
+  return Environment("cell-a", version, static_cast<std::int64_t>(version) * 1'000'000'000, boxes);
+}
+
+std::string blob_of(std::uint64_t version) {
+  return "octree-" + std::to_string(version) + std::string(1000, 'x');
+}
+
+TEST(VersionStoreTest, FreshDirectoryStartsAtVersionOne) {
+  TempDir dir;
+  VersionStore store(dir.path() / "state", "cell-a");
+  EXPECT_EQ(store.recovered().environment, Environment("cell-a"));
+  EXPECT_FALSE(store.recovered().blob.has_value());
+  EXPECT_TRUE(store.recovered().problems.empty());
+  EXPECT_EQ(store.next_version(), 1u);
+}
+
+TEST(VersionStoreTest, RoundTripKeepsEveryFieldAndTheBlob) {
+  TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    for (std::uint64_t v = 1; v <= 5; ++v) store.save(content(v), blob_of(v));
+    EXPECT_EQ(store.next_version(), 6u);
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(5));
+  ASSERT_TRUE(store.recovered().blob.has_value());
+  EXPECT_EQ(read_file(*store.recovered().blob), blob_of(5));
+  EXPECT_TRUE(store.recovered().problems.empty());
+  EXPECT_EQ(store.next_version(), 6u);
+  // Only the current and the previous good version stay on disk; the snapshot is a boxes file.
+  EXPECT_FALSE(fs::exists(dir.path() / "environment-00000000000000000003.json"));
+  EXPECT_TRUE(fs::exists(dir.path() / "environment-00000000000000000004.json"));
+  EXPECT_EQ(read_box_file(dir.path() / "environment-00000000000000000005.json").boxes.size(),
+            content(5).boxes().size());
+}
+
+TEST(VersionStoreTest, RefusesBackwardsAndForeignCells) {
+  TempDir dir;
+  VersionStore store(dir.path(), "cell-a");
+  store.save(content(3));
+  EXPECT_THROW(store.save(content(3)), Error);
+  EXPECT_THROW(store.save(content(2)), Error);
+  EXPECT_THROW(store.save(Environment("cell-b", 9, 0, {})), Error);
+  store.reserve(7);
+  EXPECT_THROW(store.save(content(6)), Error);  // 7 may be out already; 6 would be published after it
+  EXPECT_THROW(store.reserve(5), Error);
+  EXPECT_EQ(store.next_version(), 8u);
+  EXPECT_THROW(VersionStore(dir.path(), "cell-b"), Error);
+}
+
+TEST(VersionStoreTest, CorruptNewestFallsBackToPreviousGoodAndSaysSo) {
+  TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    for (std::uint64_t v = 1; v <= 3; ++v) store.save(content(v), blob_of(v));
+  }
+  const fs::path newest = dir.path() / "environment-00000000000000000003.json";
+  const std::string text = read_file(newest);
+  std::ofstream(newest, std::ios::trunc) << text.substr(0, text.size() / 2);  // truncated mid-document
+
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(2));
+  EXPECT_EQ(read_file(*store.recovered().blob), blob_of(2));
+  ASSERT_EQ(store.recovered().problems.size(), 1u);
+  EXPECT_NE(store.recovered().problems[0].find("environment-00000000000000000003.json"), std::string::npos)
+      << store.recovered().problems[0];
+  EXPECT_TRUE(fs::exists(newest.string() + ".corrupt"));  // kept for inspection, not dropped
+  EXPECT_EQ(store.next_version(), 4u);                    // 3 may have been published: never reused
+}
+
+TEST(VersionStoreTest, DamagedBlobFallsBackToo) {
+  TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    for (std::uint64_t v = 1; v <= 2; ++v) store.save(content(v), blob_of(v));
+  }
+  std::ofstream(dir.path() / "environment-00000000000000000002.blob", std::ios::trunc)
+      << blob_of(2).substr(0, 10);
+  {
+    VersionStore store(dir.path(), "cell-a");
+    EXPECT_EQ(store.recovered().environment, content(1));
+    ASSERT_EQ(store.recovered().problems.size(), 1u);
+    EXPECT_NE(store.recovered().problems[0].find("truncated"), std::string::npos);
+    store.save(content(3));
+  }
+  // A later open finds 3 (no blob) and 1 as the previous good; the corrupt 2 stays aside.
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(3));
+  EXPECT_FALSE(store.recovered().blob.has_value());
+  EXPECT_TRUE(store.recovered().problems.empty());
+  EXPECT_EQ(store.next_version(), 4u);
+}
+
+TEST(VersionStoreTest, EveryCorruptSnapshotMeansEmptyButVersionsGoOn) {
+  TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    store.save(content(1));
+    store.save(content(2));
+  }
+  std::ofstream(dir.path() / "environment-00000000000000000001.json", std::ios::trunc) << "{";
+  std::ofstream(dir.path() / "environment-00000000000000000002.json", std::ios::trunc) << "";
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment.version(), 0u);
+  EXPECT_EQ(store.recovered().problems.size(), 2u);
+  EXPECT_EQ(store.next_version(), 3u);
+}
+
+TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
+  TempDir dir;
+  std::ofstream(dir.path() / "environment-99999999999999999999.json") << "{}";
+  std::ofstream(dir.path() / "notes.txt") << "operator notes";
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.next_version(), 1u);
+  EXPECT_TRUE(fs::exists(dir.path() / "notes.txt"));
+}
+
+TEST(VersionStoreTest, ReservationSurvivesWithoutSnapshot) {
+  TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    store.save(content(1));
+    store.reserve(2);  // published 2, then crashed before saving it
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(1));
+  EXPECT_EQ(store.next_version(), 3u);
+}
+
+// Runs in a forked child until killed: each loop publishes one version, in the order the store documents.
+// The "publication" is the version number written to `fd`.
+[[noreturn]] void write_versions_forever(const fs::path& dir, int fd, bool reserve_first) {
+  VersionStore store(dir, "cell-a");
+  for (;;) {
+    const std::uint64_t v = store.next_version();
+    if (reserve_first) {
+      store.reserve(v);
+      if (::write(fd, &v, sizeof v) != sizeof v) ::_exit(3);
+      store.save(content(v), blob_of(v));
+    } else {
+      store.save(content(v), blob_of(v));
+      if (::write(fd, &v, sizeof v) != sizeof v) ::_exit(3);
+    }
+  }
+}
+
+void kill_during_writes(bool reserve_first) {
+  TempDir dir;
+  std::mt19937 random(reserve_first ? 11 : 12);
+  std::uniform_int_distribution<int> delay_us(0, 40'000);
+  std::uint64_t published = 0;
+  std::uint64_t loaded_before = 0;
+  for (int round = 0; round < 25; ++round) {
+    int fds[2];
+    ASSERT_EQ(::pipe(fds), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      ::close(fds[0]);
+      try {
+        write_versions_forever(dir.path(), fds[1], reserve_first);
+      } catch (...) {
+        ::_exit(2);
+      }
+    }
+    ::close(fds[1]);
+    // Let the child get a few versions out (it must have started writing), then kill it at a random instant.
+    std::uint64_t v = 0;
+    std::uint64_t before_last = 0;  // the publication before this round's last one
+    ASSERT_EQ(::read(fds[0], &v, sizeof v), static_cast<ssize_t>(sizeof v));
+    published = std::max(published, v);
+    ::usleep(static_cast<useconds_t>(delay_us(random)));
+    ASSERT_EQ(::kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "child failed on its own, exit " << WEXITSTATUS(status);
+    while (::read(fds[0], &v, sizeof v) == static_cast<ssize_t>(sizeof v)) {
+      before_last = published;
+      published = std::max(published, v);
+    }
+    ::close(fds[0]);
+
+    VersionStore store(dir.path(), "cell-a");
+    const Environment& env = store.recovered().environment;
+    EXPECT_TRUE(store.recovered().problems.empty()) << store.recovered().problems.front();
+    if (env.version() == 0) {  // killed before the first save completed (reserve-first only)
+      EXPECT_TRUE(reserve_first);
+      EXPECT_EQ(env, Environment("cell-a"));
+    } else {
+      EXPECT_EQ(env, content(env.version())) << "round " << round;
+      ASSERT_TRUE(store.recovered().blob.has_value());
+      EXPECT_EQ(read_file(*store.recovered().blob), blob_of(env.version()));
+    }
+    EXPECT_GE(env.version(), loaded_before);
+    // Saved before published: nothing published is lost. Reserved first: the version published before the
+    // last one was saved before the last one was reserved.
+    EXPECT_GE(env.version(), reserve_first ? before_last : published) << "round " << round;
+    EXPECT_GT(store.next_version(), published)
+        << "round " << round << ": a published version would be reused";
+    loaded_before = env.version();
+  }
+  EXPECT_GE(published, 25u);  // every round published at least once
+}
+
+TEST(VersionStoreTest, KillDuringWritesNeverReusesAVersionSaveFirst) {
+  kill_during_writes(false);
+}
+TEST(VersionStoreTest, KillDuringWritesNeverReusesAVersionReserveFirst) {
+  kill_during_writes(true);
+}
+
+}  // namespace
+}  // namespace cellmap

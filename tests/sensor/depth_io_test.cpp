@@ -1,0 +1,60 @@
+// Depth image files (16-bit PNG and TIFF) and intrinsics files, on files the test writes itself.
+#include "cellmap/sensor/depth_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
+#include "sensor/sensor_test_util.hpp"
+
+namespace cellmap {
+namespace {
+
+using test::ramp;
+using test::TempDir;
+
+TEST(DepthIoTest, PngRoundTripKeepsEverySixteenBitValue) {
+  TempDir dir("png");
+  RawDepth image = ramp(5, 3);
+  image.depth[1] = 65535;  // high byte and low byte both matter
+  image.depth[2] = 256;
+  write_depth_png(dir / "d.png", image);
+  const RawDepth back = read_depth_image(dir / "d.png");
+  EXPECT_EQ(back.width, 5);
+  EXPECT_EQ(back.height, 3);
+  EXPECT_EQ(back.depth, image.depth);
+}
+
+TEST(DepthIoTest, RefusesWhatIsNotSixteenBitDepth) {
+  TempDir dir("bad");
+  write_file_atomically(dir / "noise.png", "not a png at all");
+  EXPECT_THROW((void)read_depth_image(dir / "noise.png"), Error);
+  write_file_atomically(dir / "noise.tiff", "II*\0garbage");
+  EXPECT_THROW((void)read_depth_image(dir / "noise.tiff"), Error);
+  EXPECT_THROW((void)read_depth_image(dir / "missing.png"), Error);
+  EXPECT_THROW((void)read_depth_image(dir / "depth.jpg"), Error);
+  RawDepth wrong = ramp(4, 2);
+  wrong.depth.pop_back();
+  EXPECT_THROW(write_depth_png(dir / "w.png", wrong), Error);
+  try {
+    (void)read_depth_image(dir / "noise.png");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("noise.png"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DepthIoTest, IntrinsicsYamlIsStrict) {
+  TempDir dir("yaml");
+  write_file_atomically(dir / "k.yaml",
+                        "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\ndepth_scale: 0.0001\n");
+  const PinholeIntrinsics k = read_intrinsics_yaml(dir / "k.yaml");
+  EXPECT_EQ(k.width, 4);
+  EXPECT_DOUBLE_EQ(k.depth_scale, 0.0001);
+  write_file_atomically(dir / "typo.yaml", "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nfocal: 3\n");
+  EXPECT_THROW((void)read_intrinsics_yaml(dir / "typo.yaml"), Error);
+  write_file_atomically(dir / "nofx.yaml", "width: 4\nheight: 3\nfy: 2\ncx: 1.5\ncy: 1\n");
+  EXPECT_THROW((void)read_intrinsics_yaml(dir / "nofx.yaml"), Error);
+}
+
+}  // namespace
+}  // namespace cellmap

@@ -1,0 +1,111 @@
+#include "cellmap/transport/environment_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include "scene_steps.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+// Versions 0..n of the test sequence, and the deltas between neighbours.
+struct History {
+  std::vector<Environment> versions;
+  std::vector<EnvironmentDelta> deltas;  // deltas[i]: version i -> i + 1
+  explicit History(int n) {
+    versions.push_back(Environment("cell-a"));
+    for (int v = 1; v <= n; ++v) {
+      versions.push_back(test::next_environment(versions.back(), v, v * 100));
+      deltas.push_back(diff(versions[v - 1], versions[v]));
+    }
+  }
+};
+
+TEST(EnvironmentTrackerTest, FirstSnapshotThenDeltasInOrder) {
+  const History h(5);
+  EnvironmentTracker tracker("cell-a");
+  EXPECT_TRUE(tracker.needs_snapshot());
+  // A delta before any snapshot is held until the snapshot it continues arrives.
+  EXPECT_TRUE(tracker.on_delta(h.deltas[2]).empty());
+  auto updates = tracker.on_snapshot(h.versions[2]);
+  ASSERT_EQ(updates.size(), 2u);
+  EXPECT_TRUE(updates[0].from_snapshot);
+  EXPECT_EQ(updates[0].delta.from_version, 0u);
+  EXPECT_EQ(updates[0].delta.added.size(), h.versions[2].boxes().size());
+  EXPECT_FALSE(updates[1].from_snapshot);
+  EXPECT_EQ(updates[1].environment, h.versions[3]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+  updates = tracker.on_delta(h.deltas[3]);
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_EQ(updates[0].environment, h.versions[4]);
+  EXPECT_EQ(updates[0].delta.added.size() + updates[0].delta.modified.size(), 1u);
+  EXPECT_EQ(tracker.stats().deltas_applied, 2u);
+  EXPECT_EQ(tracker.stats().snapshots_applied, 1u);
+  EXPECT_EQ(tracker.stats().gaps, 0u);
+}
+
+TEST(EnvironmentTrackerTest, OldDuplicateAndForeignSamplesAreIgnored) {
+  const History h(4);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[3]);
+  EXPECT_TRUE(tracker.on_snapshot(h.versions[3]).empty());
+  EXPECT_TRUE(tracker.on_snapshot(h.versions[2]).empty());
+  EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty());
+  EXPECT_TRUE(tracker.on_snapshot(Environment("cell-b", 9, 0, {})).empty());
+  EXPECT_EQ(tracker.environment()->version(), 3u);
+  EXPECT_FALSE(tracker.needs_snapshot());
+}
+
+TEST(EnvironmentTrackerTest, GapHoldsDeltasUntilASnapshotResyncs) {
+  const History h(8);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[1]);
+  (void)tracker.on_delta(h.deltas[1]);  // 1 -> 2
+  // 2 -> 3 and 3 -> 4 are lost; 4 -> 5 and 5 -> 6 arrive.
+  EXPECT_TRUE(tracker.on_delta(h.deltas[4]).empty());
+  EXPECT_TRUE(tracker.on_delta(h.deltas[5]).empty());
+  EXPECT_TRUE(tracker.needs_snapshot());
+  EXPECT_EQ(tracker.stats().gaps, 2u);
+  EXPECT_EQ(tracker.environment()->version(), 2u);
+  // The snapshot of 4 bridges the gap; the held deltas then continue to 6.
+  const auto updates = tracker.on_snapshot(h.versions[4]);
+  ASSERT_EQ(updates.size(), 3u);
+  EXPECT_TRUE(updates[0].from_snapshot);
+  EXPECT_EQ(updates[0].delta.from_version, 2u);
+  EXPECT_EQ(apply(h.versions[2], updates[0].delta), h.versions[4]);
+  EXPECT_EQ(updates[2].environment, h.versions[6]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+  EXPECT_EQ(tracker.stats().snapshots_applied, 2u);
+}
+
+TEST(EnvironmentTrackerTest, DeltaFromVersionZeroIsASnapshot) {
+  const History h(6);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[2]);
+  // A restarted publisher sends version 5 whole: the copy jumps there without waiting for the snapshot topic.
+  const auto updates = tracker.on_delta(diff(h.versions[0], h.versions[5]));
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_EQ(updates[0].delta.from_version, 2u);
+  EXPECT_EQ(updates[0].environment, h.versions[5]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+  EXPECT_EQ(tracker.stats().gaps, 0u);
+}
+
+TEST(EnvironmentTrackerTest, ContradictingDeltaWaitsForSnapshot) {
+  const History h(3);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[1]);
+  EnvironmentDelta bad = h.deltas[1];
+  bad.added = {h.versions[1].boxes().front()};  // re-adds an id the copy has: a reused version number
+  bad.modified.clear();
+  EXPECT_TRUE(tracker.on_delta(bad).empty());
+  EXPECT_EQ(tracker.stats().rejected, 1u);
+  EXPECT_TRUE(tracker.needs_snapshot());
+  EXPECT_TRUE(tracker.on_delta(h.deltas[2]).empty());  // no delta is trusted until a snapshot
+  const auto updates = tracker.on_snapshot(h.versions[3]);
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_EQ(*tracker.environment(), h.versions[3]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+}
+
+}  // namespace
+}  // namespace cellmap::transport

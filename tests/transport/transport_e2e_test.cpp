@@ -1,0 +1,215 @@
+// Publisher, planner subscriber and `cellmap echo` as separate processes on loopback DDS.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <future>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "cellmap/environment/version_store.hpp"
+#include "cellmap/transport/environment_subscriber.hpp"
+#include "child_process.hpp"
+#include "loopback.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using nlohmann::json;
+constexpr auto kPatience = 60s;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "cellmap-e2e-XXXXXX").string();
+    path_ = ::mkdtemp(pattern.data());
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::vector<std::string> helper(int domain, const fs::path& state, int versions, int interval_ms) {
+  return {TRANSPORT_PUBLISHER_HELPER, std::to_string(domain), state.string(), std::to_string(versions),
+          std::to_string(interval_ms)};
+}
+
+// Reads the helper's lines until one starts with `prefix`; records every "publishing V". Returns V of it.
+std::uint64_t read_until(test::ChildProcess& child, const std::string& prefix,
+                         std::vector<std::uint64_t>& published) {
+  for (;;) {
+    const std::optional<std::string> line = child.read_line(kPatience);
+    if (!line) throw std::runtime_error("helper said nothing for a minute (waiting for '" + prefix + "')");
+    const auto space = line->find(' ');
+    const std::uint64_t version = std::stoull(line->substr(space + 1));
+    if (line->rfind("publishing", 0) == 0) published.push_back(version);
+    if (line->rfind(prefix, 0) == 0) return version;
+  }
+}
+
+class TransportE2eTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { test::use_loopback(); }
+};
+
+TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
+  constexpr int kDomain = 121;
+  TempDir dir;
+  test::ChildProcess daemon(helper(kDomain, dir.path(), 10, 0));
+  std::vector<std::uint64_t> published;
+  const std::uint64_t last = read_until(daemon, "done", published);
+  ASSERT_EQ(last, 10u);
+
+  // Both joiners arrive after ten versions: the library copy and `cellmap echo`.
+  test::ChildProcess echo(
+      {CELLMAP_TOOL, "echo", "--domain", std::to_string(kDomain), "--count", "11", "--timeout", "60"});
+  const dds::Participant planner(kDomain);
+  std::atomic<int> calls{0};
+  EnvironmentSubscriber subscriber(planner, "cell-e2e",
+                                   [&](const Environment&, const EnvironmentDelta&) { ++calls; });
+  ASSERT_TRUE(subscriber.wait_for_version(10, kPatience)) << subscriber.last_error();
+  EXPECT_EQ(subscriber.environment()->version(), 10u);
+  EXPECT_EQ(calls.load(), 1);  // straight to version 10, no replay
+
+  // echo: the ten deltas (the history keeps 16) and the snapshot of 10. The two topics arrive independently,
+  // so only the order within each is fixed.
+  std::vector<json> deltas;
+  std::vector<json> snapshots;
+  while (auto line = echo.read_line(kPatience)) {
+    const json message = json::parse(*line);
+    (message["type"] == "delta" ? deltas : snapshots).push_back(message);
+  }
+  ASSERT_EQ(snapshots.size(), 1u);
+  EXPECT_EQ(snapshots[0]["cell"], "cell-e2e");
+  EXPECT_EQ(snapshots[0]["version"], 10);
+  EXPECT_EQ(snapshots[0]["boxes"].size(), subscriber.environment()->boxes().size());
+  ASSERT_EQ(deltas.size(), 10u);
+  for (std::size_t i = 0; i < deltas.size(); ++i) {
+    EXPECT_EQ(deltas[i]["cell"], "cell-e2e");
+    EXPECT_EQ(deltas[i]["version"], i + 1);
+    EXPECT_EQ(deltas[i]["from_version"], i);
+    EXPECT_EQ(deltas[i]["added"].size() + deltas[i]["modified"].size(), 1u);
+    EXPECT_TRUE(deltas[i]["removed"].empty());
+  }
+  EXPECT_EQ(WEXITSTATUS(echo.wait()), 0);
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(WEXITSTATUS(daemon.wait()), 0);
+}
+
+TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
+  constexpr int kDomain = 123;
+  TempDir dir;
+  const dds::Participant planner(kDomain);
+  std::mutex gate;
+  std::unique_lock<std::mutex> hold(gate);  // the first callback blocks until the daemon is done
+  std::promise<void> entered;
+  std::once_flag first;
+  EnvironmentSubscriber subscriber(
+      planner, "cell-e2e",
+      [&](const Environment&, const EnvironmentDelta&) {
+        std::call_once(first, [&] { entered.set_value(); });
+        const std::lock_guard<std::mutex> wait_for_daemon(gate);
+      },
+      /*delta_depth=*/2);
+  test::ChildProcess daemon(helper(kDomain, dir.path(), 1, 0));
+  std::vector<std::uint64_t> published;
+  read_until(daemon, "done", published);
+  ASSERT_EQ(entered.get_future().wait_for(kPatience), std::future_status::ready);
+  daemon.signal(SIGTERM);
+  daemon.wait();
+  // While the planner's callback is stuck, a second daemon run publishes 40 versions; its reader keeps 2.
+  test::ChildProcess busy(helper(kDomain, dir.path(), 40, 0));
+  const std::uint64_t last = read_until(busy, "done", published);
+  hold.unlock();
+  ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
+  busy.signal(SIGTERM);
+  busy.wait();
+  EXPECT_EQ(*subscriber.environment(), VersionStore(dir.path(), "cell-e2e").recovered().environment);
+  EXPECT_GE(subscriber.stats().gaps, 1u);
+  EXPECT_GE(subscriber.stats().snapshots_applied, 2u);
+}
+
+TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
+  constexpr int kDomain = 122;
+  TempDir dir;
+  const dds::Participant planner(kDomain);
+  std::mutex mutex;
+  std::vector<std::pair<Environment, EnvironmentDelta>> calls;
+  EnvironmentSubscriber subscriber(planner, "cell-e2e",
+                                   [&](const Environment& env, const EnvironmentDelta& delta) {
+                                     const std::lock_guard<std::mutex> lock(mutex);
+                                     calls.emplace_back(env, delta);
+                                   });
+  test::ChildProcess echo({CELLMAP_TOOL, "echo", "--domain", std::to_string(kDomain), "--timeout", "600"});
+
+  std::vector<std::uint64_t> published;
+  std::mt19937 random(5);
+  // Three daemons killed at random instants while publishing every 10 ms, then one that finishes.
+  for (int run = 0; run < 3; ++run) {
+    test::ChildProcess daemon(helper(kDomain, dir.path(), 100000, 10));
+    read_until(daemon, "publishing", published);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50 + random() % 200));
+    daemon.signal(SIGKILL);
+    daemon.wait();
+    try {
+      for (;;) read_until(daemon, "publishing", published);  // what it printed before dying
+    } catch (const std::exception&) {
+    }
+  }
+  // Past the 1 s lease of the loopback config: the killed daemons' writers have expired at the subscriber,
+  // which must not read that as "all boxes removed".
+  std::this_thread::sleep_for(2500ms);
+  test::ChildProcess daemon(helper(kDomain, dir.path(), 5, 10));
+  const std::uint64_t last = read_until(daemon, "done", published);
+  ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
+
+  // No version number was published twice, by any of the four daemons.
+  const std::set<std::uint64_t> unique(published.begin(), published.end());
+  EXPECT_GT(published.size(), 8u);
+  EXPECT_EQ(unique.size(), published.size());
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(WEXITSTATUS(daemon.wait()), 0);
+
+  // The planner's copy is what the store persisted; it only ever grew, and no box was ever removed.
+  const VersionStore store(dir.path(), "cell-e2e");
+  EXPECT_EQ(*subscriber.environment(), store.recovered().environment);
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    ASSERT_FALSE(calls.empty());
+    std::uint64_t previous = 0;
+    for (const auto& [env, delta] : calls) {
+      EXPECT_GT(env.version(), previous);
+      EXPECT_TRUE(delta.removed.empty())
+          << "version " << env.version() << " removed " << delta.removed.size();
+      previous = env.version();
+    }
+  }
+
+  // echo saw every daemon: each version it printed has one content only (a reused number would not).
+  echo.signal(SIGTERM);
+  std::map<std::uint64_t, std::string> boxes_by_version;
+  std::uint64_t highest = 0;
+  while (auto line = echo.read_line(5s)) {
+    const json message = json::parse(*line);
+    if (message["type"] != "snapshot") continue;
+    const std::uint64_t version = message["version"];
+    const auto [it, fresh] = boxes_by_version.emplace(version, message["boxes"].dump());
+    EXPECT_TRUE(fresh || it->second == message["boxes"].dump()) << "version " << version << " reused";
+    highest = std::max(highest, version);
+  }
+  EXPECT_EQ(highest, last);
+}
+
+}  // namespace
+}  // namespace cellmap::transport

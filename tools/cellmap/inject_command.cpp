@@ -1,0 +1,103 @@
+// `cellmap inject [--domain N] add-box|remove|move ...`: edits the simulated scene of a running cellmapd.
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/scene_edits.hpp"
+#include "commands.hpp"
+#include "parse.hpp"
+
+namespace cellmap::cli {
+namespace {
+
+struct InjectOptions {
+  std::uint32_t domain = 0;
+  std::string cell;
+  double wait = 10.0;
+  std::string name;
+  std::string center;
+  std::string half_extents;
+  double yaw = 0.0;
+};
+
+Eigen::Vector3d vector3(const std::string& text, const std::string& what) {
+  const std::vector<double> v = parse_numbers(text, what, {3});
+  return {v[0], v[1], v[2]};
+}
+
+// A name no other injection is likely to have chosen, so the caller can refer to the obstacle later.
+std::string fresh_name() {
+  std::random_device random;
+  std::ostringstream name;
+  name << "box-" << std::hex << std::setw(8) << std::setfill('0') << (random() & 0xffffffffu);
+  return name.str();
+}
+
+void send(const InjectOptions& options, transport::SceneEdit edit) {
+  edit.cell = options.cell;
+  const dds::Participant participant(options.domain);
+  const transport::SceneEditWriter writer(participant);
+  const auto wait =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(options.wait));
+  if (!writer.wait_for_reader(wait)) {
+    std::ostringstream reason;
+    reason << "inject: no simulating cellmapd on domain " << options.domain << " within " << options.wait
+           << " s";
+    throw Error(reason.str());
+  }
+  writer.write(edit);
+  if (!writer.wait_for_acks(wait)) throw Error("inject: the daemon did not acknowledge the edit");
+}
+
+}  // namespace
+
+void add_inject_command(CLI::App& app) {
+  auto options = std::make_shared<InjectOptions>();
+  CLI::App* inject = app.add_subcommand("inject", "Edit the simulated scene of a running cellmapd over DDS");
+  inject->add_option("--domain", options->domain, "DDS domain id")->check(CLI::Range(0, 232));
+  inject->add_option("--cell", options->cell, "only this cell's daemon (default: every simulating daemon)");
+  inject->add_option("--wait", options->wait, "seconds to wait for the daemon")
+      ->check(CLI::NonNegativeNumber);
+  inject->require_subcommand(1);
+
+  CLI::App* add = inject->add_subcommand("add-box", "Add a box obstacle; prints its name");
+  add->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
+  add->add_option("--half-extents", options->half_extents, "A,B,C, metres")->required();
+  add->add_option("--yaw", options->yaw, "rotation about the cell's z axis, radians");
+  add->callback([options] {
+    transport::SceneEdit edit;
+    edit.kind = transport::SceneEdit::Kind::kAddBox;
+    edit.name = fresh_name();
+    edit.center = vector3(options->center, "--center");
+    edit.half_extents = vector3(options->half_extents, "--half-extents");
+    if (edit.half_extents.minCoeff() <= 0) throw Error("--half-extents: must be positive");
+    edit.yaw = options->yaw;
+    send(*options, edit);
+    std::cout << edit.name << std::endl;
+  });
+
+  CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name");
+  remove->add_option("--name", options->name, "obstacle name")->required();
+  remove->callback([options] {
+    transport::SceneEdit edit;
+    edit.kind = transport::SceneEdit::Kind::kRemove;
+    edit.name = options->name;
+    send(*options, edit);
+  });
+
+  CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre");
+  move->add_option("--name", options->name, "obstacle name")->required();
+  move->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
+  move->callback([options] {
+    transport::SceneEdit edit;
+    edit.kind = transport::SceneEdit::Kind::kMove;
+    edit.name = options->name;
+    edit.center = vector3(options->center, "--center");
+    send(*options, edit);
+  });
+}
+
+}  // namespace cellmap::cli
