@@ -12,6 +12,7 @@ void add_bench_command(CLI::App& app);
 void add_distance_command(CLI::App& app);
 void add_sensors_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_sensor_comparison_command(CLI::App& app);
 void add_paper_figure_command(CLI::App& app);
 
 }  // namespace cellmap::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   cellmap::cli::add_distance_command(app);
   cellmap::cli::add_sensors_command(app);
   cellmap::cli::add_simulate_command(app);
+  cellmap::cli::add_sensor_comparison_command(app);
   cellmap::cli::add_paper_figure_command(app);
 
   try {
