@@ -1,5 +1,7 @@
 #include "cellmap/sim/noise.hpp"
 
+#include "parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -185,14 +187,14 @@ std::vector<bool> near_depth_edge(const NoiseModel& model, const std::vector<dou
 }
 
 std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vector<double>& exact_z, int width,
-                                       int height, const NoiseKey& key) {
+                                       int height, const NoiseKey& key, int threads) {
   if (model.is_zero()) return exact_z;
   const Random random(key);
   std::vector<double> z = exact_z;
 
   if (model.flying_probability > 0) {
     const std::vector<bool> edge = edge_pixels(model, exact_z, width, height, false);
-    for (int v = 0; v < height; ++v) {
+    parallel_for(height, threads, [&](int v) {
       for (int u = 0; u < width; ++u) {
         const std::size_t p = at(u, v, width);
         if (!edge[p] || random.uniform(p, kFlying) >= model.flying_probability) continue;
@@ -206,14 +208,14 @@ std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vecto
         // The pixel integrates light from both surfaces: its phase, and so its depth, lands in between.
         z[p] = lo + random.uniform(p, kMix) * (hi - lo);
       }
-    }
+    });
   }
 
   if (model.smear_radius > 0) {
     const int r = model.smear_radius;
     const std::vector<bool> near_edge = edge_pixels(model, exact_z, width, height, true);
     const std::vector<bool> reach = dilate(near_edge, width, height, r);  // only these can be smeared
-    for (int v = 0; v < height; ++v) {
+    parallel_for(height, threads, [&](int v) {
       for (int u = 0; u < width; ++u) {
         const std::size_t p = at(u, v, width);
         const double zp = exact_z[p];
@@ -234,12 +236,12 @@ std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vecto
         const double s = (std::sqrt(best_d2) + 0.5 * random.uniform(p, kSmear)) / (r + 1.0);
         z[p] = z_front + std::min(s, 1.0) * (zp - z_front);
       }
-    }
+    });
   }
 
   const bool wavy = model.wave_amplitude > 0;
   const Waviness wave(random, wavy ? model.wave_length_px : 1.0, wavy ? width : 0, wavy ? height : 0);
-  for (int v = 0; v < height; ++v) {
+  parallel_for(height, threads, [&](int v) {
     for (int u = 0; u < width; ++u) {
       const std::size_t p = at(u, v, width);
       if (z[p] <= 0) continue;
@@ -248,7 +250,7 @@ std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vecto
       if (wavy) noisy += model.wave_amplitude * sigma * wave.at(u, v);
       z[p] = std::max(noisy, 0.0);
     }
-  }
+  });
   return z;
 }
 

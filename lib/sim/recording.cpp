@@ -1,11 +1,9 @@
 #include "cellmap/sim/recording.hpp"
 
 #include <pcl/io/pcd_io.h>
-#include <png.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <sstream>
 
 #include "cellmap/common/atomic_file.hpp"
@@ -41,80 +39,6 @@ double parse_double(const std::string& text, const std::string& where) {
     throw Error(where + ": '" + text + "' is not a finite number");
   }
   return value;
-}
-
-// ---- libpng glue. libpng reports errors by longjmp; the functions that call setjmp keep only trivially
-// destructible locals, so no C++ destructor is skipped.
-
-struct PngError {
-  char message[256] = "";
-};
-
-void on_png_error(png_structp png, png_const_charp message) {
-  auto* error = static_cast<PngError*>(png_get_error_ptr(png));
-  std::snprintf(error->message, sizeof error->message, "%s", message);
-  png_longjmp(png, 1);
-}
-
-void on_png_warning(png_structp, png_const_charp) {}
-
-void append_bytes(png_structp png, png_bytep data, png_size_t length) {
-  static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
-}
-
-void flush_nothing(png_structp) {}
-
-struct ReadCursor {
-  const std::string* bytes;
-  std::size_t offset;
-};
-
-void read_bytes(png_structp png, png_bytep data, png_size_t length) {
-  auto* cursor = static_cast<ReadCursor*>(png_get_io_ptr(png));
-  if (cursor->offset + length > cursor->bytes->size()) png_error(png, "file is truncated");
-  std::memcpy(data, cursor->bytes->data() + cursor->offset, length);
-  cursor->offset += length;
-}
-
-bool encode_png(std::uint32_t width, std::uint32_t height, png_bytep* rows, std::string* out,
-                PngError* error) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
-  if (!png) return false;
-  png_infop info = png_create_info_struct(png);
-  if (!info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    return false;
-  }
-  png_set_write_fn(png, out, append_bytes, flush_nothing);
-  png_set_compression_level(png, 1);  // depth compresses well even at the fastest level
-  png_set_IHDR(png, info, width, height, 16, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  png_write_image(png, rows);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return true;
-}
-
-// Reads the header into width/height/depth/color, then (if `rows` is set) the pixels.
-bool decode_png(ReadCursor* cursor, std::uint32_t* width, std::uint32_t* height, int* bit_depth, int* color,
-                png_bytep* rows, PngError* error) {
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
-  if (!png) return false;
-  png_infop info = png_create_info_struct(png);
-  if (!info || setjmp(png_jmpbuf(png))) {
-    png_destroy_read_struct(&png, &info, nullptr);
-    return false;
-  }
-  png_set_read_fn(png, cursor, read_bytes);
-  png_read_info(png, info);
-  *width = png_get_image_width(png, info);
-  *height = png_get_image_height(png, info);
-  *bit_depth = png_get_bit_depth(png, info);
-  *color = png_get_color_type(png, info);
-  if (rows) png_read_image(png, rows);
-  png_destroy_read_struct(&png, &info, nullptr);
-  return true;
 }
 
 }  // namespace
@@ -192,64 +116,6 @@ std::vector<PoseRecord> read_poses(const std::filesystem::path& path) {
     records.push_back(std::move(r));
   }
   return records;
-}
-
-void write_depth_png(const std::filesystem::path& path, const DepthImage& image) {
-  const PinholeIntrinsics& k = image.intrinsics;
-  if (k.width <= 0 || k.height <= 0 ||
-      image.depth.size() != static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height)) {
-    throw Error(path.string() + ": depth image size disagrees with its intrinsics");
-  }
-  // PNG stores 16-bit samples big-endian.
-  std::vector<png_byte> bytes(image.depth.size() * 2);
-  for (std::size_t i = 0; i < image.depth.size(); ++i) {
-    bytes[2 * i] = static_cast<png_byte>(image.depth[i] >> 8);
-    bytes[2 * i + 1] = static_cast<png_byte>(image.depth[i] & 0xff);
-  }
-  std::vector<png_bytep> rows(static_cast<std::size_t>(k.height));
-  for (int v = 0; v < k.height; ++v)
-    rows[static_cast<std::size_t>(v)] = bytes.data() + 2 * static_cast<std::size_t>(v) * k.width;
-  std::string encoded;
-  PngError error;
-  if (!encode_png(static_cast<std::uint32_t>(k.width), static_cast<std::uint32_t>(k.height), rows.data(),
-                  &encoded, &error)) {
-    throw Error(path.string() + ": PNG encoding failed: " + error.message);
-  }
-  write_file_atomically(path, encoded);
-}
-
-DepthImage read_depth_png(const std::filesystem::path& path, const PinholeIntrinsics& intrinsics) {
-  const std::string bytes = read_file(path);
-  std::uint32_t width = 0, height = 0;
-  int bit_depth = 0, color = 0;
-  PngError error;
-  ReadCursor cursor{&bytes, 0};
-  if (!decode_png(&cursor, &width, &height, &bit_depth, &color, nullptr, &error)) {
-    throw Error(path.string() + ": not a readable PNG: " + error.message);
-  }
-  if (bit_depth != 16 || color != PNG_COLOR_TYPE_GRAY) {
-    throw Error(path.string() + ": depth PNG must be 16-bit greyscale, got " + std::to_string(bit_depth) +
-                "-bit colour type " + std::to_string(color));
-  }
-  if (static_cast<int>(width) != intrinsics.width || static_cast<int>(height) != intrinsics.height) {
-    throw Error(path.string() + ": image is " + std::to_string(width) + "x" + std::to_string(height) +
-                ", intrinsics say " + std::to_string(intrinsics.width) + "x" +
-                std::to_string(intrinsics.height));
-  }
-  std::vector<png_byte> data(static_cast<std::size_t>(width) * height * 2);
-  std::vector<png_bytep> rows(height);
-  for (std::uint32_t v = 0; v < height; ++v) rows[v] = data.data() + 2 * static_cast<std::size_t>(v) * width;
-  cursor.offset = 0;
-  if (!decode_png(&cursor, &width, &height, &bit_depth, &color, rows.data(), &error)) {
-    throw Error(path.string() + ": corrupt PNG: " + error.message);
-  }
-  DepthImage image;
-  image.intrinsics = intrinsics;
-  image.depth.resize(static_cast<std::size_t>(width) * height);
-  for (std::size_t i = 0; i < image.depth.size(); ++i) {
-    image.depth[i] = static_cast<std::uint16_t>((data[2 * i] << 8) | data[2 * i + 1]);
-  }
-  return image;
 }
 
 void write_intrinsics(const std::filesystem::path& path, const PinholeIntrinsics& k) {

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
 #include "cellmap/common/error.hpp"
+#include "parallel.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -14,24 +14,6 @@ constexpr int kTile = 16;  // pixels per side of the tiles that share one candid
 Scene validated(Scene scene) {
   scene.validate();
   return scene;
-}
-
-// Runs body(0..count-1) on up to `threads` threads, interleaved so that neighbouring (similarly costly) items
-// go to different threads.
-template <typename Body>
-void parallel_for(int count, int threads, const Body& body) {
-  threads = std::clamp(threads, 1, std::max(1, count));
-  if (threads == 1) {
-    for (int i = 0; i < count; ++i) body(i);
-    return;
-  }
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&, t] {
-      for (int i = t; i < count; i += threads) body(i);
-    });
-  }
-  for (std::thread& thread : pool) thread.join();
 }
 
 }  // namespace
@@ -121,7 +103,8 @@ SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3
   });
 
   const NoiseModel model = options_.noise ? noise_model(spec.model, k) : zero_noise();
-  const std::vector<double> noisy = apply_camera_noise(model, out.exact, width, height, key);
+  const std::vector<double> noisy =
+      apply_camera_noise(model, out.exact, width, height, key, options_.threads);
 
   // Quantize like the camera does (raw units of depth_scale, 0 = no return) and drop what lies outside the
   // cell.

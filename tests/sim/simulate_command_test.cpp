@@ -8,8 +8,11 @@
 #include <filesystem>
 
 #include "cellmap/common/atomic_file.hpp"
+#include "cellmap/sensor/depth_io.hpp"
+#include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/recording.hpp"
+#include "cellmap/sim/simulator.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -47,7 +50,7 @@ TEST(SimulateCommandTest, LineScannerSweepWritesScansPosesAndTheMergedCloud) {
   const ToolRun run = run_tool("simulate --sensor os32c -o " + (dir / "out").string(), dir);
   ASSERT_EQ(run.status, 0) << run.err;
   EXPECT_NE(run.err.find("151 frames"), std::string::npos) << run.err;
-  const std::vector<PoseRecord> poses = read_poses(dir / "out" / "poses.csv");
+  const std::vector<PoseRecord> poses = read_poses(dir / "out" / "frames.csv");
   ASSERT_EQ(poses.size(), 151u);
   std::size_t total = 0;
   for (const PoseRecord& pose : poses) total += pcd_points(dir / "out" / pose.file);
@@ -58,24 +61,40 @@ TEST(SimulateCommandTest, LineScannerSweepWritesScansPosesAndTheMergedCloud) {
   fs::remove_all(dir);
 }
 
-TEST(SimulateCommandTest, ExactCameraSweepWritesSixteenBitPngs) {
+TEST(SimulateCommandTest, ExactCameraSweepIsAReplayDirectoryOfTheSameFrames) {
   const fs::path dir = temp_dir("kinect");
-  const ToolRun run = run_tool(std::string("simulate ") + CELLMAP_SOURCE_DIR +
-                               "/config/cell.yaml --sensor kinect_v2 "
-                               "--exact --seed 9 -o " +
-                               (dir / "out").string(),
-                           dir);
+  const ToolRun run =
+      run_tool(std::string("simulate ") + CELLMAP_SOURCE_DIR +
+                   "/config/cell.yaml --sensor kinect_v2 --exact --seed 9 -o " + (dir / "out").string(),
+               dir);
   ASSERT_EQ(run.status, 0) << run.err;
   const Scene scene = default_scene();
-  const PinholeIntrinsics& k =
-      scene.sensors[static_cast<std::size_t>(scene.find_sensor("kinect_v2"))].intrinsics;
-  const std::vector<PoseRecord> poses = read_poses(dir / "out" / "poses.csv");
-  ASSERT_EQ(poses.size(), scene.sweep.stops.size());
+  const int cam = scene.find_sensor("kinect_v2");
+  const SensorSpec& spec = scene.sensors[static_cast<std::size_t>(cam)];
+  const std::vector<SimFrame> expected = Simulator(scene, SimOptions{false, 2}).sweep(cam);
+  const std::vector<PoseRecord> records = read_poses(dir / "out" / "frames.csv");
+  ASSERT_EQ(records.size(), expected.size());
+
+  // The sensor stage's replay source plays the directory back: the same depth images, the same tool poses.
+  ReplayConfig config;
+  config.directory = (dir / "out").string();
+  config.playback = ReplayConfig::Playback::kFastest;
+  ReplaySource replay(config);
+  ASSERT_EQ(replay.open().state, SourceState::kConnected) << replay.status().reason;
+  ASSERT_EQ(replay.size(), expected.size());
+  const std::vector<StampedPose> tool_poses = replay.poses();
   std::size_t valid = 0;
-  for (const PoseRecord& pose : poses) {
-    EXPECT_EQ(pose.q, scene.sweep.stops[pose.frame]);
-    const DepthImage image = read_depth_png(dir / "out" / pose.file, k);
-    for (std::uint16_t raw : image.depth) valid += raw != 0;
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(records[k].q, scene.sweep.stops[k]);
+    EXPECT_TRUE(records[k].X_CS.isApprox(expected[k].frame.X_CS, 1e-12));
+    EXPECT_DOUBLE_EQ(tool_poses[k].stamp, expected[k].frame.stamp);
+    EXPECT_TRUE((tool_poses[k].X_CE * spec.X_ES).isApprox(expected[k].frame.X_CS, 1e-12));
+    const Frame played = replay.load(k);
+    ASSERT_TRUE(played.depth.has_value());
+    EXPECT_EQ(played.depth->depth, expected[k].frame.depth->depth);
+    EXPECT_EQ(played.depth->intrinsics.fx, spec.intrinsics.fx);
+    EXPECT_EQ(played.points_S.size(), expected[k].frame.points_S.size());
+    valid += played.points_S.size();
   }
   EXPECT_EQ(pcd_points(dir / "out" / "merged.pcd"), valid);
   fs::remove_all(dir);

@@ -1,4 +1,6 @@
-// `cellmap simulate [SCENE.yaml] [--sensor NAME] [--seed N] [--exact] -o DIR`: one simulated sweep on disk.
+// `cellmap simulate [SCENE.yaml] [--sensor NAME] [--seed N] [--exact] -o DIR`: one simulated sweep on disk,
+// as a replay directory (replay_source.hpp) plus frames.csv (sensor poses and joint vectors) and the merged
+// cloud.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -7,6 +9,8 @@
 #include <string>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/sensor/depth_io.hpp"
+#include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/recording.hpp"
 #include "cellmap/sim/simulator.hpp"
@@ -55,28 +59,33 @@ void simulate(const SimulateArgs& args) {
   const auto write_start = std::chrono::steady_clock::now();
   const std::filesystem::path dir = args.out;
   std::vector<Frame> plain;
-  std::vector<sim::PoseRecord> poses;
+  std::vector<sim::PoseRecord> records;
+  std::vector<ReplayEntry> replay;
+  const Eigen::Isometry3d X_SE = spec.X_ES.inverse();
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const Frame& frame = frames[k].frame;
     char name[64];
     std::snprintf(name, sizeof name, "frames/%s_%04zu.%s", spec.name.c_str(), k, frame.depth ? "png" : "pcd");
     if (frame.depth) {
-      sim::write_depth_png(dir / name, *frame.depth);
+      write_depth_png((dir / name).string(), RawDepth{frame.depth->intrinsics.width,
+                                                      frame.depth->intrinsics.height, frame.depth->depth});
     } else {
       sim::write_pcd(dir / name, frame.points_S);
     }
-    poses.push_back(sim::PoseRecord{k, spec.name, frame.stamp, name, frame.X_CS, frames[k].q});
+    records.push_back(sim::PoseRecord{k, spec.name, frame.stamp, name, frame.X_CS, frames[k].q});
+    replay.push_back(ReplayEntry{name, frame.stamp, frame.X_CS * X_SE});  // the replay format holds X_CE
     plain.push_back(frame);
   }
-  if (spec.is_camera()) sim::write_intrinsics(dir / (spec.name + "_intrinsics.yaml"), spec.intrinsics);
-  sim::write_poses(dir / "poses.csv", poses, joint_names);
+  if (spec.is_camera()) sim::write_intrinsics(dir / "intrinsics.yaml", spec.intrinsics);
+  write_replay_poses((dir / "poses.csv").string(), replay);
+  sim::write_poses(dir / "frames.csv", records, joint_names);
   const Sweep sweep = merge_frames(plain);
   sim::write_sweep_pcd(dir / "merged.pcd", sweep);
   const double write_seconds = seconds_since(write_start);
 
   std::fprintf(stderr,
                "simulate: sensor %s (%s%s), %zu frames, %zu points merged in the cell frame; render %.3f s, "
-               "write %.3f s; wrote %s/{frames/, poses.csv, merged.pcd}\n",
+               "write %.3f s; wrote %s/{frames/, poses.csv, frames.csv, merged.pcd}\n",
                spec.name.c_str(), to_string(spec.model).c_str(), args.exact ? ", exact" : "", frames.size(),
                sweep.point_count(), render_seconds, write_seconds, dir.string().c_str());
 }
@@ -86,7 +95,8 @@ void simulate(const SimulateArgs& args) {
 void add_simulate_command(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "simulate",
-      "Simulate one sweep of a scene: per-frame 16-bit PNG depth (or PCD scans), poses.csv, merged.pcd");
+      "Simulate one sweep of a scene into a replay directory: per-frame 16-bit PNG depth (or PCD scans), "
+      "poses.csv (tool poses), frames.csv (sensor poses, joints), merged.pcd (cell frame, with origins)");
   auto args = std::make_shared<SimulateArgs>();
   sub->add_option("scene", args->scene, "scene YAML (default: the embedded config/cell.yaml)");
   sub->add_option(

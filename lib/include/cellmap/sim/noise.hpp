@@ -61,9 +61,10 @@ struct NoiseModel final {
                                                 int width, int height, int radius);
 
 /// The noisy depth image (metres, 0 = no return) for exact depths `exact_z` (width × height, row-major).
+/// `threads` share the per-pixel work; the result does not depend on it.
 [[nodiscard]] std::vector<double> apply_camera_noise(const NoiseModel& model,
                                                      const std::vector<double>& exact_z, int width,
-                                                     int height, const NoiseKey& key);
+                                                     int height, const NoiseKey& key, int threads = 1);
 /// The noisy ranges of a line scan (one per beam, metres, 0 = no return).
 [[nodiscard]] std::vector<double> apply_range_noise(const NoiseModel& model,
                                                     const std::vector<double>& exact_r, const NoiseKey& key);

@@ -1,6 +1,7 @@
 #pragma once
-// Files of a recorded sweep: 16-bit PNG depth images, the poses file, and clouds with their sensor origins.
-// What `cellmap simulate` writes, in formats a replay source can read back.
+// Files of a simulated sweep beside the replay directory format of the sensor stage (replay_source.hpp, whose
+// depth PNG writer and poses.csv we reuse): the frames file with sensor poses and joint vectors, intrinsics,
+// and clouds with their sensor origins.
 
 #include <Eigen/Geometry>
 
@@ -14,7 +15,7 @@
 
 namespace cellmap::sim {
 
-/// One line of the poses file: when and from where a frame was taken.
+/// One line of the frames file: when and from where a frame was taken.
 struct PoseRecord final {
   std::uint64_t frame = 0;  ///< index of the frame in its sweep
   std::string sensor;       ///< sensor name
@@ -24,7 +25,7 @@ struct PoseRecord final {
   Eigen::VectorXd q;                                       ///< robot joint vector
 };
 
-/// Writes the poses file as CSV: a header `frame,sensor,stamp,file,x,y,z,qw,qx,qy,qz,q:<joint>...` and one
+/// Writes the frames file as CSV: a header `frame,sensor,stamp,file,x,y,z,qw,qx,qy,qz,q:<joint>...` and one
 /// line per record; position in metres, orientation as a unit quaternion [w, x, y, z], joints in metres or
 /// radians. Numbers are written with 17 significant digits, so reading gives back the same doubles.
 /// @throws Error if records disagree in joint count with `joint_names`, a name holds a comma or a line break,
@@ -32,19 +33,11 @@ struct PoseRecord final {
 void write_poses(const std::filesystem::path& path, const std::vector<PoseRecord>& records,
                  const std::vector<std::string>& joint_names);
 
-/// Reads a poses file written by write_poses. @throws Error naming the file and line on a malformed line.
+/// Reads a frames file written by write_poses. @throws Error naming the file and line on a malformed line.
 [[nodiscard]] std::vector<PoseRecord> read_poses(const std::filesystem::path& path);
 
-/// Writes a depth image as a 16-bit greyscale PNG (raw depth units, 0 = no return), as RealSense and Kinect
-/// tools record them. @throws Error if the image is inconsistent or the file cannot be written.
-void write_depth_png(const std::filesystem::path& path, const DepthImage& image);
-
-/// Reads a 16-bit greyscale PNG into a depth image with the given intrinsics.
-/// @throws Error naming the file if it is not a 16-bit greyscale PNG of the intrinsics' size.
-[[nodiscard]] DepthImage read_depth_png(const std::filesystem::path& path,
-                                        const PinholeIntrinsics& intrinsics);
-
-/// Writes intrinsics as a small YAML map (width, height, fx, fy, cx, cy, depth_scale, min_range, max_range).
+/// Writes intrinsics as a small YAML map (width, height, fx, fy, cx, cy, depth_scale, min_range, max_range),
+/// as read_intrinsics_yaml (sensor stage) reads them. @throws Error on I/O failure.
 void write_intrinsics(const std::filesystem::path& path, const PinholeIntrinsics& intrinsics);
 
 /// Writes a cloud as binary PCD (fields x y z). @throws Error on I/O failure.
