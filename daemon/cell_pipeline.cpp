@@ -74,9 +74,17 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
   if (changes.empty()) return report;
 
   start = std::chrono::steady_clock::now();
+  // Re-fit what the changes touch: the change regions, and the boxes that hold a changed voxel (their whole
+  // extent, so a partly changed object is fitted whole).
   std::vector<Region> area;
-  for (const ChangeRegion& region : changes.regions) area.push_back({region.min_C, region.max_C});
-  const std::vector<std::uint64_t> scope = boxes_in_scope(boxes_, area, config_.reconcile);
+  std::vector<Eigen::Vector3d> changed_C;
+  for (const ChangeRegion& region : changes.regions) {
+    area.push_back({region.min_C, region.max_C});
+    for (const auto* keys : {&region.appeared, &region.vanished}) {
+      for (const octomap::OcTreeKey& key : *keys) changed_C.push_back(map_.centre(key));
+    }
+  }
+  const std::vector<std::uint64_t> scope = boxes_touched(boxes_, changed_C);
   std::vector<Box> kept;
   for (const Box& box : boxes_) {
     if (std::find(scope.begin(), scope.end(), box.id) != scope.end()) {

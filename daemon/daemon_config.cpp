@@ -10,7 +10,6 @@ namespace {
 
 ReconcileOptions reconcile_from_yaml(YamlMap section) {
   ReconcileOptions o;
-  o.scope_fraction = section.number("scope_fraction", o.scope_fraction, 0.0, 1.0);
   o.min_overlap = section.number("min_overlap", o.min_overlap, 0.0, 1.0);
   o.position_tolerance = section.number("position_tolerance", o.position_tolerance, 0.0, 1.0);
   o.rotation_tolerance = section.number("rotation_tolerance", o.rotation_tolerance, 0.0, 3.2);

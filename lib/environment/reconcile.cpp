@@ -38,22 +38,15 @@ bool box_inside(const Box& inner, const Box& outer, double tolerance) {
   return true;
 }
 
-std::vector<std::uint64_t> boxes_in_scope(const std::vector<Box>& previous,
-                                          const std::vector<Region>& regions,
-                                          const ReconcileOptions& options) {
+std::vector<std::uint64_t> boxes_touched(const std::vector<Box>& previous,
+                                         const std::vector<Eigen::Vector3d>& changed_C) {
   std::vector<std::uint64_t> ids;
   for (const Box& box : previous) {
-    const Region b = bounds_of(box);
-    const double box_volume = b.volume();
-    double inside = 0.0;
-    bool centre_inside = false;
-    for (const Region& region : regions) {
-      inside += b.intersection(region).volume();
-      centre_inside = centre_inside || region.contains(box.center);
-    }
-    // Overlapping regions may count a volume twice; the share is only compared against a threshold.
-    if (centre_inside || (box_volume > 0 && inside >= options.scope_fraction * box_volume))
-      ids.push_back(box.id);
+    const Region bounds = bounds_of(box);
+    const bool touched = std::any_of(changed_C.begin(), changed_C.end(), [&](const Eigen::Vector3d& p) {
+      return bounds.contains(p) && box.contains(p);
+    });
+    if (touched) ids.push_back(box.id);
   }
   return ids;
 }
@@ -73,12 +66,21 @@ Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::ui
   std::vector<const Box*> kept;
   for (const Box& box : previous) (scope.count(box.id) ? old_in_scope : kept).push_back(&box);
 
+  // Largest first, so a sliver inside a bigger new box (a face segment the merge left apart) is the one
+  // dropped.
+  std::vector<const Box*> by_volume;
+  for (const Box& box : resegmented) by_volume.push_back(&box);
+  std::stable_sort(by_volume.begin(), by_volume.end(),
+                   [](const Box* a, const Box* b) { return a->volume() > b->volume(); });
   std::vector<const Box*> candidates;
-  for (const Box& box : resegmented) {
-    const bool redundant = std::any_of(kept.begin(), kept.end(), [&](const Box* k) {
-      return box_inside(box, *k, options.redundant_tolerance);
-    });
-    if (!redundant) candidates.push_back(&box);
+  for (const Box* box : by_volume) {
+    const auto covers = [&](const Box* other) {
+      return box_inside(*box, *other, options.redundant_tolerance);
+    };
+    if (std::none_of(kept.begin(), kept.end(), covers) &&
+        std::none_of(candidates.begin(), candidates.end(), covers)) {
+      candidates.push_back(box);
+    }
   }
 
   // Greedy matching, best overlap first; ties broken by index so the result is deterministic.

@@ -2,19 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_support.hpp"
+
 #include <functional>
 
 namespace cellmap {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(YamlMapTest, ReadsValuesAndDefaults) {
   YamlMap root = YamlMap::parse("a: 2.5\nsub:\n  k: 7\n", "cfg.yaml");

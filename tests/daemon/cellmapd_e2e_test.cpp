@@ -3,6 +3,8 @@
 // reuse.
 #include <gtest/gtest.h>
 
+#include "support/test_support.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -21,22 +23,6 @@ using namespace std::chrono_literals;
 constexpr int kAddRemoveDomain = 150;
 constexpr int kRestartDomain = 151;
 constexpr auto kPatience = 90s;
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "cellmapd-e2e-XXXXXX").string();
-    path_ = ::mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 // Records every delta the planner's callback sees.
 class Recorder {
@@ -93,7 +79,7 @@ class CellmapdE2eTest : public ::testing::Test {
     return *planner.environment();
   }
 
-  TempDir dir_;
+  test::TempDir dir_;
   fs::path config_;
 };
 

@@ -17,10 +17,6 @@ Box make_box(std::uint64_t id, Eigen::Vector3d center, Eigen::Vector3d half, dou
   return box;
 }
 
-Region around(const Box& box, double margin) {
-  return bounds_of(box).grown(margin);
-}
-
 // A table (id 1) with one object on it (id 2).
 std::vector<Box> table_scene() {
   return {make_box(1, {1.5, 1.0, 0.375}, {1.5, 1.0, 0.025}), make_box(2, {0.5, 0.5, 0.5}, {0.1, 0.1, 0.1})};
@@ -35,9 +31,9 @@ TEST(ReconcileTest, BoundsOfRotatedBox) {
 
 TEST(ReconcileTest, NoiseWithinToleranceGivesNoDelta) {
   const auto previous = table_scene();
-  const Region region = around(previous[1], 0.05);
-  const auto scope = boxes_in_scope(previous, {region});
-  ASSERT_EQ(scope, std::vector<std::uint64_t>{2});  // the table only touches the region
+  // Surface voxels of the object flickered.
+  const auto scope = boxes_touched(previous, {previous[1].center + Eigen::Vector3d(0.09, 0, 0.09)});
+  ASSERT_EQ(scope, std::vector<std::uint64_t>{2});
   Box jittered = previous[1];
   jittered.center.x() += 0.005;
   jittered.half_extents.z() += 0.004;
@@ -51,8 +47,8 @@ TEST(ReconcileTest, NoiseWithinToleranceGivesNoDelta) {
 TEST(ReconcileTest, AddedObjectGetsAFreshIdAndTablePatchIsRedundant) {
   const auto previous = table_scene();
   const Box added = make_box(0, {2.0, 1.2, 0.55}, {0.15, 0.1, 0.15});
-  const Region region = around(added, 0.05);
-  const auto scope = boxes_in_scope(previous, {region});
+  // The new object's voxels, down to the layer right above the table top (z = 0.4): the table is untouched.
+  const auto scope = boxes_touched(previous, {added.center, Eigen::Vector3d(2.0, 1.2, 0.41)});
   EXPECT_TRUE(scope.empty());
   // Re-segmenting region + margin also yields a patch of the table surface beside the new object.
   const Box table_patch = make_box(0, {2.0, 1.2, 0.38}, {0.2, 0.15, 0.01});
@@ -68,7 +64,7 @@ TEST(ReconcileTest, AddedObjectGetsAFreshIdAndTablePatchIsRedundant) {
 
 TEST(ReconcileTest, VanishedObjectIsRemovedAndItsIdNeverReused) {
   const auto previous = table_scene();
-  const auto scope = boxes_in_scope(previous, {around(previous[1], 0.05)});
+  const auto scope = boxes_touched(previous, {previous[1].center});
   const Reconciled removed = reconcile(previous, scope, {}, 3);
   EXPECT_EQ(removed.removed, std::vector<std::uint64_t>{2});
   ASSERT_EQ(removed.boxes.size(), 1u);
@@ -83,9 +79,8 @@ TEST(ReconcileTest, SmallMoveKeepsTheIdLargeMoveIsRemoveAndAdd) {
   const auto previous = table_scene();
   Box nudged = previous[1];
   nudged.center.x() += 0.06;
-  Region region = around(previous[1], 0.05);
-  region.max = region.max.cwiseMax(around(nudged, 0.05).max);
-  const auto scope = boxes_in_scope(previous, {region});
+  // The voxels the object left at its -x side.
+  const auto scope = boxes_touched(previous, {previous[1].center - Eigen::Vector3d(0.09, 0, 0)});
   const Reconciled small = reconcile(previous, scope, {nudged}, 3);
   ASSERT_EQ(small.modified.size(), 1u);
   EXPECT_EQ(small.modified[0].id, 2u);
@@ -94,7 +89,7 @@ TEST(ReconcileTest, SmallMoveKeepsTheIdLargeMoveIsRemoveAndAdd) {
 
   Box far = previous[1];
   far.center.x() += 1.0;
-  const auto scope_far = boxes_in_scope(previous, {around(previous[1], 0.05), around(far, 0.05)});
+  const auto scope_far = boxes_touched(previous, {previous[1].center, far.center});
   const Reconciled large = reconcile(previous, scope_far, {far}, 3);
   EXPECT_EQ(large.removed, std::vector<std::uint64_t>{2});
   ASSERT_EQ(large.added.size(), 1u);
@@ -105,13 +100,22 @@ TEST(ReconcileTest, SplitObjectKeepsIdOnTheBiggerPart) {
   const auto previous = table_scene();
   const Box left = make_box(0, {0.45, 0.5, 0.5}, {0.05, 0.1, 0.1});
   const Box right = make_box(0, {0.58, 0.5, 0.5}, {0.02, 0.1, 0.1});
-  const auto scope = boxes_in_scope(previous, {around(previous[1], 0.05)});
+  const auto scope = boxes_touched(previous, {previous[1].center});
   const Reconciled out = reconcile(previous, scope, {right, left}, 3);
   ASSERT_EQ(out.modified.size(), 1u);
   EXPECT_EQ(out.modified[0].id, 2u);
   EXPECT_EQ(out.modified[0].center, left.center);
   ASSERT_EQ(out.added.size(), 1u);
   EXPECT_EQ(out.added[0].center, right.center);
+}
+
+TEST(ReconcileTest, SliverInsideALargerNewBoxIsDropped) {
+  const auto previous = table_scene();
+  const Box added = make_box(0, {2.12, 0.45, 0.91}, {0.12, 0.11, 0.15});
+  const Box sliver = make_box(0, {2.22, 0.45, 0.91}, {0.02, 0.11, 0.13});  // one face, inside `added`
+  const Reconciled out = reconcile(previous, {}, {sliver, added}, 3);
+  ASSERT_EQ(out.added.size(), 1u);
+  EXPECT_EQ(out.added[0].center, added.center);
 }
 
 TEST(ReconcileTest, RejectsAnIdCounterThatCouldReuseIds) {

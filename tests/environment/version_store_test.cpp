@@ -1,10 +1,12 @@
 #include "cellmap/environment/version_store.hpp"
 
 #include <gtest/gtest.h>
+
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "support/test_support.hpp"
 
 #include <chrono>
 #include <fstream>
@@ -17,23 +19,6 @@ namespace cellmap {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A fresh directory under the system temp folder, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "cellmap-store-XXXXXX").string();
-    path_ = ::mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 // A rotation that reads back bit for bit: box_set_from_json re-normalises quaternions, so use one that
 // normalisation leaves unchanged.
@@ -63,7 +48,7 @@ std::string blob_of(std::uint64_t version) {
 }
 
 TEST(VersionStoreTest, FreshDirectoryStartsAtVersionOne) {
-  TempDir dir;
+  test::TempDir dir;
   VersionStore store(dir.path() / "state", "cell-a");
   EXPECT_EQ(store.recovered().environment, Environment("cell-a"));
   EXPECT_FALSE(store.recovered().blob.has_value());
@@ -72,7 +57,7 @@ TEST(VersionStoreTest, FreshDirectoryStartsAtVersionOne) {
 }
 
 TEST(VersionStoreTest, RoundTripKeepsEveryFieldAndTheBlob) {
-  TempDir dir;
+  test::TempDir dir;
   {
     VersionStore store(dir.path(), "cell-a");
     for (std::uint64_t v = 1; v <= 5; ++v) store.save(content(v), blob_of(v));
@@ -92,7 +77,7 @@ TEST(VersionStoreTest, RoundTripKeepsEveryFieldAndTheBlob) {
 }
 
 TEST(VersionStoreTest, RefusesBackwardsAndForeignCells) {
-  TempDir dir;
+  test::TempDir dir;
   VersionStore store(dir.path(), "cell-a");
   store.save(content(3));
   EXPECT_THROW(store.save(content(3)), Error);
@@ -106,7 +91,7 @@ TEST(VersionStoreTest, RefusesBackwardsAndForeignCells) {
 }
 
 TEST(VersionStoreTest, CorruptNewestFallsBackToPreviousGoodAndSaysSo) {
-  TempDir dir;
+  test::TempDir dir;
   {
     VersionStore store(dir.path(), "cell-a");
     for (std::uint64_t v = 1; v <= 3; ++v) store.save(content(v), blob_of(v));
@@ -126,7 +111,7 @@ TEST(VersionStoreTest, CorruptNewestFallsBackToPreviousGoodAndSaysSo) {
 }
 
 TEST(VersionStoreTest, DamagedBlobFallsBackToo) {
-  TempDir dir;
+  test::TempDir dir;
   {
     VersionStore store(dir.path(), "cell-a");
     for (std::uint64_t v = 1; v <= 2; ++v) store.save(content(v), blob_of(v));
@@ -149,7 +134,7 @@ TEST(VersionStoreTest, DamagedBlobFallsBackToo) {
 }
 
 TEST(VersionStoreTest, EveryCorruptSnapshotMeansEmptyButVersionsGoOn) {
-  TempDir dir;
+  test::TempDir dir;
   {
     VersionStore store(dir.path(), "cell-a");
     store.save(content(1));
@@ -164,7 +149,7 @@ TEST(VersionStoreTest, EveryCorruptSnapshotMeansEmptyButVersionsGoOn) {
 }
 
 TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
-  TempDir dir;
+  test::TempDir dir;
   std::ofstream(dir.path() / "environment-99999999999999999999.json") << "{}";
   std::ofstream(dir.path() / "notes.txt") << "operator notes";
   VersionStore store(dir.path(), "cell-a");
@@ -173,7 +158,7 @@ TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
 }
 
 TEST(VersionStoreTest, ReservationSurvivesWithoutSnapshot) {
-  TempDir dir;
+  test::TempDir dir;
   {
     VersionStore store(dir.path(), "cell-a");
     store.save(content(1));
@@ -202,7 +187,7 @@ TEST(VersionStoreTest, ReservationSurvivesWithoutSnapshot) {
 }
 
 void kill_during_writes(bool reserve_first) {
-  TempDir dir;
+  test::TempDir dir;
   std::mt19937 random(reserve_first ? 11 : 12);
   std::uniform_int_distribution<int> delay_us(0, 40'000);
   std::uint64_t published = 0;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_support.hpp"
+
 #include <functional>
 #include <string>
 
@@ -10,14 +12,7 @@
 namespace cellmap {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 OccupancyConfig from_text(const std::string& text) {
   YamlMap root = YamlMap::parse(text, "cell.yaml");

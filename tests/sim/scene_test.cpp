@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_support.hpp"
+
 #include <cmath>
 #include <functional>
 
@@ -12,14 +14,7 @@
 namespace cellmap::sim {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 // A small valid scene; tests replace one line to break it.
 const std::string kScene = R"(cell: {min: [0, 0, 0], max: [4, 3, 3]}

@@ -1,6 +1,8 @@
 // Publisher, planner subscriber and `cellmap echo` as separate processes on loopback DDS.
 #include <gtest/gtest.h>
+
 #include <stdlib.h>
+#include "support/test_support.hpp"
 
 #include <filesystem>
 #include <future>
@@ -23,22 +25,6 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using nlohmann::json;
 constexpr auto kPatience = 60s;
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "cellmap-e2e-XXXXXX").string();
-    path_ = ::mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 std::vector<std::string> helper(int domain, const fs::path& state, int versions, int interval_ms) {
   return {TRANSPORT_PUBLISHER_HELPER, std::to_string(domain), state.string(), std::to_string(versions),
@@ -65,7 +51,7 @@ class TransportE2eTest : public ::testing::Test {
 
 TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
   constexpr int kDomain = 121;
-  TempDir dir;
+  test::TempDir dir;
   test::ChildProcess daemon(helper(kDomain, dir.path(), 10, 0));
   std::vector<std::uint64_t> published;
   const std::uint64_t last = read_until(daemon, "done", published);
@@ -109,7 +95,7 @@ TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
 
 TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
   constexpr int kDomain = 123;
-  TempDir dir;
+  test::TempDir dir;
   const dds::Participant planner(kDomain);
   std::mutex gate;
   std::unique_lock<std::mutex> hold(gate);  // the first callback blocks until the daemon is done
@@ -142,7 +128,7 @@ TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
 
 TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
   constexpr int kDomain = 122;
-  TempDir dir;
+  test::TempDir dir;
   const dds::Participant planner(kDomain);
   std::mutex mutex;
   std::vector<std::pair<Environment, EnvironmentDelta>> calls;

@@ -16,24 +16,22 @@ namespace cellmap {
 [[nodiscard]] bool box_inside(const Box& inner, const Box& outer, double tolerance);
 
 struct ReconcileOptions final {
-  /// An old box is re-fitted ("in scope") when at least this share of its bounds' volume lies inside the
-  /// change regions, or its centre does. Small overlaps (the table under a new object) leave a box untouched.
-  double scope_fraction = 0.5;
   /// A new box takes an old box's id when the IoU of their bounds is at least this; else it is a new object.
   double min_overlap = 0.3;
   /// A matched box whose centre and half extents moved less than this (metres) and rotated less than
   /// `rotation_tolerance` (radians) keeps its old value exactly, so noise yields no delta.
   double position_tolerance = 0.02;
   double rotation_tolerance = 0.05;
-  /// New boxes lying entirely inside a kept box grown by this (metres) are redundant and dropped: their
-  /// points are already covered.
+  /// New boxes lying entirely inside a kept box, or inside a larger new box, grown by this (metres) are
+  /// redundant and dropped: their points are already covered.
   double redundant_tolerance = 0.02;
 };
 
-/// Ids of the boxes of `previous` that are in scope of the change `regions` (see ReconcileOptions).
-[[nodiscard]] std::vector<std::uint64_t> boxes_in_scope(const std::vector<Box>& previous,
-                                                        const std::vector<Region>& regions,
-                                                        const ReconcileOptions& options = {});
+/// Ids of the boxes of `previous` that contain at least one of `changed_C` (the centres of voxels whose state
+/// changed, cell frame): the boxes whose own evidence changed, which must be re-fitted. A box merely next to
+/// a change (the table under a new object) is not touched and keeps its id and content.
+[[nodiscard]] std::vector<std::uint64_t> boxes_touched(const std::vector<Box>& previous,
+                                                       const std::vector<Eigen::Vector3d>& changed_C);
 
 /// The outcome of one reconciliation.
 struct Reconciled final {
