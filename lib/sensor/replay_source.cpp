@@ -10,41 +10,13 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 
 namespace cellmap {
 namespace {
 
 constexpr const char* kPosesHeader = "file,stamp,x,y,z,qw,qx,qy,qz";
-
-std::string trim(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
-}
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream stream(line);
-  std::string field;
-  while (std::getline(stream, field, ',')) fields.push_back(trim(field));
-  if (!line.empty() && line.back() == ',') fields.emplace_back();
-  return fields;
-}
-
-double parse_number(const std::string& text, const std::string& where) {
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value)) {
-    throw Error(where + ": '" + text + "' is not a finite number");
-  }
-  return value;
-}
 
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -65,22 +37,22 @@ std::vector<ReplayEntry> read_replay_poses(const std::string& path) {
     const std::string where = path + ":" + std::to_string(number);
     if (!have_header) {
       std::string header;
-      for (const std::string& field : split_csv(line)) header += (header.empty() ? "" : ",") + field;
+      for (const std::string& field : split(line, ',')) header += (header.empty() ? "" : ",") + field;
       if (header != kPosesHeader) throw Error(where + ": header must be '" + std::string(kPosesHeader) + "'");
       have_header = true;
       continue;
     }
-    const std::vector<std::string> fields = split_csv(line);
+    const std::vector<std::string> fields = split(line, ',');
     if (fields.size() != 9) throw Error(where + ": expected 9 fields, got " + std::to_string(fields.size()));
     if (fields[0].empty()) throw Error(where + ": file is empty");
     ReplayEntry entry;
     entry.file = fields[0];
-    entry.stamp = parse_number(fields[1], where + ": stamp");
-    const Eigen::Vector3d p(parse_number(fields[2], where + ": x"), parse_number(fields[3], where + ": y"),
-                            parse_number(fields[4], where + ": z"));
+    entry.stamp = parse_finite(fields[1], where + ": stamp");
+    const Eigen::Vector3d p(parse_finite(fields[2], where + ": x"), parse_finite(fields[3], where + ": y"),
+                            parse_finite(fields[4], where + ": z"));
     const Eigen::Quaterniond q(
-        parse_number(fields[5], where + ": qw"), parse_number(fields[6], where + ": qx"),
-        parse_number(fields[7], where + ": qy"), parse_number(fields[8], where + ": qz"));
+        parse_finite(fields[5], where + ": qw"), parse_finite(fields[6], where + ": qx"),
+        parse_finite(fields[7], where + ": qy"), parse_finite(fields[8], where + ": qz"));
     if (std::abs(q.norm() - 1.0) > 1e-3) {
       throw Error(where + ": quaternion [qw, qx, qy, qz] has norm " + std::to_string(q.norm()) +
                   ", expected 1");

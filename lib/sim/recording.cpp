@@ -8,6 +8,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -16,29 +17,6 @@ std::string number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.17g", value);
   return text;
-}
-
-std::vector<std::string> split(const std::string& line, char separator) {
-  std::vector<std::string> items;
-  std::stringstream stream(line);
-  std::string item;
-  while (std::getline(stream, item, separator)) items.push_back(item);
-  if (!line.empty() && line.back() == separator) items.emplace_back();
-  return items;
-}
-
-double parse_double(const std::string& text, const std::string& where) {
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value)) {
-    throw Error(where + ": '" + text + "' is not a finite number");
-  }
-  return value;
 }
 
 }  // namespace
@@ -94,15 +72,15 @@ std::vector<PoseRecord> read_poses(const std::filesystem::path& path) {
                   std::to_string(header.size()));
     }
     PoseRecord r;
-    const double frame = parse_double(items[0], where + ": frame");
+    const double frame = parse_finite(items[0], where + ": frame");
     if (frame < 0 || frame != std::floor(frame))
       throw Error(where + ": frame must be a non-negative integer");
     r.frame = static_cast<std::uint64_t>(frame);
     r.sensor = items[1];
-    r.stamp = parse_double(items[2], where + ": stamp");
+    r.stamp = parse_finite(items[2], where + ": stamp");
     r.file = items[3];
     double v[7];
-    for (int i = 0; i < 7; ++i) v[i] = parse_double(items[4 + i], where + ": " + fixed[4 + i]);
+    for (int i = 0; i < 7; ++i) v[i] = parse_finite(items[4 + i], where + ": " + fixed[4 + i]);
     const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-6) throw Error(where + ": orientation is not a unit quaternion");
     r.X_CS = Eigen::Isometry3d::Identity();
@@ -111,7 +89,7 @@ std::vector<PoseRecord> read_poses(const std::filesystem::path& path) {
     r.q.resize(static_cast<Eigen::Index>(joints));
     for (std::size_t j = 0; j < joints; ++j) {
       r.q[static_cast<Eigen::Index>(j)] =
-          parse_double(items[fixed.size() + j], where + ": " + header[fixed.size() + j]);
+          parse_finite(items[fixed.size() + j], where + ": " + header[fixed.size() + j]);
     }
     records.push_back(std::move(r));
   }

@@ -5,27 +5,14 @@
 #include <sstream>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap::cli {
 
 std::vector<double> parse_numbers(const std::string& text, const std::string& what,
                                   const std::vector<std::size_t>& allowed_counts) {
   std::vector<double> values;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    std::size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(value)) {
-      throw Error(what + ": '" + item + "' is not a finite number");
-    }
-    values.push_back(value);
-  }
+  for (const std::string& item : split(text, ',')) values.push_back(parse_finite(item, what));
   if (std::find(allowed_counts.begin(), allowed_counts.end(), values.size()) == allowed_counts.end()) {
     std::string counts;
     for (std::size_t n : allowed_counts) counts += (counts.empty() ? "" : " or ") + std::to_string(n);

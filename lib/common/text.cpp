@@ -1,0 +1,39 @@
+#include "cellmap/common/text.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap {
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return "";
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
+std::vector<std::string> split(const std::string& line, char separator) {
+  std::vector<std::string> items;
+  std::stringstream stream(line);
+  std::string item;
+  while (std::getline(stream, item, separator)) items.push_back(trim(item));
+  if (!line.empty() && line.back() == separator) items.emplace_back();
+  return items;
+}
+
+double parse_finite(const std::string& text, const std::string& where) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw Error(where + ": '" + text + "' is not a finite number");
+  }
+  return value;
+}
+
+}  // namespace cellmap

@@ -1,0 +1,18 @@
+#pragma once
+// Parsing of the small text formats cellmap reads (CSV pose files, comma lists on the command line).
+
+#include <string>
+#include <vector>
+
+namespace cellmap {
+
+/// `text` without leading and trailing blanks (space, tab, CR).
+[[nodiscard]] std::string trim(const std::string& text);
+
+/// Splits at `separator`; every item is trimmed; a trailing separator gives a last empty item.
+[[nodiscard]] std::vector<std::string> split(const std::string& line, char separator);
+
+/// The whole of `text` as a finite number. @throws Error "<where>: '<text>' is not a finite number".
+[[nodiscard]] double parse_finite(const std::string& text, const std::string& where);
+
+}  // namespace cellmap
