@@ -26,35 +26,34 @@ struct Pairs {
   std::vector<fcl::Boxd> fa, fb;
 };
 
+fcl::Transform3d fcl_pose(const Obb& o) {
+  fcl::Transform3d X = fcl::Transform3d::Identity();
+  X.linear() = o.rotation;
+  X.translation() = o.center;
+  return X;
+}
+
 Pairs make_pairs(bool separated_only) {
-  {
-    Pairs p;
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    std::uniform_real_distribution<double> h(0.02, 1.0);
-    const auto box = [&](double spread) {
-      return Obb(Vector3d(u(rng), u(rng), u(rng)) * spread, Vector3d(h(rng), h(rng), h(rng)),
-                 Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix());
-    };
-    const auto pose = [](const Obb& o) {
-      fcl::Transform3d X = fcl::Transform3d::Identity();
-      X.linear() = o.rotation;
-      X.translation() = o.center;
-      return X;
-    };
-    while (p.a.size() < 1024) {
-      const Obb a = box(1.0);
-      const Obb b = box(3.0);
-      if (separated_only && cellmap::collision::overlap(a, b)) continue;
-      p.a.push_back(a);
-      p.b.push_back(b);
-      p.Xa.push_back(pose(p.a.back()));
-      p.Xb.push_back(pose(p.b.back()));
-      p.fa.emplace_back(2 * p.a.back().half_extents);
-      p.fb.emplace_back(2 * p.b.back().half_extents);
-    }
-    return p;
+  Pairs p;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<double> h(0.02, 1.0);
+  const auto box = [&](double spread) {
+    return Obb(Vector3d(u(rng), u(rng), u(rng)) * spread, Vector3d(h(rng), h(rng), h(rng)),
+               Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix());
+  };
+  while (p.a.size() < 1024) {
+    const Obb a = box(1.0);
+    const Obb b = box(3.0);
+    if (separated_only && cellmap::collision::overlap(a, b)) continue;
+    p.a.push_back(a);
+    p.b.push_back(b);
+    p.Xa.push_back(fcl_pose(a));
+    p.Xb.push_back(fcl_pose(b));
+    p.fa.emplace_back(2 * a.half_extents);
+    p.fb.emplace_back(2 * b.half_extents);
   }
+  return p;
 }
 
 const Pairs& separated() {
@@ -67,82 +66,67 @@ const Pairs& mixed() {
   return p;
 }
 
-void BM_BoxDistanceOurs(benchmark::State& state) {
-  const Pairs& p = separated();
+// Runs `query(pairs, i)` on pair after pair, cycling through the 1024.
+template <typename Query>
+void cycle(benchmark::State& state, const Pairs& pairs, Query query) {
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(cellmap::collision::signed_distance(p.a[i], p.b[i]));
+    benchmark::DoNotOptimize(query(pairs, i));
     i = (i + 1) & 1023;
   }
+}
+
+void BM_BoxDistanceOurs(benchmark::State& state) {
+  cycle(state, separated(),
+        [](const Pairs& p, std::size_t i) { return cellmap::collision::signed_distance(p.a[i], p.b[i]); });
 }
 BENCHMARK(BM_BoxDistanceOurs);
 
 void BM_BoxDistanceFcl(benchmark::State& state) {
-  const Pairs& p = separated();
   fcl::DistanceRequestd request(true, false);
   request.gjk_solver_type = fcl::GST_INDEP;
-  std::size_t i = 0;
-  for (auto _ : state) {
+  cycle(state, separated(), [&](const Pairs& p, std::size_t i) {
     fcl::DistanceResultd result;
-    benchmark::DoNotOptimize(fcl::distance(&p.fa[i], p.Xa[i], &p.fb[i], p.Xb[i], request, result));
-    i = (i + 1) & 1023;
-  }
+    return fcl::distance(&p.fa[i], p.Xa[i], &p.fb[i], p.Xb[i], request, result);
+  });
 }
 BENCHMARK(BM_BoxDistanceFcl);
 
 void BM_OverlapOurs(benchmark::State& state) {
-  const Pairs& p = mixed();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(cellmap::collision::overlap(p.a[i], p.b[i]));
-    i = (i + 1) & 1023;
-  }
+  cycle(state, mixed(),
+        [](const Pairs& p, std::size_t i) { return cellmap::collision::overlap(p.a[i], p.b[i]); });
 }
 BENCHMARK(BM_OverlapOurs);
 
 // The exact separating-axis depth (all 15 axes, normalised): the first step of every signed distance.
 void BM_SeparatingAxisDepthOurs(benchmark::State& state) {
-  const Pairs& p = separated();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(cellmap::collision::separating_axis_depth(p.a[i], p.b[i]));
-    i = (i + 1) & 1023;
-  }
+  cycle(state, separated(), [](const Pairs& p, std::size_t i) {
+    return cellmap::collision::separating_axis_depth(p.a[i], p.b[i]);
+  });
 }
 BENCHMARK(BM_SeparatingAxisDepthOurs);
 
 // GJK alone (no separating-axis certificate) on the separated set.
 void BM_GjkDistanceOurs(benchmark::State& state) {
-  const Pairs& p = separated();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(cellmap::collision::gjk_distance(p.a[i], p.b[i]));
-    i = (i + 1) & 1023;
-  }
+  cycle(state, separated(),
+        [](const Pairs& p, std::size_t i) { return cellmap::collision::gjk_distance(p.a[i], p.b[i]); });
 }
 BENCHMARK(BM_GjkDistanceOurs);
 
 // Signed distance on the mixed set: overlapping pairs add the separating-axis depth and the witness search.
 void BM_SignedDistanceMixedOurs(benchmark::State& state) {
-  const Pairs& p = mixed();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(cellmap::collision::signed_distance(p.a[i], p.b[i]));
-    i = (i + 1) & 1023;
-  }
+  cycle(state, mixed(),
+        [](const Pairs& p, std::size_t i) { return cellmap::collision::signed_distance(p.a[i], p.b[i]); });
 }
 BENCHMARK(BM_SignedDistanceMixedOurs);
 
 void BM_OverlapFcl(benchmark::State& state) {
-  const Pairs& p = mixed();
   fcl::CollisionRequestd request;
   request.gjk_solver_type = fcl::GST_INDEP;
-  std::size_t i = 0;
-  for (auto _ : state) {
+  cycle(state, mixed(), [&](const Pairs& p, std::size_t i) {
     fcl::CollisionResultd result;
-    benchmark::DoNotOptimize(fcl::collide(&p.fa[i], p.Xa[i], &p.fb[i], p.Xb[i], request, result));
-    i = (i + 1) & 1023;
-  }
+    return fcl::collide(&p.fa[i], p.Xa[i], &p.fb[i], p.Xb[i], request, result);
+  });
 }
 BENCHMARK(BM_OverlapFcl);
 
@@ -225,17 +209,11 @@ BENCHMARK(BM_BoxTreeBuild)->ArgName("n_env")->Arg(1000)->Unit(benchmark::kMicros
 // FCL doing the same dense batch: one fcl::distance per pair (overlapping pairs return -1 there, cheaper).
 void BM_BatchFcl(benchmark::State& state) {
   const BatchScene scene = make_batch_scene(static_cast<int>(state.range(0)));
-  const auto pose = [](const Obb& o) {
-    fcl::Transform3d X = fcl::Transform3d::Identity();
-    X.linear() = o.rotation;
-    X.translation() = o.center;
-    return X;
-  };
   std::vector<fcl::Boxd> env_shapes;
   std::vector<fcl::Transform3d> env_poses;
   for (const Obb& o : scene.environment) {
     env_shapes.emplace_back(2 * o.half_extents);
-    env_poses.push_back(pose(o));
+    env_poses.push_back(fcl_pose(o));
   }
   fcl::DistanceRequestd request(true, false);
   request.gjk_solver_type = fcl::GST_INDEP;
@@ -244,7 +222,7 @@ void BM_BatchFcl(benchmark::State& state) {
     for (const auto& boxes : scene.robot) {
       for (const Obb& r : boxes) {
         const fcl::Boxd shape(2 * r.half_extents);
-        const fcl::Transform3d X = pose(r);
+        const fcl::Transform3d X = fcl_pose(r);
         for (std::size_t e = 0; e < env_shapes.size(); ++e) {
           fcl::DistanceResultd result;
           sum += fcl::distance(&shape, X, &env_shapes[e], env_poses[e], request, result);

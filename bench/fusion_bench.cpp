@@ -3,11 +3,9 @@
 // map per iteration. Prints the voxel-state agreement of the resulting maps before the timings.
 
 #include <benchmark/benchmark.h>
-#include <pcl/io/pcd_io.h>
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -15,6 +13,7 @@
 #include "cellmap/occupancy/occupancy_map.hpp"
 #include "cellmap/occupancy/tree_agreement.hpp"
 #include "occupancy/box_scene.hpp"
+#include "occupancy/grabber_scans.hpp"
 #include "ratio_report.hpp"
 
 namespace {
@@ -75,21 +74,12 @@ void BM_FusionOctomap(benchmark::State& state, const std::string& set, bool disc
   }
 }
 
+// Each real frame is a sweep of its own.
 std::vector<Sweep> grabber_frames() {
-  const std::filesystem::path dir = std::filesystem::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
-  std::vector<std::filesystem::path> files;
-  if (std::filesystem::is_directory(dir)) {
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-      if (entry.path().extension() == ".pcd") files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
   std::vector<Sweep> sweeps;
-  for (const auto& file : files) {
-    Sweep sweep;
-    sweep.scans.emplace_back();
-    if (pcl::io::loadPCDFile(file.string(), sweep.scans.back().points_C) != 0) return {};
-    sweeps.push_back(std::move(sweep));
+  for (cellmap::Scan& scan : cellmap::testing::grabber_scans()) {
+    sweeps.emplace_back();
+    sweeps.back().scans.push_back(std::move(scan));
   }
   return sweeps;
 }

@@ -1,37 +1,17 @@
 // Real frames: our sweep fusion against OctoMap's own insertPointCloud on the grabber sequence.
 #include <gtest/gtest.h>
-#include <pcl/io/pcd_io.h>
 
-#include <algorithm>
 #include <cmath>
-#include <filesystem>
 
 #include "cellmap/occupancy/occupancy_map.hpp"
 #include "cellmap/occupancy/tree_agreement.hpp"
+#include "occupancy/grabber_scans.hpp"
 
 namespace cellmap {
 namespace {
 
-std::vector<Scan> grabber_scans() {
-  const std::filesystem::path dir = std::filesystem::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
-  std::vector<std::filesystem::path> files;
-  if (std::filesystem::is_directory(dir)) {
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-      if (entry.path().extension() == ".pcd") files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  std::vector<Scan> scans;
-  for (const auto& file : files) {
-    Scan scan;  // camera frame = cell frame: identity pose, origin at the camera
-    if (pcl::io::loadPCDFile(file.string(), scan.points_C) != 0) ADD_FAILURE() << "cannot read " << file;
-    scans.push_back(std::move(scan));
-  }
-  return scans;
-}
-
 TEST(GrabberAgreementTest, SameOccupancyAsOctomapInsertPointCloud) {
-  const std::vector<Scan> scans = grabber_scans();
+  const std::vector<Scan> scans = testing::grabber_scans();
   if (scans.empty()) GTEST_SKIP() << CELLMAP_SHARED_DATA << "/pcl/grabber_sequence is absent";
   ASSERT_EQ(scans.size(), 3u);
 
