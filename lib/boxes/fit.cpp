@@ -4,14 +4,16 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "cellmap/common/error.hpp"
 
 namespace cellmap {
 namespace {
 
-// The box with axes R (columns, in the points' frame) that holds all points, as centre and half extents.
-Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
+// The extent of the points along the axes R (columns, in the points' frame), as low and high corners.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> extent_along(const Cloud& cloud, const std::vector<int>& indices,
+                                                         const Eigen::Matrix3d& R) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (int i : indices) {
@@ -19,6 +21,12 @@ Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Ma
     low = low.cwiseMin(p_B);
     high = high.cwiseMax(p_B);
   }
+  return {low, high};
+}
+
+// The box with axes R that holds all points, as centre and half extents.
+Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
+  const auto [low, high] = extent_along(cloud, indices, R);
   Box box;
   box.center = R * (0.5 * (low + high));
   box.half_extents = (0.5 * (high - low)).array() + kBoxFitSlack;
@@ -28,13 +36,7 @@ Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Ma
 }
 
 double volume_with_axes(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
-  for (int i : indices) {
-    const Eigen::Vector3d p_B = R.transpose() * cloud[i].getVector3fMap().cast<double>();
-    low = low.cwiseMin(p_B);
-    high = high.cwiseMax(p_B);
-  }
+  const auto [low, high] = extent_along(cloud, indices, R);
   return (high - low).prod();
 }
 

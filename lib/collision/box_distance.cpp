@@ -315,25 +315,26 @@ sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool f
     tb[j] = t.dot(R.col(j));
     gap[3 + j] = std::abs(tb[j]) - ha.dot(absR.col(j)) - hb[j];
   }
+  int k = 0;
+  for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
+  const auto face_result = [&](int face) {
+    SatResult best;
+    best.gap = gap[face];
+    if (face < 3) {
+      best.kind = SatResult::kFaceA;
+      best.i = face;
+      best.axis = Vector3d::Unit(face) * (t[face] >= 0.0 ? 1.0 : -1.0);
+    } else {
+      best.kind = SatResult::kFaceB;
+      best.j = face - 3;
+      best.axis = R.col(face - 3) * (tb[face - 3] >= 0.0 ? 1.0 : -1.0);
+    }
+    return best;
+  };
+  if (faces_only) return face_result(k);
   // Edge axes: L = e_i x R.col(j), |L|^2 = R(i1, j)^2 + R(i2, j)^2. Near-parallel edges (|L| < 1e-8) are
   // skipped: their facets of the Minkowski difference degenerate and the neighbouring axes bound the same
   // overlap.
-  if (faces_only) {
-    int k = 0;
-    for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
-    SatResult best;
-    best.gap = gap[k];
-    if (k < 3) {
-      best.kind = SatResult::kFaceA;
-      best.i = k;
-      best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
-    } else {
-      best.kind = SatResult::kFaceB;
-      best.j = k - 3;
-      best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
-    }
-    return best;
-  }
   double tl[9];
   double numerator[9];
   double length2[9];
@@ -351,8 +352,6 @@ sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool f
       numerator[m] = std::abs(tl[m]) - ra - rb;
     }
   }
-  int k = 0;
-  for (int m = 1; m < 6; ++m) k = gap[m] > gap[k] ? m : k;
   for (int m = 0; m < 9; ++m) {
     gap[6 + m] = -std::numeric_limits<double>::infinity();
     if (length2[m] < 1e-16) continue;
@@ -364,23 +363,14 @@ sat_relative(const Vector3d& ha, const Vector3d& hb, const Relative& rel, bool f
     gap[6 + m] = numerator[m] / std::sqrt(length2[m]);
     if (gap[6 + m] > best) k = 6 + m;
   }
+  if (k < 6) return face_result(k);
   SatResult best;
   best.gap = gap[k];
-  if (k < 3) {
-    best.kind = SatResult::kFaceA;
-    best.i = k;
-    best.axis = Vector3d::Unit(k) * (t[k] >= 0.0 ? 1.0 : -1.0);
-  } else if (k < 6) {
-    best.kind = SatResult::kFaceB;
-    best.j = k - 3;
-    best.axis = R.col(k - 3) * (tb[k - 3] >= 0.0 ? 1.0 : -1.0);
-  } else {
-    best.kind = SatResult::kEdges;
-    best.i = (k - 6) / 3;
-    best.j = (k - 6) % 3;
-    const Vector3d L = Vector3d::Unit(best.i).cross(R.col(best.j));
-    best.axis = L * ((tl[k - 6] >= 0.0 ? 1.0 : -1.0) / L.norm());
-  }
+  best.kind = SatResult::kEdges;
+  best.i = (k - 6) / 3;
+  best.j = (k - 6) % 3;
+  const Vector3d L = Vector3d::Unit(best.i).cross(R.col(best.j));
+  best.axis = L * ((tl[k - 6] >= 0.0 ? 1.0 : -1.0) / L.norm());
   return best;
 }
 
