@@ -99,7 +99,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   };
   Observations seen;
   std::uint64_t subscriber_last = 0;  // the newest version the current subscriber process printed
-  std::unique_ptr<test::ChildProcess> daemon = service.start_daemon(kKillDomain);
+  std::unique_ptr<test::ChildProcess> daemon = service.start_daemon(kKillDomain, true);
   std::unique_ptr<test::ChildProcess> subscriber = start_subscriber();
   const auto collect = [&] {
     for (const std::string& line : drain(*daemon)) seen.daemon_line(line);
@@ -126,7 +126,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
     if (victim != 0) expect_killed(*subscriber, "the subscriber");
     collect();
     std::this_thread::sleep_for(uniform(0.0, 1.0));
-    if (victim != 1) daemon = service.start_daemon(kKillDomain);
+    if (victim != 1) daemon = service.start_daemon(kKillDomain, true);
     if (victim != 0) {
       subscriber = start_subscriber();
       subscriber_last = 0;

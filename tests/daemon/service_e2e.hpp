@@ -31,10 +31,13 @@ class ServiceFixture {
                            << "\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n";
   }
 
-  [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain) const {
-    return std::make_unique<ChildProcess>(std::vector<std::string>{CELLMAPD, "--config", config_.string(),
-                                                                   "--domain", std::to_string(domain),
-                                                                   "--state-dir", state_dir().string()});
+  /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess.
+  [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain, bool log_on_stdout = false) const {
+    std::vector<std::string> argv{
+        CELLMAPD,      "--config",          config_.string(), "--domain", std::to_string(domain),
+        "--state-dir", state_dir().string()};
+    if (log_on_stdout) argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
+    return std::make_unique<ChildProcess>(argv);
   }
   [[nodiscard]] std::filesystem::path state_dir() const { return dir_.path() / "state"; }
   [[nodiscard]] const std::string& cell() const { return cell_; }
