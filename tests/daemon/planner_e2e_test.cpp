@@ -1,9 +1,10 @@
 // The example planner (examples/planner) as a real process against cellmapd on the simulated cell: a box
 // injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
-// by it; removing the box frees the path again.
+// by it; removing the box frees the path again; a clean daemon restart does not read as "all removed".
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "daemon/service_e2e.hpp"
 
@@ -69,6 +70,23 @@ TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const nlohmann::json free = next_state(planner);
   EXPECT_EQ(free.value("state", ""), "free") << free.dump();
   EXPECT_EQ(free.value("removed", 0), 1) << free.dump();
+
+  // A clean stop and restart of the daemon (its writers deleted) must not look like "all boxes removed":
+  // the local copy keeps every box, and the restarted daemon goes on above the last version.
+  const Environment last = test::settled(observer, 3s);
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+  std::this_thread::sleep_for(2s);  // past the 1 s lease: the writers are gone for the readers too
+  EXPECT_EQ(*observer.environment(), last);
+  daemon = service.start_daemon(kPlannerDomain);
+  const std::string again = test::inject(
+      kPlannerDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kPatience)) << "nothing after the restart";
+  const nlohmann::json blocked_again = next_state(planner);
+  EXPECT_EQ(blocked_again.value("state", ""), "blocked") << blocked_again.dump();
+  EXPECT_EQ(blocked_again.value("removed", -1), 0) << blocked_again.dump();
+  EXPECT_GT(blocked_again.value("box", std::uint64_t{0}), box.id) << "a box id was reused";
+  EXPECT_EQ(observer.environment()->boxes().size(), last.boxes().size() + 1);
 
   planner.signal(SIGTERM);
   EXPECT_EQ(planner.wait(), 0);
