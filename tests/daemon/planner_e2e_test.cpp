@@ -95,8 +95,12 @@ TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
 }
 
 TEST(PlannerE2eTest, BadPathIsRefusedWithOneLine) {
-  test::ChildProcess planner({CELLMAP_PLANNER, "--control-points", "1,2;3,4,5"});
-  EXPECT_EQ(planner.read_line(10s), std::nullopt);  // nothing on stdout; the reason goes to stderr
+  // stderr through the pipe: the reason is the only output.
+  test::ChildProcess planner(
+      {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1", CELLMAP_PLANNER, "--control-points", "1,2;3,4,5"});
+  EXPECT_EQ(planner.read_line(10s).value_or(""),
+            "cellmap_example_planner: --control-points: '1,2' is not x,y,z");
+  EXPECT_EQ(planner.read_line(10s), std::nullopt);
   const int status = planner.wait();
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 1);
