@@ -1,0 +1,110 @@
+// The example planner (examples/planner) as a real process against cellmapd on the simulated cell: a box
+// injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
+// by it; removing the box frees the path again; a clean daemon restart does not read as "all removed".
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "daemon/service_e2e.hpp"
+
+namespace cellmap {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr int kPlannerDomain = 170;
+
+// The next JSON line the planner prints, or a failure.
+nlohmann::json next_state(test::ChildProcess& planner) {
+  const std::optional<std::string> line = planner.read_line(test::kPatience);
+  if (!line) {
+    ADD_FAILURE() << "the planner printed nothing";
+    return nlohmann::json::object();
+  }
+  return nlohmann::json::parse(*line);
+}
+
+TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
+  test::use_loopback();
+  test::ServiceFixture service("planner");
+  auto daemon = service.start_daemon(kPlannerDomain);
+  const dds::Participant participant(kPlannerDomain);
+  test::DeltaRecorder recorder;
+  transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
+  // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
+  test::ChildProcess planner(
+      {CELLMAP_PLANNER, "--domain", std::to_string(kPlannerDomain), "--cell", "planner", "--json"});
+
+  ASSERT_TRUE(observer.wait_for_version(1, test::kPatience)) << "no first version from the daemon";
+  const nlohmann::json first = next_state(planner);
+  EXPECT_EQ(first.value("state", ""), "free") << first.dump();
+  const Environment before = test::settled(observer, 5s);
+
+  const std::string name = test::inject(
+      kPlannerDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  ASSERT_FALSE(name.empty());
+  ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kPatience)) << "the box never arrived";
+  const EnvironmentDelta added = recorder.last();
+  ASSERT_EQ(added.added.size(), 1u);
+  EXPECT_TRUE(added.modified.empty());
+  EXPECT_TRUE(added.removed.empty());
+  const Box box = added.added[0];
+  EXPECT_TRUE(box.contains(Eigen::Vector3d(2.12, 0.45, 0.9)));
+
+  const nlohmann::json blocked = next_state(planner);
+  EXPECT_EQ(blocked.value("state", ""), "blocked") << blocked.dump();
+  EXPECT_EQ(blocked.value("box", std::uint64_t{0}), box.id) << blocked.dump();
+  EXPECT_EQ(blocked.value("version", std::uint64_t{0}), added.to_version) << blocked.dump();
+  EXPECT_EQ(blocked.value("added", 0), 1) << blocked.dump();
+  // The path first comes within the margin (0.02) of the box's side at y = 0.45 − 0.1 − 0.05 − margin.
+  ASSERT_TRUE(blocked.contains("position"));
+  EXPECT_NEAR(blocked["position"][0].get<double>(), 2.12, 1e-9);
+  EXPECT_GT(blocked["position"][1].get<double>(), box.center.y() - box.half_extents.y() - 0.1);
+  EXPECT_LT(blocked["position"][1].get<double>(), box.center.y());
+  EXPECT_LT(blocked.value("distance", 1.0), 0.02);
+
+  const Environment with_box = test::settled(observer, 3s);
+  test::inject(kPlannerDomain, {"remove", "--name", name});
+  ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
+  EXPECT_EQ(recorder.last().removed, std::vector<std::uint64_t>{box.id});
+  const nlohmann::json free = next_state(planner);
+  EXPECT_EQ(free.value("state", ""), "free") << free.dump();
+  EXPECT_EQ(free.value("removed", 0), 1) << free.dump();
+
+  // A clean stop and restart of the daemon (its writers deleted) must not look like "all boxes removed":
+  // the local copy keeps every box, and the restarted daemon goes on above the last version.
+  const Environment last = test::settled(observer, 3s);
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+  std::this_thread::sleep_for(2s);  // past the 1 s lease: the writers are gone for the readers too
+  EXPECT_EQ(*observer.environment(), last);
+  daemon = service.start_daemon(kPlannerDomain);
+  const std::string again = test::inject(
+      kPlannerDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kPatience)) << "nothing after the restart";
+  const nlohmann::json blocked_again = next_state(planner);
+  EXPECT_EQ(blocked_again.value("state", ""), "blocked") << blocked_again.dump();
+  EXPECT_EQ(blocked_again.value("removed", -1), 0) << blocked_again.dump();
+  EXPECT_GT(blocked_again.value("box", std::uint64_t{0}), box.id) << "a box id was reused";
+  EXPECT_EQ(observer.environment()->boxes().size(), last.boxes().size() + 1);
+
+  planner.signal(SIGTERM);
+  EXPECT_EQ(planner.wait(), 0);
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+}
+
+TEST(PlannerE2eTest, BadPathIsRefusedWithOneLine) {
+  // stderr through the pipe: the reason is the only output.
+  test::ChildProcess planner(
+      {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1", CELLMAP_PLANNER, "--control-points", "1,2;3,4,5"});
+  EXPECT_EQ(planner.read_line(10s).value_or(""),
+            "cellmap_example_planner: --control-points: '1,2' is not x,y,z");
+  EXPECT_EQ(planner.read_line(10s), std::nullopt);
+  const int status = planner.wait();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
+}  // namespace
+}  // namespace cellmap

@@ -1,0 +1,90 @@
+#pragma once
+// Helpers for end-to-end tests of the service: cellmapd on the simulated cell as a real process (exact
+// depths, a private state directory), `cellmap inject` as a process, and in-process planner subscribers.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "cellmap/transport/environment_subscriber.hpp"
+#include "support/test_support.hpp"
+#include "transport/child_process.hpp"
+#include "transport/loopback.hpp"
+
+namespace cellmap::test {
+
+inline constexpr std::chrono::seconds kPatience{90};
+
+/// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:
+/// these tests are about versions and deltas; noise robustness is tested where the noise is modelled.
+class ServiceFixture {
+ public:
+  explicit ServiceFixture(std::string cell) : cell_(std::move(cell)) {
+    config_ = dir_.path() / "cellmapd.yaml";
+    std::ofstream(config_) << "cell: " << cell_
+                           << "\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n";
+  }
+
+  /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess.
+  [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain, bool log_on_stdout = false) const {
+    std::vector<std::string> argv{
+        CELLMAPD,      "--config",          config_.string(), "--domain", std::to_string(domain),
+        "--state-dir", state_dir().string()};
+    if (log_on_stdout) argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
+    return std::make_unique<ChildProcess>(argv);
+  }
+  [[nodiscard]] std::filesystem::path state_dir() const { return dir_.path() / "state"; }
+  [[nodiscard]] const std::string& cell() const { return cell_; }
+
+ private:
+  std::string cell_;
+  TempDir dir_;
+  std::filesystem::path config_;
+};
+
+/// `cellmap inject --domain N ARGS...`; returns its first output line (add-box prints the new name).
+inline std::string inject(int domain, const std::vector<std::string>& args) {
+  std::vector<std::string> argv{CELLMAP_TOOL, "inject", "--domain", std::to_string(domain), "--wait", "60"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ChildProcess tool(argv);
+  const std::string out = tool.read_line(kPatience).value_or("");
+  EXPECT_EQ(tool.wait(), 0) << "cellmap inject failed";
+  return out;
+}
+
+/// Waits until no new version came for `quiet` (the map has settled); returns the environment then.
+inline Environment settled(const transport::EnvironmentSubscriber& planner, std::chrono::seconds quiet) {
+  std::uint64_t version = planner.environment()->version();
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (!planner.wait_for_version(version + 1, quiet)) return *planner.environment();
+    version = planner.environment()->version();
+  }
+  ADD_FAILURE() << "the environment never settled";
+  return *planner.environment();
+}
+
+/// An on_change callback that records every delta the subscriber applied.
+class DeltaRecorder {
+ public:
+  void operator()(const Environment&, const EnvironmentDelta& delta) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    deltas_.push_back(delta);
+  }
+  [[nodiscard]] EnvironmentDelta last() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return deltas_.back();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<EnvironmentDelta> deltas_;
+};
+
+}  // namespace cellmap::test
