@@ -160,8 +160,12 @@ class Daemon {
   // Sweeps come as the camera's frames arrive and get their poses; the camera's own back-off paces retries.
   void acquire_camera() {
     const SourceStatus opened = camera_->open();
-    spdlog::info("camera '{}': {}", camera_->name(), camera_->sensor_state());
     std::string reported = camera_->sensor_state();
+    if (opened.state == SourceState::kConnected) {
+      spdlog::info("camera '{}': {}", camera_->name(), reported);
+    } else {
+      spdlog::warn("camera '{}': {}", camera_->name(), reported);
+    }
     set_sensor_state(reported);
     if (opened.state == SourceState::kConnected && camera_->poses_received() > 0)
       spdlog::info("camera '{}': {} recorded robot poses", camera_->name(), camera_->poses_received());
