@@ -170,5 +170,53 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
 }
 
+// The real OpenNI2 driver path: Debian's Dummy device streams 320x240 depth at 30 fps (row 0 at 2 m, a disc
+// near 1 m). Poses come over cellmap/robot_state from this test, as a robot controller would send them.
+TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
+  const std::string yaml =
+      "cell: wrist-cell\nsweep_period: 0.5\nstatus_period: 0.2\nsource:\n  kind: openni2\n  sensor: wrist\n"
+      "  pose_tolerance: 0.05\n  pose_wait: 0.3\n"
+      "  openni2: {uri: Dummy, width: 320, height: 240, intrinsics: {fx: 285, fy: 285, cx: 159.5, cy: "
+      "119.5}}\n";
+  const dds::Participant participant(kRobotPoseDomain);
+  transport::StatusReader reader(participant);
+  auto daemon = start_daemon(yaml, kRobotPoseDomain);
+
+  // No robot poses yet: frames stream but are dropped, none is fused.
+  const auto unposed = wait_for_status(reader, "wrist-cell",
+                                       [](const transport::CellStatus& s) { return s.dropped_frames >= 10; });
+  ASSERT_TRUE(unposed.has_value()) << "frames without a pose were not counted as dropped";
+  EXPECT_EQ(unposed->sweeps, 0u) << "a frame without a pose was fused";
+  ASSERT_EQ(unposed->sensors.size(), 1u);
+  EXPECT_EQ(unposed->sensors[0].state, "streaming");
+
+  // A robot controller at 100 Hz: the tool at rest, stamped on the same clock as the frames.
+  transport::RobotStateWriter writer(participant);
+  std::atomic<bool> stop{false};
+  std::thread controller([&] {
+    transport::RobotState state;
+    state.cell = "wrist-cell";
+    state.X_CE.translation() = Eigen::Vector3d(1.0, 2.0, 1.5);
+    while (!stop) {
+      state.stamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                           .count();
+      writer.write(state);
+      std::this_thread::sleep_for(10ms);
+    }
+  });
+  const auto posed =
+      wait_for_status(reader, "wrist-cell", [](const transport::CellStatus& s) { return s.sweeps >= 3; });
+  stop = true;
+  controller.join();
+  ASSERT_TRUE(posed.has_value()) << "no sweep was fused with poses from cellmap/robot_state";
+  EXPECT_EQ(posed->state, "running");
+  EXPECT_EQ(posed->sensors[0].state, "streaming");
+
+  daemon->signal(SIGTERM);
+  const int status = daemon->wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
+}
+
 }  // namespace
 }  // namespace cellmap
