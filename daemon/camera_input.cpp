@@ -8,10 +8,6 @@
 namespace cellmap::daemon {
 namespace {
 
-double steady_now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 // Live: 16 s of a 250 Hz controller, far more than a frame waits. A replay loads all its poses at once.
 std::size_t pose_capacity(const SourceConfig& config) {
   return std::holds_alternative<ReplayConfig>(config.camera.source) ? 1'000'000 : 4096;
@@ -49,7 +45,7 @@ std::vector<Sweep> CameraInput::step(std::chrono::milliseconds timeout) {
   }
   const auto start = std::chrono::steady_clock::now();
   std::optional<Frame> frame = source_->next(timeout);
-  const double now = steady_now();
+  const double now = steady_seconds();
   if (frame) assembler_.add(std::move(*frame), now);
   std::vector<Sweep> sweeps = assembler_.poll(poses_, now);
   const SourceState state = source_->status().state;
