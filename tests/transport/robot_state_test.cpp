@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 
 #include "cellmap/common/error.hpp"
 #include "loopback.hpp"
@@ -82,6 +83,46 @@ TEST(RobotStateTest, MalformedPosesAreRejectedNotFused) {
   RobotState nan = state_at("cell-a", 1, 0, 0);
   nan.X_CE.translation().x() = std::nan("");
   EXPECT_NE(test::error_of([&] { writer.write(nan); }).find("not finite"), std::string::npos);
+}
+
+TEST(RobotStateTest, RobotPoseCommandPublishesAStandingToolPose) {
+  test::use_loopback();
+  dds::Participant daemon(185);
+  RobotStateReader reader(daemon, "desk");
+  const std::string command =
+      std::string(CELLMAP_TOOL) +
+      " robot-pose --domain 185 --cell desk --pose 1,2,1.5,0.5,-0.5,0.5,-0.5 --rate 50"
+      " --duration 0.5 2>&1";
+  const auto before_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                             std::chrono::system_clock::now().time_since_epoch())
+                             .count();
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[256];
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  ASSERT_EQ(::pclose(pipe), 0) << output;
+  const std::vector<RobotState> got = take_until(reader, 25);
+  ASSERT_EQ(output, "sent " + std::to_string(got.size()) + " poses\n");
+  ASSERT_GE(got.size(), 20u);  // 50 Hz for 0.5 s
+  ASSERT_LE(got.size(), 26u);
+  Eigen::Isometry3d X_CE = Eigen::Isometry3d::Identity();
+  X_CE.translation() = Eigen::Vector3d(1, 2, 1.5);
+  X_CE.linear() = Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5).toRotationMatrix();
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_TRUE(got[i].X_CE.isApprox(X_CE, 1e-12));
+    EXPECT_GE(got[i].stamp_ns, before_ns);  // stamped now, on the frames' clock
+    if (i > 0) {
+      EXPECT_GT(got[i].stamp_ns, got[i - 1].stamp_ns);
+    }
+  }
+  // A bad pose is one line naming the option.
+  pipe = ::popen((std::string(CELLMAP_TOOL) + " robot-pose --cell desk --pose 1,2 2>&1").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  output.clear();
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  EXPECT_NE(::pclose(pipe), 0);
+  EXPECT_EQ(output.rfind("cellmap: --pose", 0), 0u) << output;
 }
 
 }  // namespace
