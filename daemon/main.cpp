@@ -141,6 +141,10 @@ class Daemon {
     try {
       const DaemonConfig fresh = DaemonConfig::load(options_.config_file);
       spdlog::set_level(spdlog::level::from_str(fresh.log_level));
+      if (camera_) {  // a camera's sweep grouping is fixed when it starts
+        spdlog::info("SIGHUP: reloaded log_level={} (other keys apply at restart)", fresh.log_level);
+        return;
+      }
       sweep_period_ = fresh.sweep_period;
       spdlog::info("SIGHUP: reloaded log_level={} sweep_period={} s (other keys apply at restart)",
                    fresh.log_level, fresh.sweep_period);
