@@ -30,6 +30,39 @@ YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay) {
   return merged;
 }
 
+// The `source` section. Every camera kind's settings are read (so a misspelt key is found whichever kind is
+// chosen); the chosen kind's become the camera.
+SourceConfig read_source(YamlMap section, double sweep_period, const std::filesystem::path& base_dir) {
+  SourceConfig c;
+  c.kind = section.get<std::string>("kind", c.kind);
+  static const std::set<std::string> kinds{"sim", "replay", "openni2", "v4l2"};
+  if (kinds.count(c.kind) == 0) section.fail("kind", "must be one of sim, replay, openni2, v4l2");
+  const std::string scene = section.get<std::string>("scene", "");
+  if (!scene.empty()) c.scene = base_dir / scene;  // an absolute scene path replaces base_dir
+  c.sensor = section.get<std::string>("sensor", c.sensor);
+  if (c.sensor.empty()) section.fail("sensor", "must not be empty");
+  c.noise = section.get<bool>("noise", c.noise);
+
+  c.camera.name = c.sensor;
+  c.camera.X_ES = read_pose_yaml(section.child("X_ES"));
+  c.camera.pose_tolerance = section.number("pose_tolerance", c.camera.pose_tolerance, 1e-6, 10.0);
+  c.grouping.period = sweep_period;
+  c.grouping.max_frames = static_cast<std::size_t>(section.integer("sweep_frames", 0, 0, 100000));
+  c.grouping.pose_wait = section.number("pose_wait", c.grouping.pose_wait, 0.0, 60.0);
+  const OpenNI2Config openni2 = read_openni2_config(section.child("openni2"), c.sensor);
+  const V4l2Config v4l2 = read_v4l2_config(section.child("v4l2"), c.sensor);
+  ReplayConfig replay = read_replay_config(section.child("replay"), c.sensor);
+  if (c.kind == "openni2") c.camera.source = openni2;
+  if (c.kind == "v4l2") c.camera.source = v4l2;
+  if (c.kind == "replay") {
+    if (replay.directory.empty()) section.child("replay").fail("directory", "is required for kind replay");
+    replay.directory = (base_dir / replay.directory).string();  // an absolute directory replaces base_dir
+    c.camera.source = replay;
+  }
+  section.expect_all_read();
+  return c;
+}
+
 }  // namespace
 
 DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
@@ -54,16 +87,7 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   if (levels.count(c.log_level) == 0)
     root.fail("log_level", "must be one of trace, debug, info, warn, error");
 
-  YamlMap source_section = root.child("source");
-  c.source.kind = source_section.get<std::string>("kind", c.source.kind);
-  if (c.source.kind != "sim")
-    source_section.fail("kind", "must be sim (the only source cellmapd wires so far)");
-  const std::string scene = source_section.get<std::string>("scene", "");
-  if (!scene.empty()) c.source.scene = base_dir / scene;  // an absolute scene path replaces base_dir
-  c.source.sensor = source_section.get<std::string>("sensor", c.source.sensor);
-  c.source.noise = source_section.get<bool>("noise", c.source.noise);
-  source_section.expect_all_read();
-
+  c.source = read_source(root.child("source"), c.sweep_period, base_dir);
   c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
   c.change = ChangeConfig::from_yaml(root.child("change"));
   c.segment = segment_config_from_yaml(root.child("segment"));

@@ -10,24 +10,38 @@
 #include "cellmap/environment/reconcile.hpp"
 #include "cellmap/occupancy/occupancy_config.hpp"
 #include "cellmap/segment/pipeline.hpp"
+#include "cellmap/sensor/sensor_config.hpp"
+#include "cellmap/sweep/sweep_assembler.hpp"
 
 namespace cellmap::daemon {
 
-/// Where sweeps come from. Only the simulated cell needs no hardware; it is the default.
+/// Where sweeps come from: the simulated cell (the default: no hardware needed) or one depth camera on the
+/// robot (an OpenNI2 or V4L2 device, or a replay directory).
 struct SourceConfig final {
-  std::string kind = "sim";  ///< `source.kind`: sim
-  /// `source.scene`: scene YAML (relative paths are relative to the config file); empty = the embedded
+  std::string kind = "sim";  ///< `source.kind`: sim | replay | openni2 | v4l2
+  /// `source.scene` (sim): scene YAML (relative paths are relative to the config file); empty = the embedded
   /// default cell (config/cell.yaml).
   std::filesystem::path scene;
-  std::string sensor = "kinect";  ///< `source.sensor`: name of the scene's sensor to sweep with
-  bool noise = true;              ///< `source.noise`: false = exact depths (tests)
+  /// `source.sensor`: sim: the scene's sensor that sweeps; cameras: the name frames, logs and the status
+  /// topic give the camera.
+  std::string sensor = "kinect";
+  bool noise = true;  ///< `source.noise` (sim): false = exact depths (tests)
+  /// Cameras: `source.X_ES`, `source.pose_tolerance` and the settings of the chosen kind (`source.openni2`,
+  /// `source.v4l2` or `source.replay`; a relative replay directory is relative to the config file).
+  SensorConfig camera;
+  /// Cameras: period = `sweep_period` (the frame time one sweep spans), max_frames = `source.sweep_frames`,
+  /// pose_wait = `source.pose_wait`.
+  SweepGrouping grouping;
+
+  [[nodiscard]] bool is_camera() const { return kind != "sim"; }
 };
 
 /// The text of config/cellmapd.yaml, embedded at build time: the built-in defaults.
 [[nodiscard]] const char* default_config_yaml();
 
-/// Everything cellmapd reads at start. SIGHUP re-reads the file and applies `log_level` and `sweep_period`;
-/// the other keys need a restart (they shape the map and the published versions).
+/// Everything cellmapd reads at start. SIGHUP re-reads the file and applies `log_level` and `sweep_period`
+/// (sim only: a camera's sweep grouping is fixed at start); the other keys need a restart (they shape the
+/// map and the published versions).
 struct DaemonConfig final {
   std::string cell = "cell-1";                ///< `cell`: the cell id the environment is published under
   int domain = 0;                             ///< `domain`: DDS domain id (--domain overrides)

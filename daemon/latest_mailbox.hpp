@@ -32,7 +32,16 @@ class LatestMailbox {
     ready_.wait_for(lock, timeout, [&] { return slot_.has_value() || closed_; });
     std::optional<T> out = std::move(slot_);
     slot_.reset();
+    lock.unlock();
+    taken_.notify_all();
     return out;
+  }
+
+  /// Waits up to `timeout` until the slot is empty (the consumer took the last item); true when it is. Lets
+  /// a producer that must not lose items (a replay played as fast as processed) wait instead of replacing.
+  [[nodiscard]] bool wait_taken(std::chrono::milliseconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return taken_.wait_for(lock, timeout, [&] { return !slot_.has_value(); });
   }
 
   /// Wakes every waiting take(); later takes return at once with what is left.
@@ -53,6 +62,7 @@ class LatestMailbox {
  private:
   mutable std::mutex mutex_;
   std::condition_variable ready_;
+  std::condition_variable taken_;
   std::optional<T> slot_;
   std::uint64_t dropped_ = 0;
   bool closed_ = false;

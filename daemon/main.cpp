@@ -1,7 +1,8 @@
 // cellmapd: keeps one cell's collision environment up to date and publishes its versions over DDS.
 //
-// Threads: acquisition (sweeps from the source → a latest-wins mailbox), processing (fusion → change →
-// re-segmentation → version → persist → publish, plus status), and main (signals).
+// Threads: acquisition (sweeps from the source — the simulated cell, or a camera's posed frames grouped into
+// sweeps — → a latest-wins mailbox), processing (fusion → change → re-segmentation → version → persist →
+// publish, plus status), and main (signals).
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -12,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "camera_input.hpp"
 #include "cell_pipeline.hpp"
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
@@ -62,8 +64,6 @@ class Daemon {
         store_(config_.state_dir, config_.cell),
         participant_(static_cast<std::uint32_t>(config_.domain)),
         publisher_(participant_, config_.cell, config_.delta_depth),
-        edits_(participant_),
-        cell_(config_.source),
         current_(config_.cell),
         sweep_period_(config_.sweep_period) {
     const RecoveredState& recovered = store_.recovered();
@@ -87,10 +87,22 @@ class Daemon {
     }
     current_ = recovered.environment;
     if (current_.version() > 0) resume();
-    spdlog::info(
-        "cell '{}' on DDS domain {}, state in {}, source sim (sensor '{}', {} obstacles), version {}",
-        config_.cell, config_.domain, store_.directory().string(), cell_.sensor_name(),
-        cell_.scene().obstacles.size(), current_.version());
+    current_version_ = current_.version();
+    if (config_.source.is_camera()) {
+      camera_.emplace(config_.source, participant_, config_.cell);
+      const auto* replay = std::get_if<ReplayConfig>(&config_.source.camera.source);
+      lossless_ = replay && replay->playback == ReplayConfig::Playback::kFastest;
+      spdlog::info("cell '{}' on DDS domain {}, state in {}, source {} (camera '{}'), version {}",
+                   config_.cell, config_.domain, store_.directory().string(), config_.source.kind,
+                   camera_->name(), current_.version());
+    } else {
+      sim_.emplace(config_.source);
+      edits_.emplace(participant_);
+      spdlog::info(
+          "cell '{}' on DDS domain {}, state in {}, source sim (sensor '{}', {} obstacles), version {}",
+          config_.cell, config_.domain, store_.directory().string(), sim_->sensor_name(),
+          sim_->scene().obstacles.size(), current_.version());
+    }
   }
 
   void run(const Signals& signals) {
@@ -129,6 +141,10 @@ class Daemon {
     try {
       const DaemonConfig fresh = DaemonConfig::load(options_.config_file);
       spdlog::set_level(spdlog::level::from_str(fresh.log_level));
+      if (camera_) {  // a camera's sweep grouping is fixed when it starts
+        spdlog::info("SIGHUP: reloaded log_level={} (other keys apply at restart)", fresh.log_level);
+        return;
+      }
       sweep_period_ = fresh.sweep_period;
       spdlog::info("SIGHUP: reloaded log_level={} sweep_period={} s (other keys apply at restart)",
                    fresh.log_level, fresh.sweep_period);
@@ -138,19 +154,80 @@ class Daemon {
   }
 
   void acquire() {
+    if (camera_) {
+      acquire_camera();
+    } else {
+      acquire_sim();
+    }
+  }
+
+  // Sweeps come as the camera's frames arrive and get their poses; the camera's own back-off paces retries.
+  void acquire_camera() {
+    const SourceStatus opened = camera_->open();
+    std::string reported = camera_->sensor_state();
+    if (opened.state == SourceState::kConnected) {
+      spdlog::info("camera '{}': {}", camera_->name(), reported);
+    } else {
+      spdlog::warn("camera '{}': {}", camera_->name(), reported);
+    }
+    set_sensor_state(reported);
+    if (opened.state == SourceState::kConnected && camera_->poses_received() > 0)
+      spdlog::info("camera '{}': {} recorded robot poses", camera_->name(), camera_->poses_received());
+    std::uint64_t dropped_reported = 0;
+    auto next_drop_log = Clock::now();
+    while (!stop_) {
+      std::vector<Sweep> sweeps;
+      try {
+        sweeps = camera_->step(std::chrono::milliseconds(100));
+      } catch (const Error& e) {
+        spdlog::error("camera '{}': {}", camera_->name(), e.what());
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      for (Sweep& sweep : sweeps) {
+        // A replay played as fast as processed must lose no sweep: wait for the processing thread.
+        while (lossless_ && !stop_ && !mailbox_.wait_taken(std::chrono::milliseconds(100))) {
+        }
+        mailbox_.put(std::move(sweep));
+        if (options_.max_sweeps > 0 && ++acquired_ >= options_.max_sweeps) return;
+      }
+      camera_dropped_ = camera_->dropped_frames();
+      const std::string state = camera_->sensor_state();
+      if (state != reported) {
+        if (state == "streaming") {
+          spdlog::info("camera '{}': streaming", camera_->name());
+        } else {
+          spdlog::warn("camera '{}': {}; keeping version {}", camera_->name(), state,
+                       current_version_.load());
+        }
+        set_sensor_state(state);
+        reported = state;
+      }
+      if (camera_->dropped_frames() > dropped_reported && Clock::now() >= next_drop_log) {
+        spdlog::warn(
+            "camera '{}': {} frames dropped without a robot pose within {} s ({} poses received, {} "
+            "malformed)",
+            camera_->name(), camera_->dropped_frames(), config_.source.camera.pose_tolerance,
+            camera_->poses_received(), camera_->poses_rejected());
+        dropped_reported = camera_->dropped_frames();
+        next_drop_log = Clock::now() + std::chrono::seconds(1);
+      }
+    }
+  }
+
+  void acquire_sim() {
     double stamp = 0.0;
     while (!stop_) {
       const auto start = Clock::now();
       try {
-        for (const transport::SceneEdit& edit : edits_.take()) {
+        for (const transport::SceneEdit& edit : edits_->take()) {
           if (!edit.cell.empty() && edit.cell != config_.cell) continue;
           try {
-            spdlog::info("scene edit applied: {}", cell_.apply(edit));
+            spdlog::info("scene edit applied: {}", sim_->apply(edit));
           } catch (const Error& e) {
             spdlog::warn("scene edit rejected: {}", e.what());
           }
         }
-        Sweep sweep = cell_.next_sweep(stamp);
+        Sweep sweep = sim_->next_sweep(stamp);
         stamp += sweep_period_;
         mailbox_.put(std::move(sweep));
         set_sensor_state("streaming");
@@ -211,19 +288,21 @@ class Daemon {
     store_.save(next, pipeline_->map_state());
     publisher_.publish(next, delta);
     current_ = next;
+    current_version_ = next.version();
     spdlog::info("version {}: {} added, {} modified, {} removed, {} boxes", next.version(),
                  change.added.size(), change.modified.size(), change.removed.size(), next.boxes().size());
   }
 
+  // Degraded while the sensor is not streaming, whatever the last sweep did: no version comes from it.
   std::string state() {
     std::lock_guard<std::mutex> lock(health_.mutex);
+    if (health_.sensor_state != "streaming" && health_.sensor_state != "starting") return "degraded";
     return health_.state;
   }
 
   void set_sensor_state(const std::string& sensor_state) {
     std::lock_guard<std::mutex> lock(health_.mutex);
     health_.sensor_state = sensor_state;
-    if (sensor_state != "streaming") health_.state = "degraded";
   }
 
   void publish_status(const std::string& state) {
@@ -232,11 +311,12 @@ class Daemon {
       std::lock_guard<std::mutex> lock(health_.mutex);
       status.cell = config_.cell;
       status.state = state;
-      status.sensors = {{cell_.sensor_name(), health_.sensor_state}};
+      status.sensors = {{camera_ ? camera_->name() : sim_->sensor_name(), health_.sensor_state}};
       status.last_sweep_ns = health_.last_sweep_ns;
       status.sweeps = health_.sweeps;
     }
-    status.dropped_frames = mailbox_.dropped();
+    // Sweeps the processing thread had no time for, plus camera frames that had no robot pose.
+    status.dropped_frames = mailbox_.dropped() + (camera_ ? camera_dropped_.load() : 0);
     status.boxes = current_.boxes().size();
     status.version = current_.version();
     try {
@@ -251,8 +331,10 @@ class Daemon {
   VersionStore store_;
   dds::Participant participant_;
   transport::EnvironmentPublisher publisher_;
-  transport::SceneEditReader edits_;
-  SimulatedCell cell_;
+  std::optional<transport::SceneEditReader> edits_;  // sim only
+  std::optional<SimulatedCell> sim_;                 // sim only
+  std::optional<CameraInput> camera_;                // cameras only
+  bool lossless_ = false;  // a replay played as fast as processed: no sweep is replaced in the mailbox
   std::optional<CellPipeline> pipeline_;
   Environment current_;
   LatestMailbox<Sweep> mailbox_;
@@ -260,6 +342,8 @@ class Daemon {
   std::atomic<bool> stop_{false};
   std::atomic<double> sweep_period_;
   std::uint64_t acquired_ = 0;
+  std::atomic<std::uint64_t> current_version_{0};  // for the acquisition thread's log lines
+  std::atomic<std::uint64_t> camera_dropped_{0};   // the camera's frames dropped without a pose
 };
 
 }  // namespace

@@ -14,10 +14,6 @@
 namespace cellmap {
 namespace {
 
-double steady_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 // OpenNI2's extended error text, on one line ("\tDeviceOpen using default: no devices found\n").
 std::string openni_error() {
   std::string text = openni::OpenNI::getExtendedError();
@@ -216,13 +212,7 @@ std::optional<Frame> OpenNI2Source::next(std::chrono::milliseconds timeout) {
   const SourceState state = reconnector_.state();
   if (ended_ || state == SourceState::kError || state == SourceState::kClosed) return std::nullopt;
   if (state == SourceState::kDisconnected) {
-    const double now = steady_seconds();
-    if (reconnector_.retry_due(now)) {
-      connect(now);
-    } else {
-      const double wait = std::min(reconnector_.next_attempt() - now, timeout.count() * 1e-3);
-      std::this_thread::sleep_for(std::chrono::duration<double>(std::max(wait, 0.0)));
-    }
+    reconnector_.retry_or_wait(timeout, [this](double now) { connect(now); });
     return std::nullopt;
   }
   openni::VideoStream* streams[] = {&device_->stream};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <sstream>
+#include <thread>
 
 #include "cellmap/common/error.hpp"
 
@@ -57,6 +58,17 @@ bool Reconnector::check(double now) {
 
 bool Reconnector::retry_due(double now) const {
   return state_ == SourceState::kDisconnected && now >= next_attempt_;
+}
+
+void Reconnector::retry_or_wait(std::chrono::milliseconds timeout,
+                                const std::function<void(double now)>& connect) {
+  const double now = steady_seconds();
+  if (retry_due(now)) {
+    connect(now);
+    return;
+  }
+  const double wait = std::min(next_attempt_ - now, static_cast<double>(timeout.count()) * 1e-3);
+  std::this_thread::sleep_for(std::chrono::duration<double>(std::max(wait, 0.0)));
 }
 
 }  // namespace cellmap

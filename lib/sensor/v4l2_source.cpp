@@ -14,16 +14,11 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <thread>
 
 #include "cellmap/common/error.hpp"
 
 namespace cellmap {
 namespace {
-
-double steady_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 double monotonic_seconds() {
   timespec now{};
@@ -312,13 +307,7 @@ std::optional<Frame> V4l2Source::next(std::chrono::milliseconds timeout) {
   const SourceState state = reconnector_.state();
   if (state == SourceState::kError || state == SourceState::kClosed) return std::nullopt;
   if (state == SourceState::kDisconnected) {
-    const double now = steady_seconds();
-    if (reconnector_.retry_due(now)) {
-      connect(now);
-    } else {
-      const double wait = std::min(reconnector_.next_attempt() - now, timeout.count() * 1e-3);
-      std::this_thread::sleep_for(std::chrono::duration<double>(std::max(wait, 0.0)));
-    }
+    reconnector_.retry_or_wait(timeout, [this](double now) { connect(now); });
     return std::nullopt;
   }
   pollfd ready{stream_->fd, POLLIN, 0};

@@ -21,4 +21,8 @@ dds::Qos scene_edit_qos() {
   return dds::Qos::make(false, 0);
 }
 
+dds::Qos robot_state_qos() {
+  return dds::Qos::make(false, 256);
+}
+
 }  // namespace cellmap::transport

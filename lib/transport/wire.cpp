@@ -138,6 +138,18 @@ SceneEditSample::SceneEditSample(const SceneEdit& edit) : edit_(edit) {
   msg_.yaw = edit_.yaw;
 }
 
+RobotStateSample::RobotStateSample(const RobotState& state) : cell_(state.cell) {
+  msg_.cell = text(cell_);
+  msg_.stamp_ns = state.stamp_ns;
+  const Eigen::Vector3d p_CE = state.X_CE.translation();
+  const Eigen::Quaterniond q_CE(state.X_CE.linear());
+  for (int i = 0; i < 3; ++i) msg_.position[i] = p_CE[i];
+  msg_.orientation[0] = q_CE.w();
+  msg_.orientation[1] = q_CE.x();
+  msg_.orientation[2] = q_CE.y();
+  msg_.orientation[3] = q_CE.z();
+}
+
 Environment from_wire(const cellmap_msg_Environment& msg) {
   const std::string where = std::string(kEnvironmentTopic) + " version " + std::to_string(msg.version);
   return Environment(cell_of(msg.cell, kEnvironmentTopic), msg.version, msg.stamp_ns,
@@ -201,6 +213,23 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   if (edit.half_extents.minCoeff() < 0) throw Error(where + ": half_extents: must not be negative");
   edit.yaw = msg.yaw;
   return edit;
+}
+
+RobotState from_wire(const cellmap_msg_RobotState& msg) {
+  RobotState state;
+  state.cell = cell_of(msg.cell, kRobotStateTopic);
+  const std::string where =
+      std::string(kRobotStateTopic) + " '" + state.cell + "' at " + std::to_string(msg.stamp_ns);
+  require_finite(msg.position, 3, where + ": position");
+  require_finite(msg.orientation, 4, where + ": orientation");
+  const Eigen::Quaterniond q(msg.orientation[0], msg.orientation[1], msg.orientation[2], msg.orientation[3]);
+  // Controllers send single-precision or rounded quaternions; accept them, refuse swapped or zero ones.
+  if (std::abs(q.norm() - 1.0) > 1e-3)
+    throw Error(where + ": orientation: must be a unit quaternion [w, x, y, z]");
+  state.stamp_ns = msg.stamp_ns;
+  state.X_CE.linear() = q.normalized().toRotationMatrix();
+  state.X_CE.translation() = Eigen::Vector3d(msg.position[0], msg.position[1], msg.position[2]);
+  return state;
 }
 
 }  // namespace cellmap::transport::wire

@@ -56,11 +56,23 @@ class SceneEditSample {
   cellmap_msg_SceneEdit msg_{};
 };
 
+class RobotStateSample {
+ public:
+  explicit RobotStateSample(const RobotState& state);
+  [[nodiscard]] const cellmap_msg_RobotState* get() const { return &msg_; }
+
+ private:
+  std::string cell_;
+  cellmap_msg_RobotState msg_{};
+};
+
 /// @throws Error naming the topic and field if a number is not finite, a half extent is negative, a rotation
 /// is not a unit quaternion, the cell is empty or box ids repeat.
 [[nodiscard]] Environment from_wire(const cellmap_msg_Environment& msg);
 [[nodiscard]] EnvironmentDelta from_wire(const cellmap_msg_EnvironmentDelta& msg);
 [[nodiscard]] CellStatus from_wire(const cellmap_msg_Status& msg);
 [[nodiscard]] SceneEdit from_wire(const cellmap_msg_SceneEdit& msg);
+/// @throws Error also for an empty cell, a non-finite number or a quaternion whose norm is not 1 ± 1e-3.
+[[nodiscard]] RobotState from_wire(const cellmap_msg_RobotState& msg);
 
 }  // namespace cellmap::transport::wire

@@ -32,6 +32,27 @@ TEST(LatestMailboxTest, TakeWaitsForAProducer) {
   EXPECT_EQ(box.dropped(), 0u);
 }
 
+TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
+  LatestMailbox<int> box;
+  EXPECT_TRUE(box.wait_taken(milliseconds(0)));  // empty from the start
+  std::vector<int> got;
+  std::thread consumer([&] {
+    while (got.size() < 50) {
+      if (const std::optional<int> item = box.take(milliseconds(10000))) got.push_back(*item);
+    }
+  });
+  for (int i = 0; i < 50; ++i) {
+    ASSERT_TRUE(box.wait_taken(milliseconds(10000)));
+    box.put(i);
+  }
+  consumer.join();
+  EXPECT_EQ(box.dropped(), 0u);
+  ASSERT_EQ(got.size(), 50u);
+  for (int i = 0; i < 50; ++i) EXPECT_EQ(got[i], i);
+  box.put(7);
+  EXPECT_FALSE(box.wait_taken(milliseconds(1)));  // nobody takes it
+}
+
 TEST(LatestMailboxTest, CloseWakesWaitingConsumers) {
   LatestMailbox<int> box;
   std::thread closer([&] {

@@ -14,19 +14,14 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/sensor/v4l2_source.hpp"
+#include "sensor/sensor_test_util.hpp"
 
 namespace cellmap {
 namespace {
 
 using std::chrono::milliseconds;
 
-ReconnectPolicy fast_retries() {
-  ReconnectPolicy policy;
-  policy.initial_backoff = 0.02;
-  policy.max_backoff = 0.1;
-  policy.frame_timeout = 0.5;
-  return policy;
-}
+using test::fast_retries;
 
 TEST(OpenNI2SourceTest, NoDeviceIsACleanDisconnectedStatusWithTheReason) {
   if (!list_openni2_devices().empty()) GTEST_SKIP() << "an OpenNI2 device is plugged in";

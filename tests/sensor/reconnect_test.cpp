@@ -73,6 +73,29 @@ TEST(ReconnectorTest, ErrorIsFinalUntilClosed) {
   EXPECT_TRUE(r.reason().empty());
 }
 
+TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
+  ReconnectPolicy p = policy();
+  p.initial_backoff = 0.2;
+  Reconnector r(p);
+  r.lost(steady_seconds(), "unplugged");
+  int attempts = 0;
+  const auto connect = [&](double now) {
+    ++attempts;
+    EXPECT_GE(now, r.next_attempt());
+    r.lost(now, "still unplugged");
+  };
+  const double start = steady_seconds();
+  r.retry_or_wait(std::chrono::milliseconds(20), connect);  // not due: waits out the 20 ms, no attempt
+  EXPECT_EQ(attempts, 0);
+  EXPECT_GE(steady_seconds() - start, 0.019);
+  while (attempts == 0 && steady_seconds() - start < 10.0)
+    r.retry_or_wait(std::chrono::milliseconds(1000), connect);
+  EXPECT_EQ(attempts, 1);
+  // The wait was cut at the attempt time (0.2 s), not the 1 s timeout.
+  EXPECT_LT(steady_seconds() - start, 0.2 + 0.5);
+  EXPECT_DOUBLE_EQ(r.backoff(), 0.8);  // 0.2 → 0.4 after the first loss, 0.8 after the failed retry
+}
+
 TEST(ReconnectorTest, RefusesBadPolicies) {
   ReconnectPolicy p = policy();
   p.max_backoff = 0.1;

@@ -1,32 +1,28 @@
 #pragma once
-// Helpers shared by the sensor tests: a temporary folder and a synthetic depth image.
+// Helpers shared by the sensor tests: files in a temporary folder, fast reconnect timings, a synthetic depth
+// image.
 
-#include <unistd.h>
-
-#include <filesystem>
 #include <string>
 
 #include "cellmap/sensor/depth_io.hpp"
+#include "cellmap/sensor/reconnect.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap::test {
 
-namespace fs = std::filesystem;
+/// dir / "name": a file in a test folder, as the string the sensor API takes.
+inline std::string operator/(const TempDir& dir, const std::string& name) {
+  return (dir.path() / name).string();
+}
 
-/// A fresh folder under the system temp folder, removed with its contents on destruction.
-class TempDir {
- public:
-  explicit TempDir(const std::string& tag)
-      : path_(fs::temp_directory_path() / ("cellmap_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  [[nodiscard]] const fs::path& path() const { return path_; }
-  [[nodiscard]] std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+/// Reconnect timings short enough for tests: 20 ms first back-off, 100 ms cap, 0.5 s frame timeout.
+inline ReconnectPolicy fast_retries() {
+  ReconnectPolicy policy;
+  policy.initial_backoff = 0.02;
+  policy.max_backoff = 0.1;
+  policy.frame_timeout = 0.5;
+  return policy;
+}
 
 /// width × height raw depth: column 0 without returns, elsewhere 1000 + 300 v + u.
 inline RawDepth ramp(int width, int height) {

@@ -8,19 +8,14 @@
 #include <filesystem>
 
 #include "cellmap/common/error.hpp"
+#include "sensor/sensor_test_util.hpp"
 
 namespace cellmap {
 namespace {
 
 using std::chrono::milliseconds;
 
-ReconnectPolicy fast_retries() {
-  ReconnectPolicy policy;
-  policy.initial_backoff = 0.02;
-  policy.max_backoff = 0.1;
-  policy.frame_timeout = 0.5;
-  return policy;
-}
+using test::fast_retries;
 
 TEST(V4l2SourceTest, MissingDeviceIsACleanDisconnectedStatusNamingIt) {
   V4l2Config config;

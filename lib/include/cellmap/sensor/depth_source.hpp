@@ -105,5 +105,7 @@ class DeviceClock final {
 
 /// Seconds on CLOCK_REALTIME now (the stamp clock of live sources).
 [[nodiscard]] double realtime_seconds();
+/// Seconds on std::chrono::steady_clock now (the clock sources time their timeouts and retries with).
+[[nodiscard]] double steady_seconds();
 
 }  // namespace cellmap

@@ -2,6 +2,8 @@
 // When a camera source should try to (re)connect: a small state machine driven by a clock the caller passes
 // in.
 
+#include <chrono>
+#include <functional>
 #include <string>
 
 #include "cellmap/sensor/depth_source.hpp"
@@ -47,6 +49,10 @@ class Reconnector final {
   bool check(double now);
   /// True when disconnected and the next attempt is due at `now`.
   [[nodiscard]] bool retry_due(double now) const;
+  /// What a source's next() does while disconnected: calls `connect(now)` (which reports connected() or
+  /// lost()) if the attempt is due on the steady clock (steady_seconds()), else sleeps until it is due or
+  /// `timeout` passed, whichever comes first, so callers never spin.
+  void retry_or_wait(std::chrono::milliseconds timeout, const std::function<void(double now)>& connect);
 
   [[nodiscard]] SourceState state() const { return state_; }
   [[nodiscard]] const std::string& reason() const { return reason_; }

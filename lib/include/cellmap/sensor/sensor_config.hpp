@@ -39,6 +39,16 @@ struct SensorConfig final {
 /// Reads the map of sensor `name` (see the format above). @throws Error naming the file and key path.
 [[nodiscard]] SensorConfig read_sensor_config(YamlMap& map, const std::string& name);
 
+/// The per-source settings maps above, one reader each (cellmapd reads them from its `source` section).
+/// Every key of the map must be known. @throws Error naming the file and key path.
+[[nodiscard]] OpenNI2Config read_openni2_config(YamlMap settings, const std::string& name);
+[[nodiscard]] V4l2Config read_v4l2_config(YamlMap settings, const std::string& name);
+/// The directory may be absent here (""): the caller decides whether a replay is configured.
+[[nodiscard]] ReplayConfig read_replay_config(YamlMap settings, const std::string& name);
+/// {translation: [x, y, z], rotation: [w, x, y, z]}, both optional (identity). @throws Error naming the key
+/// for a wrong length, a non-unit quaternion or non-finite values.
+[[nodiscard]] Eigen::Isometry3d read_pose_yaml(YamlMap map);
+
 /// Builds the configured source (not opened yet). @throws Error as the source's constructor.
 [[nodiscard]] std::unique_ptr<DepthSource> make_depth_source(const SensorConfig& config);
 

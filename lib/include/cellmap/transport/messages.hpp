@@ -1,8 +1,9 @@
 #pragma once
-// Value types for the status and scene-edit topics (the environment ones are cellmap::Environment and
-// cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside lib/transport.
+// Value types for the status, scene-edit and robot-state topics (the environment ones are
+// cellmap::Environment and cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside
+// lib/transport.
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstdint>
 #include <string>
@@ -36,6 +37,13 @@ struct SceneEdit final {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();        ///< p_CB, metres (add-box, move)
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< metres (add-box)
   double yaw = 0.0;                                        ///< about the cell's z axis, radians (add-box)
+};
+
+/// cellmap/robot_state: the robot's tool pose at one instant (what the robot controller sends).
+struct RobotState final {
+  std::string cell;                                        ///< must not be empty
+  std::int64_t stamp_ns = 0;                               ///< ns since the Unix epoch (CLOCK_REALTIME)
+  Eigen::Isometry3d X_CE = Eigen::Isometry3d::Identity();  ///< tool pose in the cell frame
 };
 
 }  // namespace cellmap::transport

@@ -12,6 +12,7 @@ inline constexpr const char* kEnvironmentTopic = "cellmap/environment";
 inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta";
 inline constexpr const char* kStatusTopic = "cellmap/status";
 inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
+inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
@@ -24,5 +25,8 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 [[nodiscard]] dds::Qos status_qos();
 /// cellmap/sim/scene_edits: RELIABLE, VOLATILE (a restarted daemon must not replay old edits), KEEP_ALL.
 [[nodiscard]] dds::Qos scene_edit_qos();
+/// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
+/// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
+[[nodiscard]] dds::Qos robot_state_qos();
 
 }  // namespace cellmap::transport

@@ -1,0 +1,56 @@
+#pragma once
+// cellmap/robot_state: the robot controller tells cellmapd where the tool is, so camera frames get their
+// pose.
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cellmap/transport/dds.hpp"
+#include "cellmap/transport/messages.hpp"
+
+namespace cellmap::transport {
+
+/// Sends tool poses (the robot controller's side, or a test). `participant` must outlive it. Thread-safe as
+/// Cyclone's writes are.
+class RobotStateWriter final {
+ public:
+  explicit RobotStateWriter(const dds::Participant& participant);
+  /// True once at least one robot-state reader (a daemon) matched, false on timeout.
+  bool wait_for_reader(std::chrono::nanoseconds timeout) const;
+  /// The rotation is sent as a quaternion of X_CE.linear(), which must be a rotation matrix.
+  /// @throws Error if the cell is empty, the pose is not finite, or the write fails.
+  void write(const RobotState& state) const;
+  /// True once every matched reader acknowledged everything written, false on timeout.
+  bool wait_for_acks(std::chrono::nanoseconds timeout) const;
+
+ private:
+  dds::Topic topic_;
+  dds::Writer writer_;
+};
+
+/// Receives tool poses for one cell (cellmapd's side). `participant` must outlive it. Not thread-safe.
+class RobotStateReader final {
+ public:
+  /// @param cell  only this cell's poses are returned; others are skipped (not counted as rejected).
+  RobotStateReader(const dds::Participant& participant, std::string cell);
+  ~RobotStateReader();
+  RobotStateReader(const RobotStateReader&) = delete;
+  RobotStateReader& operator=(const RobotStateReader&) = delete;
+  /// Waits up to `timeout` for data (zero: just looks) and returns the poses received, oldest first.
+  /// Malformed samples (empty cell, non-finite numbers, non-unit quaternion) are skipped and counted.
+  std::vector<RobotState> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
+  [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
+  /// How many writers (robot controllers) are matched right now.
+  [[nodiscard]] std::uint32_t matched_writers() const { return reader_.matched_writers(); }
+
+ private:
+  std::string cell_;
+  dds::Topic topic_;
+  dds::Reader reader_;
+  dds::WaitSet waitset_;
+  std::uint64_t rejected_ = 0;
+};
+
+}  // namespace cellmap::transport

@@ -1,0 +1,62 @@
+#include "cellmap/transport/robot_state.hpp"
+
+#include <utility>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/topics.hpp"
+#include "wire.hpp"
+
+namespace cellmap::transport {
+
+RobotStateWriter::RobotStateWriter(const dds::Participant& participant)
+    : topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
+      writer_(participant, topic_, robot_state_qos()) {}
+
+bool RobotStateWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
+  return writer_.wait_for_readers(1, timeout);
+}
+
+void RobotStateWriter::write(const RobotState& state) const {
+  if (state.cell.empty()) throw Error(std::string(kRobotStateTopic) + ": cell: must not be empty");
+  if (!state.X_CE.matrix().allFinite())
+    throw Error(std::string(kRobotStateTopic) + " '" + state.cell + "': pose is not finite");
+  const wire::RobotStateSample sample(state);
+  writer_.write(sample.get());
+}
+
+bool RobotStateWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
+  return writer_.wait_for_acks(timeout);
+}
+
+RobotStateReader::RobotStateReader(const dds::Participant& participant, std::string cell)
+    : cell_(std::move(cell)),
+      topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
+      reader_(participant, topic_, robot_state_qos()),
+      waitset_(participant) {
+  waitset_.attach(reader_);
+}
+
+RobotStateReader::~RobotStateReader() {
+  try {
+    waitset_.detach(reader_);
+  } catch (const Error&) {
+    // Deleting the reader detaches it anyway.
+  }
+}
+
+std::vector<RobotState> RobotStateReader::take(std::chrono::nanoseconds timeout) {
+  if (timeout.count() > 0) waitset_.wait(timeout);
+  std::vector<RobotState> states;
+  reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
+    const auto& msg = *static_cast<const cellmap_msg_RobotState*>(sample);
+    if (msg.cell != nullptr && cell_ != msg.cell) return;
+    try {
+      states.push_back(wire::from_wire(msg));
+    } catch (const Error&) {
+      ++rejected_;
+    }
+  });
+  return states;
+}
+
+}  // namespace cellmap::transport
