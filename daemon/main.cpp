@@ -106,7 +106,10 @@ class Daemon {
   }
 
   void run(const Signals& signals) {
-    std::thread acquisition([this] { acquire(); });
+    std::thread acquisition([this] {
+      acquire();
+      acquisition_done_ = true;
+    });
     std::thread processing([this] { process(); });
     while (!stop_) {
       const std::optional<int> signal = signals.wait_for(std::chrono::milliseconds(200));
@@ -249,7 +252,10 @@ class Daemon {
       if (sweep) {
         handle(*sweep, ++processed);
         if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
-      } else if (stop_) {
+      } else if (stop_ || acquisition_done_) {
+        // With --sweeps, acquisition ends after N sweeps; some may have been replaced in the mailbox, so
+        // processing ends when the mailbox is empty, not only after N.
+        stop_ = true;
         break;
       }
       if (Clock::now() >= next_status) {
@@ -342,6 +348,7 @@ class Daemon {
   std::atomic<bool> stop_{false};
   std::atomic<double> sweep_period_;
   std::uint64_t acquired_ = 0;
+  std::atomic<bool> acquisition_done_{false};
   std::atomic<std::uint64_t> current_version_{0};  // for the acquisition thread's log lines
   std::atomic<std::uint64_t> camera_dropped_{0};   // the camera's frames dropped without a pose
 };
