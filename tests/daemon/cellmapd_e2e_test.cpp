@@ -3,90 +3,36 @@
 // reuse.
 #include <gtest/gtest.h>
 
-#include "support/test_support.hpp"
-
-#include <filesystem>
-#include <fstream>
-#include <mutex>
 #include <thread>
 
-#include "cellmap/transport/environment_subscriber.hpp"
-#include "transport/child_process.hpp"
-#include "transport/loopback.hpp"
+#include "daemon/service_e2e.hpp"
 
 namespace cellmap {
 namespace {
 
-namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 // Transport tests use 110-149; each test here has its own domain so ctest -j runs them side by side.
 constexpr int kAddRemoveDomain = 150;
 constexpr int kRestartDomain = 151;
-constexpr auto kPatience = 90s;
-
-// Records every delta the planner's callback sees.
-class Recorder {
- public:
-  void operator()(const Environment&, const EnvironmentDelta& delta) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    deltas_.push_back(delta);
-  }
-  EnvironmentDelta last() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return deltas_.back();
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<EnvironmentDelta> deltas_;
-};
+using test::inject;
+using test::kPatience;
+using test::settled;
 
 class CellmapdE2eTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { test::use_loopback(); }
 
-  void SetUp() override {
-    config_ = dir_.path() / "cellmapd.yaml";
-    // Exact depths: this test is about the mechanics of versions and deltas; noise robustness is tested
-    // where the noise is modelled (change detection).
-    std::ofstream(config_) << "cell: e2e\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n";
+  [[nodiscard]] std::unique_ptr<test::ChildProcess> start_daemon(int domain) const {
+    return service_.start_daemon(domain);
   }
 
-  std::unique_ptr<test::ChildProcess> start_daemon(int domain) {
-    return std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{CELLMAPD, "--config", config_.string(), "--domain", std::to_string(domain),
-                                 "--state-dir", (dir_.path() / "state").string()});
-  }
-
-  static std::string inject(int domain, const std::vector<std::string>& args) {
-    std::vector<std::string> argv{CELLMAP_TOOL, "inject", "--domain", std::to_string(domain), "--wait", "60"};
-    argv.insert(argv.end(), args.begin(), args.end());
-    test::ChildProcess tool(argv);
-    const std::string out = tool.read_line(kPatience).value_or("");
-    EXPECT_EQ(tool.wait(), 0) << "cellmap inject failed";
-    return out;
-  }
-
-  // Waits until no new version came for `quiet` (the map has settled), returns the environment then.
-  static Environment settled(const transport::EnvironmentSubscriber& planner, std::chrono::seconds quiet) {
-    std::uint64_t version = planner.environment()->version();
-    const auto deadline = std::chrono::steady_clock::now() + kPatience;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (!planner.wait_for_version(version + 1, quiet)) return *planner.environment();
-      version = planner.environment()->version();
-    }
-    ADD_FAILURE() << "the environment never settled";
-    return *planner.environment();
-  }
-
-  test::TempDir dir_;
-  fs::path config_;
+  test::ServiceFixture service_{"e2e"};
 };
 
 TEST_F(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   auto daemon = start_daemon(kAddRemoveDomain);
   const dds::Participant participant(kAddRemoveDomain);
-  Recorder recorder;
+  test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber planner(participant, "e2e", std::ref(recorder));
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "no first version from the daemon";
   const Environment before = settled(planner, 5s);
