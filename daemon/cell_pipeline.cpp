@@ -9,7 +9,10 @@
 namespace cellmap::daemon {
 namespace {
 
-constexpr const char* kStateMagic = "cellmap-map-state 1";
+// Version 2 adds the viewpoint line (normals are oriented towards it, so a restart re-fits boxes alike);
+// version 1 states (no viewpoint) are still read.
+constexpr const char* kStateMagicV1 = "cellmap-map-state 1";
+constexpr const char* kStateMagic = "cellmap-map-state 2";
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -36,8 +39,16 @@ CellPipeline::CellPipeline(const DaemonConfig& config, std::vector<Box> boxes, s
   std::string magic;
   std::getline(in, magic);
   std::uint64_t stored_next_id = 0;
-  if (magic != kStateMagic || !(in >> stored_next_id) || in.get() != '\n') {
+  if ((magic != kStateMagic && magic != kStateMagicV1) || !(in >> stored_next_id) || in.get() != '\n') {
     throw Error("map state: not a cellmap map state (bad header)");
+  }
+  if (magic == kStateMagic) {
+    Eigen::Vector3d viewpoint;
+    if (!(in >> viewpoint.x() >> viewpoint.y() >> viewpoint.z()) || in.get() != '\n' ||
+        !viewpoint.allFinite()) {
+      throw Error("map state: bad viewpoint line");
+    }
+    viewpoint_C_ = viewpoint;
   }
   next_box_id_ = std::max(next_box_id_, stored_next_id);
   map_.read(in);
@@ -46,6 +57,8 @@ CellPipeline::CellPipeline(const DaemonConfig& config, std::vector<Box> boxes, s
 std::string CellPipeline::map_state() const {
   std::ostringstream out;
   out << kStateMagic << "\n" << next_box_id_ << "\n";
+  out.precision(17);
+  out << viewpoint_C_.x() << " " << viewpoint_C_.y() << " " << viewpoint_C_.z() << "\n";
   map_.write(out);
   return out.str();
 }
@@ -67,13 +80,26 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
   report.flipped = update.appeared.size() + update.vanished.size();
 
   start = std::chrono::steady_clock::now();
-  const ChangeSet changes = detector_.update(update, map_);
+  ChangeSet changes = detector_.update(update, map_);
   report.t_change = seconds_since(start);
   report.regions = changes.regions.size();
   report.boxes = boxes_.size();
   if (changes.empty()) return report;
 
   start = std::chrono::steady_clock::now();
+  Reconciled reconciled = resegment(changes, &report.evidence);
+  report.t_segment = seconds_since(start);
+  report.changes = std::move(changes);
+  next_box_id_ = reconciled.next_id;
+  if (reconciled.changed()) {
+    boxes_ = reconciled.boxes;
+    report.change = std::move(reconciled);
+  }
+  report.boxes = boxes_.size();
+  return report;
+}
+
+Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* evidence) const {
   // Re-fit what the changes touch: the change regions, and the boxes that hold a changed voxel (their whole
   // extent, so a partly changed object is fitted whole).
   std::vector<Region> area;
@@ -93,22 +119,11 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
       kept.push_back(box);
     }
   }
-  const std::vector<Box> fitted = fit_boxes(area, kept);
-  report.evidence = 0;
-  for (const Box& box : fitted) report.evidence += box.points;
-  Reconciled reconciled = reconcile(boxes_, scope, fitted, next_box_id_, config_.reconcile);
-  report.t_segment = seconds_since(start);
-  next_box_id_ = reconciled.next_id;
-  if (reconciled.changed()) {
-    boxes_ = reconciled.boxes;
-    report.change = std::move(reconciled);
-  }
-  report.boxes = boxes_.size();
-  return report;
+  return reconcile(boxes_, scope, fit_boxes(area, kept, evidence), next_box_id_, config_.reconcile);
 }
 
-std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area,
-                                         const std::vector<Box>& kept) const {
+std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
+                                         std::size_t* evidence) const {
   Cloud cloud;
   for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
     // Evidence a kept box already covers needs no new box (e.g. the table around a new object).
@@ -116,6 +131,7 @@ std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area,
         std::any_of(kept.begin(), kept.end(), [&](const Box& box) { return box.contains(c); });
     if (!covered) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
   }
+  if (evidence != nullptr) *evidence = cloud.size();
   if (cloud.empty()) return {};
   cloud.sensor_origin_ = Eigen::Vector4f(viewpoint_C_.x(), viewpoint_C_.y(), viewpoint_C_.z(), 0.0f);
   SegmentResult result = segment_cloud(cloud, config_.segment);
@@ -129,6 +145,12 @@ std::vector<Box> CellPipeline::segment_everything() const {
   tree.getMetricMin(x0, y0, z0);
   tree.getMetricMax(x1, y1, z1);
   return fit_boxes({Region{{x0, y0, z0}, {x1, y1, z1}}.grown(tree.getResolution())}, {});
+}
+
+Reconciled CellPipeline::resegment_everything() const {
+  std::vector<std::uint64_t> scope;
+  for (const Box& box : boxes_) scope.push_back(box.id);
+  return reconcile(boxes_, scope, segment_everything(), next_box_id_, config_.reconcile);
 }
 
 }  // namespace cellmap::daemon
