@@ -35,6 +35,7 @@ CellPipeline::CellPipeline(const DaemonConfig& config, std::vector<Box> boxes, s
       boxes_(std::move(boxes)),
       next_box_id_(next_box_id) {
   if (!map_state) return;
+  settling_ = false;  // a restored map has settled before
   std::istringstream in(*map_state);
   std::string magic;
   std::getline(in, magic);
@@ -84,10 +85,14 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
   report.t_change = seconds_since(start);
   report.regions = changes.regions.size();
   report.boxes = boxes_.size();
-  if (changes.empty()) return report;
+  if (settling_ && ++settled_sweeps_ < config_.change.settle_sweeps) return report;
+  if (!settling_ && changes.empty()) return report;
 
   start = std::chrono::steady_clock::now();
-  Reconciled reconciled = resegment(changes, &report.evidence);
+  // The map has settled: one segmentation of all of it makes the first version; changes from then on.
+  Reconciled reconciled =
+      settling_ ? resegment_everything(&report.evidence) : resegment(changes, &report.evidence);
+  settling_ = false;
   report.t_segment = seconds_since(start);
   report.changes = std::move(changes);
   next_box_id_ = reconciled.next_id;
@@ -100,17 +105,16 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
 }
 
 Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* evidence) const {
-  // Re-fit what the changes touch: the change regions, and the boxes that hold a changed voxel (their whole
-  // extent, so a partly changed object is fitted whole).
+  // Re-fit what the changes touch: the change regions, and the boxes that lost evidence (hold a vanished
+  // voxel; their whole extent, so a partly changed object is fitted whole). A box that merely holds an
+  // appeared voxel already covers it: re-fitting it (the table under a new object) would only churn ids.
   std::vector<Region> area;
-  std::vector<Eigen::Vector3d> changed_C;
+  std::vector<Eigen::Vector3d> vanished_C;
   for (const ChangeRegion& region : changes.regions) {
     area.push_back({region.min_C, region.max_C});
-    for (const auto* keys : {&region.appeared, &region.vanished}) {
-      for (const octomap::OcTreeKey& key : *keys) changed_C.push_back(map_.centre(key));
-    }
+    for (const octomap::OcTreeKey& key : region.vanished) vanished_C.push_back(map_.centre(key));
   }
-  const std::vector<std::uint64_t> scope = boxes_touched(boxes_, changed_C);
+  const std::vector<std::uint64_t> scope = boxes_touched(boxes_, vanished_C);
   std::vector<Box> kept;
   for (const Box& box : boxes_) {
     if (std::find(scope.begin(), scope.end(), box.id) != scope.end()) {
@@ -139,18 +143,18 @@ std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const 
   return std::move(result.boxes.boxes);
 }
 
-std::vector<Box> CellPipeline::segment_everything() const {
+std::vector<Box> CellPipeline::segment_everything(std::size_t* evidence) const {
   const octomap::OcTree& tree = map_.tree();
   double x0, y0, z0, x1, y1, z1;
   tree.getMetricMin(x0, y0, z0);
   tree.getMetricMax(x1, y1, z1);
-  return fit_boxes({Region{{x0, y0, z0}, {x1, y1, z1}}.grown(tree.getResolution())}, {});
+  return fit_boxes({Region{{x0, y0, z0}, {x1, y1, z1}}.grown(tree.getResolution())}, {}, evidence);
 }
 
-Reconciled CellPipeline::resegment_everything() const {
+Reconciled CellPipeline::resegment_everything(std::size_t* evidence) const {
   std::vector<std::uint64_t> scope;
   for (const Box& box : boxes_) scope.push_back(box.id);
-  return reconcile(boxes_, scope, segment_everything(), next_box_id_, config_.reconcile);
+  return reconcile(boxes_, scope, segment_everything(evidence), next_box_id_, config_.reconcile);
 }
 
 }  // namespace cellmap::daemon

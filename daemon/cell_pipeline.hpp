@@ -43,7 +43,9 @@ class CellPipeline final {
                const std::optional<std::string>& map_state = std::nullopt);
 
   /// Fuses `sweep`, detects confirmed changes and, if there are any, re-segments the evidence inside the
-  /// changed regions (plus every box in their scope) and reconciles it with the current boxes.
+  /// changed regions (plus every box in their scope) and reconciles it with the current boxes. A pipeline
+  /// that started from an empty map first settles: it publishes nothing for `change.settle_sweeps` sweeps,
+  /// then segments the whole map once (the first version), and from then on works on changes only.
   SweepReport process(const Sweep& sweep);
 
   /// The incremental step of process(), without applying it: re-segments the occupied evidence inside the
@@ -53,10 +55,10 @@ class CellPipeline final {
   [[nodiscard]] Reconciled resegment(const ChangeSet& changes, std::size_t* evidence = nullptr) const;
 
   /// Re-segments the whole map from scratch (what the incremental path avoids; used to measure it).
-  [[nodiscard]] std::vector<Box> segment_everything() const;
+  [[nodiscard]] std::vector<Box> segment_everything(std::size_t* evidence = nullptr) const;
   /// segment_everything() reconciled with the current boxes (every box in scope): what publishing a change
   /// would cost without change regions.
-  [[nodiscard]] Reconciled resegment_everything() const;
+  [[nodiscard]] Reconciled resegment_everything(std::size_t* evidence = nullptr) const;
 
   [[nodiscard]] const std::vector<Box>& boxes() const { return boxes_; }
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
@@ -76,6 +78,8 @@ class CellPipeline final {
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;
   Eigen::Vector3d viewpoint_C_ = Eigen::Vector3d::Zero();  // where normals are oriented towards
+  bool settling_ = true;    // an empty map that has not made its first version yet
+  int settled_sweeps_ = 0;  // sweeps fused while settling
 };
 
 }  // namespace cellmap::daemon

@@ -47,6 +47,8 @@ void ChangeConfig::validate() const {
   if (!(margin >= 0.0 && margin <= 10.0)) bad("margin", "must be in [0, 10] m", margin);
   if (min_voxels < 1 || min_voxels > 1000000)
     bad("min_voxels", "must be an integer in [1, 1000000]", min_voxels);
+  if (settle_sweeps < 0 || settle_sweeps > 100000)
+    bad("settle_sweeps", "must be an integer in [0, 100000]", settle_sweeps);
 }
 
 ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
@@ -54,6 +56,7 @@ ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
   c.persist_sweeps = static_cast<int>(section.integer("persist_sweeps", c.persist_sweeps, 1, 1000));
   c.margin = section.number("margin", c.margin, 0.0, 10.0);
   c.min_voxels = static_cast<int>(section.integer("min_voxels", c.min_voxels, 1, 1000000));
+  c.settle_sweeps = static_cast<int>(section.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   section.expect_all_read();
   return c;
 }
@@ -104,14 +107,15 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
   for (const Key& seed : seeds) {
     if (!grouped.insert(seed).second) continue;
     ChangeRegion region;
-    int off_surface = 0;
+    int off_surface_appeared = 0, off_surface_vanished = 0;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
     Eigen::Vector3d hi = -lo;
     std::vector<Key> stack = {seed};
     while (!stack.empty()) {
       const Key key = stack.back();
       stack.pop_back();
-      (confirmed.at(key) ? region.appeared : region.vanished).push_back(key);
+      const bool appeared = confirmed.at(key);
+      (appeared ? region.appeared : region.vanished).push_back(key);
       const Eigen::Vector3d c = map.centre(key);
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
@@ -124,9 +128,11 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
           touches_unchanged_surface = true;
         }
       });
-      if (!touches_unchanged_surface) ++off_surface;
+      if (!touches_unchanged_surface) ++(appeared ? off_surface_appeared : off_surface_vanished);
     }
-    if (off_surface < config_.min_voxels) continue;  // surface jitter
+    // Counted per kind: a surface voxel that jitters to its neighbour is one vanished and one appeared voxel,
+    // which together are not an object arriving or leaving.
+    if (std::max(off_surface_appeared, off_surface_vanished) < config_.min_voxels) continue;  // jitter
     std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
     std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
     region.min_C = lo.array() - half - config_.margin;
