@@ -114,14 +114,27 @@ Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* eviden
     area.push_back({region.min_C, region.max_C});
     for (const octomap::OcTreeKey& key : region.vanished) vanished_C.push_back(map_.centre(key));
   }
-  const std::vector<std::uint64_t> scope = boxes_touched(boxes_, vanished_C);
+  std::vector<std::uint64_t> scope = boxes_touched(boxes_, vanished_C);
+  const auto in_scope = [&](const Box& box) {
+    return std::find(scope.begin(), scope.end(), box.id) != scope.end();
+  };
+  for (const Box& box : boxes_) {
+    if (in_scope(box)) area.push_back(bounds_of(box).grown(config_.change.margin));
+  }
+  // Boxes lying wholly inside that area join it: after a small move the part that appeared first got its own
+  // box, and it is fitted together with the rest of the object once the old place clears.
+  const std::size_t refitted = area.size() - changes.regions.size();
+  for (const Box& box : boxes_) {
+    const Region bounds = bounds_of(box);
+    const auto holds = [&](const Region& r) { return r.intersection(bounds).volume() >= bounds.volume(); };
+    if (!in_scope(box) &&
+        std::any_of(area.end() - static_cast<std::ptrdiff_t>(refitted), area.end(), holds)) {
+      scope.push_back(box.id);
+    }
+  }
   std::vector<Box> kept;
   for (const Box& box : boxes_) {
-    if (std::find(scope.begin(), scope.end(), box.id) != scope.end()) {
-      area.push_back(bounds_of(box).grown(config_.change.margin));
-    } else {
-      kept.push_back(box);
-    }
+    if (!in_scope(box)) kept.push_back(box);
   }
   return reconcile(boxes_, scope, fit_boxes(area, kept, evidence), next_box_id_, config_.reconcile);
 }
