@@ -121,16 +121,13 @@ Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* eviden
   for (const Box& box : boxes_) {
     if (in_scope(box)) area.push_back(bounds_of(box).grown(config_.change.margin));
   }
-  // Boxes lying wholly inside that area join it: after a small move the part that appeared first got its own
-  // box, and it is fitted together with the rest of the object once the old place clears.
-  const std::size_t refitted = area.size() - changes.regions.size();
+  // Boxes lying wholly inside that area join it: the top of a new object published a few sweeps before its
+  // sides, or the part of a slightly moved object that appeared before its old place cleared, is fitted again
+  // together with the rest of the object (same id, modified) instead of staying a box of its own.
   for (const Box& box : boxes_) {
     const Region bounds = bounds_of(box);
     const auto holds = [&](const Region& r) { return r.intersection(bounds).volume() >= bounds.volume(); };
-    if (!in_scope(box) &&
-        std::any_of(area.end() - static_cast<std::ptrdiff_t>(refitted), area.end(), holds)) {
-      scope.push_back(box.id);
-    }
+    if (!in_scope(box) && std::any_of(area.begin(), area.end(), holds)) scope.push_back(box.id);
   }
   std::vector<Box> kept;
   for (const Box& box : boxes_) {

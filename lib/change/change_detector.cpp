@@ -1,6 +1,7 @@
 #include "cellmap/change/change_detector.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <sstream>
 #include <tuple>
 #include <unordered_set>
@@ -95,6 +96,11 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
       ++it;
     }
   }
+  // A reported object's voxels stop counting as "new" once its slower parts have had time to follow.
+  const std::uint64_t follow = 2 * static_cast<std::uint64_t>(config_.persist_sweeps);
+  for (auto it = reported_.begin(); it != reported_.end();) {
+    it = (sweep_ - it->second >= follow) ? reported_.erase(it) : std::next(it);
+  }
   if (confirmed.empty()) return changes;
 
   // 3. Group by 26-connectivity, in sorted order so that the result is deterministic.
@@ -123,7 +129,7 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
       for_each_neighbour(key, [&](const Key& n) {
         if (confirmed.count(n) != 0) {
           if (grouped.insert(n).second) stack.push_back(n);
-        } else if (!touches_unchanged_surface && pending_.count(n) == 0 &&
+        } else if (!touches_unchanged_surface && pending_.count(n) == 0 && reported_.count(n) == 0 &&
                    map.state(n) == VoxelState::occupied) {
           touches_unchanged_surface = true;
         }
@@ -133,6 +139,7 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
     // Counted per kind: a surface voxel that jitters to its neighbour is one vanished and one appeared voxel,
     // which together are not an object arriving or leaving.
     if (std::max(off_surface_appeared, off_surface_vanished) < config_.min_voxels) continue;  // jitter
+    for (const Key& key : region.appeared) reported_.emplace(key, sweep_);
     std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
     std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
     region.min_C = lo.array() - half - config_.margin;

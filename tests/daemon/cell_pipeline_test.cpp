@@ -75,7 +75,8 @@ class Cell {
         const Eigen::Vector3d p_C = X_CS * f.frame.points_S[i].getVector3fMap().cast<double>();
         ++seen;
         const auto holds = [&](const Box& box) { return box.contains(p_C, 0.001); };
-        covered += std::any_of(pipeline_.boxes().begin(), pipeline_.boxes().end(), holds) ? 1 : 0;
+        const bool in = std::any_of(pipeline_.boxes().begin(), pipeline_.boxes().end(), holds);
+        covered += in ? 1 : 0;
       }
     }
     return seen > 0 ? static_cast<double>(covered) / static_cast<double>(seen) : 0.0;
@@ -210,9 +211,35 @@ TEST(CellPipelineTest, FarMoveIsOneRemovedAndOneAdded) {
   EXPECT_EQ(box_holding(cell.pipeline().boxes(), at + lift), nullptr);
   ASSERT_NE(box_holding(cell.pipeline().boxes(), moved_to + lift), nullptr);
   EXPECT_EQ(box_holding(cell.pipeline().boxes(), moved_to + lift)->id, move.added[0]);
-  // Known gap: the new place's sides fill in after its top was published; their voxels touch the confirmed
-  // top, so change detection takes them for surface jitter and no version covers them (measured 99.96 %).
+  // Known gap (measured 99.96 %): at the new place a row of side voxels collects its second hit only after
+  // the object was published; too few of them lie off the published surface to count as a change, so no
+  // version covers them (the 1 cm of exact surface along the object's lower side edge).
   EXPECT_GE(cell.coverage(), 0.999);
+}
+
+TEST(CellPipelineTest, SmallMoveKeepsTheIdAndEndsAsOneBox) {
+  Cell cell(coarse_cell());
+  settle(cell);
+  const Eigen::Vector3d at(1.9, 0.7, 0.87), lift(0, 0, 0.11);
+  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
+  const Versions add = run(cell, 15);
+  ASSERT_EQ(add.added.size(), 1u);
+  const std::uint64_t planted_id = add.added[0];
+  const std::vector<Box> before_move = cell.pipeline().boxes();
+
+  // 5 cm along x (bounds IoU with the old box ≈ 0.6 ≥ reconcile.min_overlap): documented as the same id,
+  // modified. The strip that appears first may get a box of its own for a few sweeps; once the old place
+  // has cleared it is fitted again together with the object and removed.
+  const Eigen::Vector3d moved_to = at + Eigen::Vector3d(0.05, 0, 0);
+  cell.edit(sim::SceneEdit::move("planted", moved_to));
+  const Versions move = run(cell, 15);
+  EXPECT_NE(std::find(move.modified.begin(), move.modified.end(), planted_id), move.modified.end());
+  EXPECT_EQ(std::find(move.removed.begin(), move.removed.end(), planted_id), move.removed.end());
+  ASSERT_NE(box_holding(cell.pipeline().boxes(), moved_to + lift), nullptr);
+  EXPECT_EQ(box_holding(cell.pipeline().boxes(), moved_to + lift)->id, planted_id);
+  EXPECT_EQ(cell.pipeline().boxes().size(), before_move.size());
+  expect_far_boxes_kept(before_move, cell.pipeline().boxes(), at, 0.3);
+  EXPECT_DOUBLE_EQ(cell.coverage(), 1.0);
 }
 
 // Sensor noise (Kinect model: depth noise and flying pixels at edges) on a static cell: after the first

@@ -68,7 +68,10 @@ struct ChangeSet final {
 /// state for `persist_sweeps` sweeps, and dropped if it flips back first. Confirmed voxels of one sweep are
 /// grouped by 26-connectivity; a group is reported when at least `min_voxels` of its voxels have no occupied
 /// 26-neighbour that is itself unchanged (the others are surface jitter; so objects less than 2 voxels tall
-/// on a surface go unreported). A new object placed in observed free space is reported after
+/// on a surface go unreported). Voxels that appeared in a region reported within the last 2 · persist_sweeps
+/// sweeps do not count as unchanged surface, so the parts of a new object that collect their hits a little
+/// later (its sides, seen at grazing angles) are reported too instead of passing for jitter on its top. A
+/// new object placed in observed free space is reported after
 /// `OccupancyConfig::sweeps_to_occupy() + persist_sweeps - 1` sweeps that see it (5 with the defaults), and a
 /// removed one after `OccupancyConfig::sweeps_to_clear() + persist_sweeps - 1` sweeps that see through where
 /// it was (11 with the defaults). The first sweeps report the scene itself as appeared (a change from the
@@ -93,6 +96,8 @@ class ChangeDetector final {
   ChangeConfig config_;
   std::uint64_t sweep_ = 0;
   std::unordered_map<octomap::OcTreeKey, Pending, octomap::OcTreeKey::KeyHash> pending_;
+  // Appeared voxels of reported regions → the sweep they were reported in, for 2 · persist_sweeps sweeps.
+  std::unordered_map<octomap::OcTreeKey, std::uint64_t, octomap::OcTreeKey::KeyHash> reported_;
 };
 
 }  // namespace cellmap
