@@ -114,7 +114,11 @@ Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* eviden
     area.push_back({region.min_C, region.max_C});
     for (const octomap::OcTreeKey& key : region.vanished) vanished_C.push_back(map_.centre(key));
   }
-  std::vector<std::uint64_t> scope = boxes_touched(boxes_, vanished_C);
+  // A box re-fits only when it lost a tenth of its voxels: the table losing the few voxels an object removed
+  // from it shared with its top layer keeps its boxes (still covering all it holds) instead of being split
+  // anew.
+  constexpr double kRefitShare = 0.1;
+  std::vector<std::uint64_t> scope = boxes_touched(boxes_, vanished_C, kRefitShare);
   const auto in_scope = [&](const Box& box) {
     return std::find(scope.begin(), scope.end(), box.id) != scope.end();
   };
