@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "cell_pipeline.hpp"
+#include "cellmap/common/error.hpp"
 #include "cellmap/environment/reconcile.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/simulator.hpp"
@@ -243,6 +244,17 @@ TEST(CellPipelineTest, SmallMoveKeepsTheId) {
   EXPECT_EQ(box_holding(cell.pipeline().boxes(), moved_to + lift)->id, planted_id);
   expect_far_boxes_kept(before_move, cell.pipeline().boxes(), at, 0.3);
   EXPECT_GE(cell.coverage(), kCoverage);
+}
+
+TEST(CellPipelineTest, MapStateRoundTripsWithItsViewpointAndRejectsGarbage) {
+  Cell cell(coarse_cell());
+  (void)cell.sweep();
+  const std::string state = cell.pipeline().map_state();
+  const CellPipeline restored(defaults(), {}, 1, state);
+  EXPECT_EQ(restored.map_state(), state);  // map, next id and viewpoint, byte for byte
+  EXPECT_EQ(restored.map().occupied_keys().size(), cell.pipeline().map().occupied_keys().size());
+  EXPECT_THROW(CellPipeline(defaults(), {}, 1, std::string("cellmap-map-state 2\n1\nnan 0 0\n")), Error);
+  EXPECT_THROW(CellPipeline(defaults(), {}, 1, std::string("not a state\n")), Error);
 }
 
 // Sensor noise (Kinect model: depth noise and flying pixels at edges) on a static cell: after the first
