@@ -125,12 +125,16 @@ Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* eviden
   for (const Box& box : boxes_) {
     if (in_scope(box)) area.push_back(bounds_of(box).grown(config_.change.margin));
   }
-  // Boxes lying wholly inside that area join it: the top of a new object published a few sweeps before its
-  // sides, or the part of a slightly moved object that appeared before its old place cleared, is fitted again
-  // together with the rest of the object (same id, modified) instead of staying a box of its own.
+  const double resolution = map_.config().resolution;
+  // Boxes lying wholly inside that area (to a voxel) join it: the top of a new object published a few sweeps
+  // before its sides, or the part of a slightly moved object that appeared before its old place cleared, is
+  // fitted again together with the rest of the object (same id, modified) instead of staying a box of its
+  // own.
   for (const Box& box : boxes_) {
     const Region bounds = bounds_of(box);
-    const auto holds = [&](const Region& r) { return r.intersection(bounds).volume() >= bounds.volume(); };
+    const auto holds = [&](const Region& r) {
+      return r.grown(resolution).intersection(bounds).volume() >= bounds.volume();
+    };
     if (!in_scope(box) && std::any_of(area.begin(), area.end(), holds)) scope.push_back(box.id);
   }
   std::vector<Box> kept;

@@ -222,7 +222,7 @@ TEST(CellPipelineTest, FarMoveIsOneRemovedAndOneAdded) {
   EXPECT_GE(cell.coverage(), 0.999);
 }
 
-TEST(CellPipelineTest, SmallMoveKeepsTheId) {
+TEST(CellPipelineTest, SmallMoveKeepsTheIdAndEndsAsOneBox) {
   Cell cell(coarse_cell());
   settle(cell);
   const Eigen::Vector3d at(1.9, 0.7, 0.87), lift(0, 0, 0.11);
@@ -233,8 +233,8 @@ TEST(CellPipelineTest, SmallMoveKeepsTheId) {
   const std::vector<Box> before_move = cell.pipeline().boxes();
 
   // 5 cm along x (bounds IoU with the old box ≈ 0.6 ≥ reconcile.min_overlap): documented as the same id,
-  // modified. The strip that appears first gets a box of its own (an added id) that may stay: the old box
-  // is re-fitted only if a tenth of its voxels vanished.
+  // modified. The part that appears first gets a box of its own (an added id); once the old place clears,
+  // that box lies inside the re-fitted area, is fitted again with the object and removed.
   const Eigen::Vector3d moved_to = at + Eigen::Vector3d(0.05, 0, 0);
   cell.edit(sim::SceneEdit::move("planted", moved_to));
   const Versions move = run(cell, 15);
@@ -242,6 +242,7 @@ TEST(CellPipelineTest, SmallMoveKeepsTheId) {
   EXPECT_EQ(std::find(move.removed.begin(), move.removed.end(), planted_id), move.removed.end());
   ASSERT_NE(box_holding(cell.pipeline().boxes(), moved_to + lift), nullptr);
   EXPECT_EQ(box_holding(cell.pipeline().boxes(), moved_to + lift)->id, planted_id);
+  EXPECT_EQ(cell.pipeline().boxes().size(), before_move.size()) << "the strip's box should be gone";
   expect_far_boxes_kept(before_move, cell.pipeline().boxes(), at, 0.3);
   EXPECT_GE(cell.coverage(), kCoverage);
 }
