@@ -28,6 +28,7 @@ struct SweepReport final {
   std::size_t evidence = 0;                        ///< occupied voxels re-segmented
   std::size_t boxes = 0;                           ///< boxes after the sweep
   double t_fuse = 0, t_change = 0, t_segment = 0;  ///< seconds
+  ChangeSet changes;                               ///< the change regions confirmed in this sweep
   std::optional<Reconciled> change;                ///< set when the boxes changed (a new version is due)
 };
 
@@ -42,22 +43,34 @@ class CellPipeline final {
                const std::optional<std::string>& map_state = std::nullopt);
 
   /// Fuses `sweep`, detects confirmed changes and, if there are any, re-segments the evidence inside the
-  /// changed regions (plus every box in their scope) and reconciles it with the current boxes.
+  /// changed regions (plus every box in their scope) and reconciles it with the current boxes. A pipeline
+  /// that started from an empty map first settles: it publishes nothing for `change.settle_sweeps` sweeps,
+  /// then segments the whole map once (the first version), and from then on works on changes only.
   SweepReport process(const Sweep& sweep);
 
+  /// The incremental step of process(), without applying it: re-segments the occupied evidence inside the
+  /// regions of `changes` and inside every current box that holds a changed voxel, leaving out what the other
+  /// boxes cover, and reconciles the result with the current boxes. `evidence` (if given) receives the number
+  /// of voxels re-segmented. Repeatable (used to measure it).
+  [[nodiscard]] Reconciled resegment(const ChangeSet& changes, std::size_t* evidence = nullptr) const;
+
   /// Re-segments the whole map from scratch (what the incremental path avoids; used to measure it).
-  [[nodiscard]] std::vector<Box> segment_everything() const;
+  [[nodiscard]] std::vector<Box> segment_everything(std::size_t* evidence = nullptr) const;
+  /// segment_everything() reconciled with the current boxes (every box in scope): what publishing a change
+  /// would cost without change regions.
+  [[nodiscard]] Reconciled resegment_everything(std::size_t* evidence = nullptr) const;
 
   [[nodiscard]] const std::vector<Box>& boxes() const { return boxes_; }
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
   [[nodiscard]] const OccupancyMap& map() const { return map_; }
-  /// The map and the box-id counter as one opaque string (for VersionStore blobs).
+  /// The map, the box-id counter and the viewpoint normals face as one opaque string (for VersionStore
+  /// blobs; also how a measurement clones a pipeline).
   [[nodiscard]] std::string map_state() const;
 
  private:
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet.
-  [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area,
-                                           const std::vector<Box>& kept) const;
+  [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
+                                           std::size_t* evidence = nullptr) const;
 
   DaemonConfig config_;
   OccupancyMap map_;
@@ -65,6 +78,8 @@ class CellPipeline final {
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;
   Eigen::Vector3d viewpoint_C_ = Eigen::Vector3d::Zero();  // where normals are oriented towards
+  bool settling_ = true;    // an empty map that has not made its first version yet
+  int settled_sweeps_ = 0;  // sweeps fused while settling
 };
 
 }  // namespace cellmap::daemon

@@ -1,6 +1,7 @@
 #include "cellmap/change/change_detector.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <sstream>
 #include <tuple>
 #include <unordered_set>
@@ -47,6 +48,8 @@ void ChangeConfig::validate() const {
   if (!(margin >= 0.0 && margin <= 10.0)) bad("margin", "must be in [0, 10] m", margin);
   if (min_voxels < 1 || min_voxels > 1000000)
     bad("min_voxels", "must be an integer in [1, 1000000]", min_voxels);
+  if (settle_sweeps < 0 || settle_sweeps > 100000)
+    bad("settle_sweeps", "must be an integer in [0, 100000]", settle_sweeps);
 }
 
 ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
@@ -54,6 +57,7 @@ ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
   c.persist_sweeps = static_cast<int>(section.integer("persist_sweeps", c.persist_sweeps, 1, 1000));
   c.margin = section.number("margin", c.margin, 0.0, 10.0);
   c.min_voxels = static_cast<int>(section.integer("min_voxels", c.min_voxels, 1, 1000000));
+  c.settle_sweeps = static_cast<int>(section.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   section.expect_all_read();
   return c;
 }
@@ -92,6 +96,11 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
       ++it;
     }
   }
+  // A reported object's voxels stop counting as "new" once its slower parts have had time to follow.
+  const std::uint64_t follow = 2 * static_cast<std::uint64_t>(config_.persist_sweeps);
+  for (auto it = reported_.begin(); it != reported_.end();) {
+    it = (sweep_ - it->second >= follow) ? reported_.erase(it) : std::next(it);
+  }
   if (confirmed.empty()) return changes;
 
   // 3. Group by 26-connectivity, in sorted order so that the result is deterministic.
@@ -104,14 +113,15 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
   for (const Key& seed : seeds) {
     if (!grouped.insert(seed).second) continue;
     ChangeRegion region;
-    int off_surface = 0;
+    int off_surface_appeared = 0, off_surface_vanished = 0;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
     Eigen::Vector3d hi = -lo;
     std::vector<Key> stack = {seed};
     while (!stack.empty()) {
       const Key key = stack.back();
       stack.pop_back();
-      (confirmed.at(key) ? region.appeared : region.vanished).push_back(key);
+      const bool appeared = confirmed.at(key);
+      (appeared ? region.appeared : region.vanished).push_back(key);
       const Eigen::Vector3d c = map.centre(key);
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
@@ -119,14 +129,17 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
       for_each_neighbour(key, [&](const Key& n) {
         if (confirmed.count(n) != 0) {
           if (grouped.insert(n).second) stack.push_back(n);
-        } else if (!touches_unchanged_surface && pending_.count(n) == 0 &&
+        } else if (!touches_unchanged_surface && pending_.count(n) == 0 && reported_.count(n) == 0 &&
                    map.state(n) == VoxelState::occupied) {
           touches_unchanged_surface = true;
         }
       });
-      if (!touches_unchanged_surface) ++off_surface;
+      if (!touches_unchanged_surface) ++(appeared ? off_surface_appeared : off_surface_vanished);
     }
-    if (off_surface < config_.min_voxels) continue;  // surface jitter
+    // Counted per kind: a surface voxel that jitters to its neighbour is one vanished and one appeared voxel,
+    // which together are not an object arriving or leaving.
+    if (std::max(off_surface_appeared, off_surface_vanished) < config_.min_voxels) continue;  // jitter
+    for (const Key& key : region.appeared) reported_.emplace(key, sweep_);
     std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
     std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
     region.min_C = lo.array() - half - config_.margin;

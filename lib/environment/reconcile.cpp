@@ -39,14 +39,16 @@ bool box_inside(const Box& inner, const Box& outer, double tolerance) {
 }
 
 std::vector<std::uint64_t> boxes_touched(const std::vector<Box>& previous,
-                                         const std::vector<Eigen::Vector3d>& changed_C) {
+                                         const std::vector<Eigen::Vector3d>& changed_C, double min_share) {
   std::vector<std::uint64_t> ids;
   for (const Box& box : previous) {
     const Region bounds = bounds_of(box);
-    const bool touched = std::any_of(changed_C.begin(), changed_C.end(), [&](const Eigen::Vector3d& p) {
+    const auto inside = std::count_if(changed_C.begin(), changed_C.end(), [&](const Eigen::Vector3d& p) {
       return bounds.contains(p) && box.contains(p);
     });
-    if (touched) ids.push_back(box.id);
+    if (inside > 0 && static_cast<double>(inside) >= min_share * static_cast<double>(box.points)) {
+      ids.push_back(box.id);
+    }
   }
   return ids;
 }

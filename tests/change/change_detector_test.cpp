@@ -52,12 +52,13 @@ Sweep sweep_of(const std::vector<AlignedBox>& scene, const PinholeIntrinsics& ca
 }
 
 TEST(ChangeConfigTest, ReadsKeysAndNamesBadOnes) {
-  YamlMap root =
-      YamlMap::parse("change:\n  persist_sweeps: 5\n  margin: 0.1\n  min_voxels: 3\n", "cell.yaml");
+  YamlMap root = YamlMap::parse(
+      "change:\n  persist_sweeps: 5\n  margin: 0.1\n  min_voxels: 3\n  settle_sweeps: 7\n", "cell.yaml");
   const ChangeConfig c = ChangeConfig::from_yaml(root.child("change"));
   EXPECT_EQ(c.persist_sweeps, 5);
   EXPECT_DOUBLE_EQ(c.margin, 0.1);
   EXPECT_EQ(c.min_voxels, 3);
+  EXPECT_EQ(c.settle_sweeps, 7);
   const ChangeConfig defaults;
   EXPECT_EQ(defaults.persist_sweeps, 3);
   EXPECT_DOUBLE_EQ(defaults.margin, 0.05);
@@ -71,6 +72,8 @@ TEST(ChangeConfigTest, ReadsKeysAndNamesBadOnes) {
             "cell.yaml: change.persist_sweeps: must be an integer in [1, 1000], got 0");
   EXPECT_EQ(error_of([&] { (void)parse("change:\n  margin: -0.1\n"); }),
             "cell.yaml: change.margin: must be in [0, 10], got -0.1");
+  EXPECT_EQ(error_of([&] { (void)parse("change:\n  settle_sweeps: -1\n"); }),
+            "cell.yaml: change.settle_sweeps: must be an integer in [0, 100000], got -1");
   ChangeConfig bad;
   bad.min_voxels = 0;
   EXPECT_EQ(error_of([&] { ChangeDetector{bad}; }),
@@ -95,9 +98,10 @@ TEST(ChangeDetectorTest, ThousandNoiseOnlySweepsGiveNoRegion) {
   X_CS.translate(Eigen::Vector3d(0.003, 0.0, 0.607));
   X_CS.rotate(Eigen::AngleAxisd(-0.9, Eigen::Vector3d::UnitX()));
   const PinholeIntrinsics camera = small_camera(48, 36, 45.0);
-  // The first sweeps show the scene itself, which is a change from the empty map.
+  // The first sweeps show the scene itself, which is a change from the empty map, and for 2 · persist_sweeps
+  // sweeps after that the parts of it that fill in later.
   std::size_t initial = 0;
-  for (int i = 0; i < config.persist_sweeps; ++i) {
+  for (int i = 0; i < 3 * config.persist_sweeps; ++i) {
     initial += detector.update(map.integrate(sweep_of(scene, camera, sigma, &rng, X_CS)), map).regions.size();
   }
   EXPECT_GE(initial, 1u);

@@ -44,6 +44,16 @@ TEST(ReconcileTest, NoiseWithinToleranceGivesNoDelta) {
   EXPECT_EQ(out.next_id, 3u);
 }
 
+TEST(ReconcileTest, BoxesTouchedNeedTheirShareOfChangedVoxels) {
+  std::vector<Box> previous = table_scene();
+  previous[1].points = 40;
+  const Eigen::Vector3d inside = previous[1].center;
+  const std::vector<Eigen::Vector3d> three(3, inside), four(4, inside);
+  EXPECT_EQ(boxes_touched(previous, three), std::vector<std::uint64_t>{2});  // any one suffices by default
+  EXPECT_TRUE(boxes_touched(previous, three, 0.1).empty());                  // 3 < 10 % of 40
+  EXPECT_EQ(boxes_touched(previous, four, 0.1), std::vector<std::uint64_t>{2});
+}
+
 TEST(ReconcileTest, AddedObjectGetsAFreshIdAndTablePatchIsRedundant) {
   const auto previous = table_scene();
   const Box added = make_box(0, {2.0, 1.2, 0.55}, {0.15, 0.1, 0.15});

@@ -27,10 +27,17 @@ struct ChangeConfig final {
   /// no unchanged occupied 26-neighbour (`change.min_voxels`, ≥ 1; default 2). Depth noise only moves a
   /// surface by a voxel, so its flips all touch the surface they belong to and never make a region.
   int min_voxels = 2;
+  /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, ≥ 0; default 15). Read
+  /// by the daemon's pipeline, not by ChangeDetector: a fresh map keeps gaining voxels for a while (surfaces
+  /// seen at grazing angles need several sweeps to collect two hits, flying pixels in unobserved space decay
+  /// slowly), so the first version is one segmentation of the settled map instead of a trickle of small
+  /// versions. 0 = the first sweep makes the first version.
+  int settle_sweeps = 15;
 
   /// @throws Error naming the field if a value is out of range.
   void validate() const;
-  /// Reads the `change` section (keys persist_sweeps, margin, min_voxels; absent keys keep their defaults).
+  /// Reads the `change` section (keys persist_sweeps, margin, min_voxels,
+  /// settle_sweeps; absent keys keep their defaults).
   /// @throws Error naming the key ("change.margin: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static ChangeConfig from_yaml(YamlMap section);
 };
@@ -61,7 +68,10 @@ struct ChangeSet final {
 /// state for `persist_sweeps` sweeps, and dropped if it flips back first. Confirmed voxels of one sweep are
 /// grouped by 26-connectivity; a group is reported when at least `min_voxels` of its voxels have no occupied
 /// 26-neighbour that is itself unchanged (the others are surface jitter; so objects less than 2 voxels tall
-/// on a surface go unreported). A new object placed in observed free space is reported after
+/// on a surface go unreported). Voxels that appeared in a region reported within the last 2 · persist_sweeps
+/// sweeps do not count as unchanged surface, so the parts of a new object that collect their hits a little
+/// later (its sides, seen at grazing angles) are reported too instead of passing for jitter on its top. A
+/// new object placed in observed free space is reported after
 /// `OccupancyConfig::sweeps_to_occupy() + persist_sweeps - 1` sweeps that see it (5 with the defaults), and a
 /// removed one after `OccupancyConfig::sweeps_to_clear() + persist_sweeps - 1` sweeps that see through where
 /// it was (11 with the defaults). The first sweeps report the scene itself as appeared (a change from the
@@ -86,6 +96,8 @@ class ChangeDetector final {
   ChangeConfig config_;
   std::uint64_t sweep_ = 0;
   std::unordered_map<octomap::OcTreeKey, Pending, octomap::OcTreeKey::KeyHash> pending_;
+  // Appeared voxels of reported regions → the sweep they were reported in, for 2 · persist_sweeps sweeps.
+  std::unordered_map<octomap::OcTreeKey, std::uint64_t, octomap::OcTreeKey::KeyHash> reported_;
 };
 
 }  // namespace cellmap

@@ -28,10 +28,12 @@ struct ReconcileOptions final {
 };
 
 /// Ids of the boxes of `previous` that contain at least one of `changed_C` (the centres of voxels whose state
-/// changed, cell frame): the boxes whose own evidence changed, which must be re-fitted. A box merely next to
-/// a change (the table under a new object) is not touched and keeps its id and content.
+/// changed, cell frame), and at least `min_share` · box.points of them: the boxes whose own evidence changed
+/// enough to be re-fitted. A box merely next to a change (the table under a new object) is not touched and
+/// keeps its id and content.
 [[nodiscard]] std::vector<std::uint64_t> boxes_touched(const std::vector<Box>& previous,
-                                                       const std::vector<Eigen::Vector3d>& changed_C);
+                                                       const std::vector<Eigen::Vector3d>& changed_C,
+                                                       double min_share = 0.0);
 
 /// The outcome of one reconciliation.
 struct Reconciled final {
