@@ -81,15 +81,16 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
   }
   std::sort(frames.begin(), frames.end());
   ASSERT_EQ(frames.size(), 3u);
-  // The three frames twice, 1 s apart: a static camera watching for 6 s. A new surface needs two sweeps to
-  // become occupied and three more to be a confirmed change (config/cellmapd.yaml defaults), so the first
-  // version comes at sweep 4 or 5.
+  // The three frames six times, 1 s apart: a static camera watching for 18 s. An empty map publishes its
+  // first version once it has settled (change.settle_sweeps = 15 in config/cellmapd.yaml), so at sweep 15.
+  constexpr int kSweeps = 18;
   const fs::path replay = dir_.path() / "replay";
   fs::create_directories(replay);
   {
     std::ofstream poses(replay / "poses.csv");
     poses << "file,stamp,x,y,z,qw,qx,qy,qz\n";
-    for (int i = 0; i < 6; ++i) poses << frames[i % 3].string() << "," << 100 + i << "," << kToolPose << "\n";
+    for (int i = 0; i < kSweeps; ++i)
+      poses << frames[i % 3].string() << "," << 100 + i << "," << kToolPose << "\n";
   }
   const std::string yaml =
       "cell: replay\nsweep_period: 0\nstatus_period: 0.2\nsource:\n  kind: replay\n"
@@ -97,10 +98,11 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
 
   const dds::Participant participant(kReplayDomain);
   transport::EnvironmentSubscriber planner(participant, "replay");
-  auto daemon = start_daemon(yaml, kReplayDomain, 6);
+  auto daemon = start_daemon(yaml, kReplayDomain, kSweeps);
   EXPECT_TRUE(planner.wait_for_version(1, kPatience)) << "no version published from the replay";
   const int status = daemon->wait();
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "cellmapd --sweeps 6 did not exit cleanly";
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+      << "cellmapd --sweeps " << kSweeps << " did not exit cleanly";
 
   // The persisted environment, as a restarted daemon would resume it.
   const Environment env = VersionStore(state_dir(), "replay").recovered().environment;
