@@ -71,4 +71,4 @@ install(CODE "set(CELLMAPD_UNIT_IN [[${PROJECT_SOURCE_DIR}/scripts/cellmapd.serv
   set(CELLMAPD_BINDIR [[${CMAKE_INSTALL_BINDIR}]])
   set(CELLMAPD_SYSCONFDIR [[${CMAKE_INSTALL_SYSCONFDIR}]])")
 install(SCRIPT ${PROJECT_SOURCE_DIR}/cmake/InstallUnit.cmake)
-install(FILES ${PROJECT_BINARY_DIR}/cellmapd.service DESTINATION ${CMAKE_INSTALL_LIBDIR}/systemd/system)
+install(FILES ${PROJECT_BINARY_DIR}/cellmapd.service DESTINATION lib/systemd/system)  # where systemd looks; never the multiarch libdir

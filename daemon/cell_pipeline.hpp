@@ -49,8 +49,9 @@ class CellPipeline final {
   SweepReport process(const Sweep& sweep);
 
   /// The incremental step of process(), without applying it: re-segments the occupied evidence inside the
-  /// regions of `changes` and inside every current box that holds a changed voxel, leaving out what the other
-  /// boxes cover, and reconciles the result with the current boxes. `evidence` (if given) receives the number
+  /// regions of `changes`, inside every current box that lost at least a tenth of its voxels, and inside
+  /// every box lying wholly within that area, leaving out what the other boxes cover, and reconciles the
+  /// result with the current boxes. `evidence` (if given) receives the number
   /// of voxels re-segmented. Repeatable (used to measure it).
   [[nodiscard]] Reconciled resegment(const ChangeSet& changes, std::size_t* evidence = nullptr) const;
 

@@ -107,8 +107,14 @@ class Daemon {
 
   void run(const Signals& signals) {
     std::thread acquisition([this] {
-      acquire();
-      acquisition_done_ = true;
+      try {
+        acquire();
+        acquisition_done_ = true;
+      } catch (const std::exception& e) {
+        // Degrade, don't die: the last environment stays published and the status says why.
+        spdlog::error("sweep source stopped: {}; keeping version {}", e.what(), current_version_.load());
+        set_sensor_state(std::string("error: ") + e.what());
+      }
     });
     std::thread processing([this] { process(); });
     while (!stop_) {
@@ -193,6 +199,8 @@ class Daemon {
         mailbox_.put(std::move(sweep));
         if (options_.max_sweeps > 0 && ++acquired_ >= options_.max_sweeps) return;
       }
+      // --sweeps N on a recording shorter than N sweeps ends with the recording (its last sweep was flushed).
+      if (options_.max_sweeps > 0 && camera_->status().state == SourceState::kEnded) return;
       camera_dropped_ = camera_->dropped_frames();
       const std::string state = camera_->sensor_state();
       if (state != reported) {
@@ -248,11 +256,13 @@ class Daemon {
     auto next_status = Clock::now();
     std::uint64_t processed = 0;
     for (;;) {
+      // Read before take(): a sweep put just before acquisition ended is then still taken.
+      const bool acquisition_was_done = acquisition_done_;
       std::optional<Sweep> sweep = mailbox_.take(std::chrono::milliseconds(100));
       if (sweep) {
         handle(*sweep, ++processed);
         if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
-      } else if (stop_ || acquisition_done_) {
+      } else if (stop_ || acquisition_was_done) {
         // With --sweeps, acquisition ends after N sweeps; some may have been replaced in the mailbox, so
         // processing ends when the mailbox is empty, not only after N.
         stop_ = true;

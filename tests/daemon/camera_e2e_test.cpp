@@ -164,6 +164,7 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
   EXPECT_EQ(degraded->sweeps, 0u);
   // Still running (and still reporting) a while later: retrying with back-off, not exiting.
   std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(daemon->running()) << "cellmapd exited without a device";
   const auto later = wait_for_status(reader, "no-device",
                                      [](const transport::CellStatus& s) { return s.state == "degraded"; });
   ASSERT_TRUE(later.has_value()) << "the daemon stopped reporting";

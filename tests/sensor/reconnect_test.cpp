@@ -74,8 +74,10 @@ TEST(ReconnectorTest, ErrorIsFinalUntilClosed) {
 }
 
 TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
+  // Times with room for a stalled, shared CI machine: the attempt is due 1 s after the loss, the waits are
+  // 20 ms (too short) and 5 s (cut at the attempt).
   ReconnectPolicy p = policy();
-  p.initial_backoff = 0.2;
+  p.initial_backoff = 1.0;
   Reconnector r(p);
   r.lost(steady_seconds(), "unplugged");
   int attempts = 0;
@@ -88,12 +90,12 @@ TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
   r.retry_or_wait(std::chrono::milliseconds(20), connect);  // not due: waits out the 20 ms, no attempt
   EXPECT_EQ(attempts, 0);
   EXPECT_GE(steady_seconds() - start, 0.019);
-  while (attempts == 0 && steady_seconds() - start < 10.0)
-    r.retry_or_wait(std::chrono::milliseconds(1000), connect);
+  while (attempts == 0 && steady_seconds() - start < 20.0)
+    r.retry_or_wait(std::chrono::milliseconds(5000), connect);
   EXPECT_EQ(attempts, 1);
-  // The wait was cut at the attempt time (0.2 s), not the 1 s timeout.
-  EXPECT_LT(steady_seconds() - start, 0.2 + 0.5);
-  EXPECT_DOUBLE_EQ(r.backoff(), 0.8);  // 0.2 → 0.4 after the first loss, 0.8 after the failed retry
+  // The wait was cut at the attempt time (1 s), not the 5 s timeout.
+  EXPECT_LT(steady_seconds() - start, 4.0);
+  EXPECT_DOUBLE_EQ(r.backoff(), 4.0);  // 1 → 2 after the first loss, 4 (the cap) after the failed retry
 }
 
 TEST(ReconnectorTest, RefusesBadPolicies) {

@@ -75,6 +75,14 @@ class ChildProcess {
     if (pid_ > 0) ::kill(pid_, sig);
   }
 
+  /// True while the child has not ended (it is not reaped: wait() still returns its status).
+  [[nodiscard]] bool running() const {
+    if (pid_ <= 0) return false;
+    siginfo_t info{};
+    if (::waitid(P_PID, static_cast<id_t>(pid_), &info, WEXITED | WNOHANG | WNOWAIT) != 0) return false;
+    return info.si_pid == 0;
+  }
+
   /// Waits for the child to end; returns its wait status.
   int wait() {
     int status = 0;

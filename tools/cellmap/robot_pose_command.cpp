@@ -56,7 +56,7 @@ void publish(const RobotPoseOptions& options) {
     writer.write(state);
     ++sent;
   }
-  writer.wait_for_acks(wait);
+  if (!writer.wait_for_acks(wait)) throw Error("robot-pose: the daemon did not acknowledge the poses");
   std::cout << "sent " << sent << " poses" << std::endl;
 }
 

@@ -23,9 +23,10 @@ struct ChangeConfig final {
   int persist_sweeps = 3;
   /// Metres added on every side of a region's bounds (`change.margin`, ≥ 0; default 0.05).
   double margin = 0.05;
-  /// A region is reported only when at least this many of its voxels lie off the unchanged surface, i.e. have
-  /// no unchanged occupied 26-neighbour (`change.min_voxels`, ≥ 1; default 2). Depth noise only moves a
-  /// surface by a voxel, so its flips all touch the surface they belong to and never make a region.
+  /// A region is reported only when at least this many of its appeared voxels, or of its vanished ones, lie
+  /// off the unchanged surface, i.e. have no unchanged occupied 26-neighbour (`change.min_voxels`, ≥ 1;
+  /// default 2 here, 3 in cellmapd's config). Depth noise mostly moves a surface by a voxel, so its flips
+  /// touch the surface they belong to and do not make a region.
   int min_voxels = 2;
   /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, ≥ 0; default 15). Read
   /// by the daemon's pipeline, not by ChangeDetector: a fresh map keeps gaining voxels for a while (surfaces
@@ -67,11 +68,11 @@ struct ChangeSet final {
 /// A voxel that flips becomes pending with the state it had before; it is confirmed once it has held its new
 /// state for `persist_sweeps` sweeps, and dropped if it flips back first. Confirmed voxels of one sweep are
 /// grouped by 26-connectivity; a group is reported when at least `min_voxels` of its voxels have no occupied
-/// 26-neighbour that is itself unchanged (the others are surface jitter; so objects less than 2 voxels tall
-/// on a surface go unreported). Voxels that appeared in a region reported within the last 2 · persist_sweeps
-/// sweeps do not count as unchanged surface, so the parts of a new object that collect their hits a little
-/// later (its sides, seen at grazing angles) are reported too instead of passing for jitter on its top. A
-/// new object placed in observed free space is reported after
+/// 26-neighbour that is itself unchanged (the others are surface jitter; so objects smaller than
+/// `min_voxels` voxels off a surface go unreported). Voxels that appeared in a region reported within the
+/// last 2 · persist_sweeps sweeps do not count as unchanged surface, so the parts of a new object that
+/// collect their hits a little later (its sides, seen at grazing angles) are reported too instead of passing
+/// for jitter on its top. A new object placed in observed free space is reported after
 /// `OccupancyConfig::sweeps_to_occupy() + persist_sweeps - 1` sweeps that see it (5 with the defaults), and a
 /// removed one after `OccupancyConfig::sweeps_to_clear() + persist_sweeps - 1` sweeps that see through where
 /// it was (11 with the defaults). The first sweeps report the scene itself as appeared (a change from the

@@ -19,7 +19,8 @@ namespace cellmap {
 /// How frames are grouped into sweeps. Seconds.
 struct SweepGrouping final {
   /// A sweep spans at most this much frame time: a frame stamped at or after the sweep's first stamp + period
-  /// closes the sweep and starts the next one (0: every frame is its own sweep).
+  /// closes the sweep and starts the next one (0: every frame is its own sweep, handed out when the next
+  /// frame arrives or the source stops streaming).
   double period = 0.5;
   /// A sweep also closes once it holds this many frames (0: no limit).
   std::size_t max_frames = 0;

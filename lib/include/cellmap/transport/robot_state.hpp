@@ -19,7 +19,8 @@ class RobotStateWriter final {
   explicit RobotStateWriter(const dds::Participant& participant);
   /// True once at least one robot-state reader (a daemon) matched, false on timeout.
   bool wait_for_reader(std::chrono::nanoseconds timeout) const;
-  /// The rotation is sent as a quaternion of X_CE.linear(), which must be a rotation matrix.
+  /// The rotation is sent as a quaternion of X_CE.linear(), which must be a rotation matrix: a scaled one
+  /// is sent as a non-unit quaternion, which every reader rejects and counts.
   /// @throws Error if the cell is empty, the pose is not finite, or the write fails.
   void write(const RobotState& state) const;
   /// True once every matched reader acknowledged everything written, false on timeout.
@@ -42,8 +43,6 @@ class RobotStateReader final {
   /// Malformed samples (empty cell, non-finite numbers, non-unit quaternion) are skipped and counted.
   std::vector<RobotState> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
-  /// How many writers (robot controllers) are matched right now.
-  [[nodiscard]] std::uint32_t matched_writers() const { return reader_.matched_writers(); }
 
  private:
   std::string cell_;
