@@ -153,6 +153,15 @@ Versions run(Cell& cell, int sweeps) {
   return v;
 }
 
+// Plants the test's box (0.2 × 0.16 × 0.24 m) standing at `at` and runs 15 sweeps: it must arrive as one
+// added id, which is returned (0 on failure, recorded by the test).
+std::uint64_t plant(Cell& cell, const Eigen::Vector3d& at) {
+  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
+  const Versions add = run(cell, 15);
+  EXPECT_EQ(add.added.size(), 1u);
+  return add.added.empty() ? 0 : add.added[0];
+}
+
 // Boxes of `before` farther than `distance` from `p_C` are in `after` unchanged.
 void expect_far_boxes_kept(const std::vector<Box>& before, const std::vector<Box>& after,
                            const Eigen::Vector3d& p_C, double distance) {
@@ -200,10 +209,8 @@ TEST(CellPipelineTest, FarMoveIsOneRemovedAndOneAdded) {
   Cell cell(coarse_cell());
   settle(cell);
   const Eigen::Vector3d at(1.9, 0.7, 0.87), lift(0, 0, 0.11);
-  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
-  const Versions add = run(cell, 15);
-  ASSERT_EQ(add.added.size(), 1u);
-  const std::uint64_t planted_id = add.added[0];
+  const std::uint64_t planted_id = plant(cell, at);
+  ASSERT_NE(planted_id, 0u);
 
   // 1.2 m away, no overlap with the old box: documented as one removed and one added id (the new place is
   // confirmed after 5–6 sweeps, the old one cleared after 11).
@@ -226,10 +233,8 @@ TEST(CellPipelineTest, SmallMoveKeepsTheIdAndEndsAsOneBox) {
   Cell cell(coarse_cell());
   settle(cell);
   const Eigen::Vector3d at(1.9, 0.7, 0.87), lift(0, 0, 0.11);
-  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
-  const Versions add = run(cell, 15);
-  ASSERT_EQ(add.added.size(), 1u);
-  const std::uint64_t planted_id = add.added[0];
+  const std::uint64_t planted_id = plant(cell, at);
+  ASSERT_NE(planted_id, 0u);
   const std::vector<Box> before_move = cell.pipeline().boxes();
 
   // 5 cm along x (bounds IoU with the old box ≈ 0.6 ≥ reconcile.min_overlap): documented as the same id,
