@@ -166,19 +166,19 @@ BatchScene make_batch_scene(int n_env) {
   return scene;
 }
 
+// The environment sizes the batch benchmarks run at.
+void environment_sizes(benchmark::internal::Benchmark* b) {
+  b->ArgName("n_env")->Unit(benchmark::kMicrosecond);
+  for (int n : {10, 50, 200, 1000}) b->Arg(n);
+}
+
 void BM_BatchDense(benchmark::State& state) {
   const BatchScene scene = make_batch_scene(static_cast<int>(state.range(0)));
   for (auto _ : state)
     benchmark::DoNotOptimize(cellmap::collision::constraints(scene.robot, scene.environment));
   state.counters["n_constr"] = 6.0 * 100 * state.range(0);
 }
-BENCHMARK(BM_BatchDense)
-    ->ArgName("n_env")
-    ->Arg(10)
-    ->Arg(50)
-    ->Arg(200)
-    ->Arg(1000)
-    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BatchDense)->Apply(environment_sizes);
 
 // Broad phase with a 0.3 m cutoff; the tree is built once per environment version, outside the loop.
 void BM_BatchBroadPhase(benchmark::State& state) {
@@ -192,13 +192,7 @@ void BM_BatchBroadPhase(benchmark::State& state) {
   }
   state.counters["evaluated"] = static_cast<double>(evaluated);
 }
-BENCHMARK(BM_BatchBroadPhase)
-    ->ArgName("n_env")
-    ->Arg(10)
-    ->Arg(50)
-    ->Arg(200)
-    ->Arg(1000)
-    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BatchBroadPhase)->Apply(environment_sizes);
 
 void BM_BoxTreeBuild(benchmark::State& state) {
   const BatchScene scene = make_batch_scene(static_cast<int>(state.range(0)));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <tuple>
+#include <utility>
 
 #include "cellmap/common/error.hpp"
 #include "occupancy/box_scene.hpp"
@@ -49,6 +50,19 @@ Sweep one_scan(const Eigen::Isometry3d& X_CS, int width = 96, int height = 72) {
   return sweep;
 }
 
+// OctoMap's own keys for a sweep: computeDiscreteUpdate per scan, united, occupied winning over free.
+std::pair<octomap::KeySet, octomap::KeySet> octomap_sweep_update(const Sweep& sweep, octomap::OcTree& tree) {
+  octomap::KeySet free, occupied;
+  for (const Scan& scan : sweep.scans) {
+    octomap::KeySet scan_free, scan_occupied;
+    tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), scan_free, scan_occupied, 5.0);
+    free.insert(scan_free.begin(), scan_free.end());
+    occupied.insert(scan_occupied.begin(), scan_occupied.end());
+  }
+  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  return {free, occupied};
+}
+
 TEST(KeyUpdateTest, EqualsOctomapsDiscreteUpdateForOneScan) {
   octomap::OcTree tree(0.04);
   for (const Eigen::Isometry3d& X_CS : {Eigen::Isometry3d::Identity(), tilted_pose()}) {
@@ -82,14 +96,7 @@ TEST(KeyUpdateTest, SeveralScansUniteWithOccupiedWinning) {
   octomap::OcTree tree(0.04);
   Sweep sweep = one_scan(Eigen::Isometry3d::Identity(), 80, 60);
   sweep.scans.push_back(one_scan(tilted_pose(), 80, 60).scans[0]);
-  octomap::KeySet free, occupied;
-  for (const Scan& scan : sweep.scans) {
-    octomap::KeySet scan_free, scan_occupied;
-    tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), scan_free, scan_occupied, 5.0);
-    free.insert(scan_free.begin(), scan_free.end());
-    occupied.insert(scan_occupied.begin(), scan_occupied.end());
-  }
-  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  const auto [free, occupied] = octomap_sweep_update(sweep, tree);
   const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 2);
   EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
   EXPECT_EQ(ours.free_keys(), sorted(free));
@@ -108,14 +115,7 @@ TEST(KeyUpdateTest, HugeSweepBoxFallsBackToSortingWithSameResult) {
     }
     sweep.scans.push_back(scan);
   }
-  octomap::KeySet free, occupied;
-  for (const Scan& scan : sweep.scans) {
-    octomap::KeySet scan_free, scan_occupied;
-    tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), scan_free, scan_occupied, 5.0);
-    free.insert(scan_free.begin(), scan_free.end());
-    occupied.insert(scan_occupied.begin(), scan_occupied.end());
-  }
-  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  const auto [free, occupied] = octomap_sweep_update(sweep, tree);
   const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 2);
   EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
   EXPECT_EQ(ours.free_keys(), sorted(free));
