@@ -42,7 +42,11 @@ install(TARGETS cellmap cellmap_client cellmap_pcl cellmap_idl ${CELLMAP_STAGES}
         EXPORT cellmapTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/lib/include/cellmap DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# Each stage's public headers (its include/ folder; internal headers beside the sources stay behind).
+foreach(stage IN LISTS CELLMAP_STAGES)
+  get_target_property(stage_dir ${stage} SOURCE_DIR)
+  install(DIRECTORY ${stage_dir}/include/cellmap DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endforeach()
 # The DDS types for programs that read the topics without the client library (other vendors, ROS 2 tools).
 install(FILES ${PROJECT_SOURCE_DIR}/idl/cellmap.idl ${PROJECT_BINARY_DIR}/idl/cellmap.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cellmap/idl)
