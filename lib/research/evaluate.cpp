@@ -1,4 +1,4 @@
-#include "cellmap/sim/evaluate.hpp"
+#include "cellmap/research/evaluate.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
-#include "cellmap/planning/paper_figure.hpp"
+#include "cellmap/research/paper_figure.hpp"
 #include "commands.hpp"
 
 namespace cellmap::cli {

@@ -14,9 +14,9 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/research/evaluate.hpp"
 #include "cellmap/segment/pipeline.hpp"
 #include "cellmap/sim/default_scene.hpp"
-#include "cellmap/sim/evaluate.hpp"
 #include "cellmap/sim/simulator.hpp"
 #include "cellmap/sweep/sweep.hpp"
 #include "commands.hpp"

@@ -5,8 +5,8 @@
 
 #include <unordered_map>
 
-#include "cellmap/boxes/fit.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/segment/fit.hpp"
 
 namespace cellmap {
 namespace {

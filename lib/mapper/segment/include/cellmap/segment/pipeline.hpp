@@ -7,12 +7,12 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
-#include "cellmap/boxes/fit.hpp"
 #include "cellmap/common/cloud.hpp"
 #include "cellmap/common/yaml_map.hpp"
 #include "cellmap/preprocess/outlier_removal.hpp"
 #include "cellmap/preprocess/workspace.hpp"
 #include "cellmap/segment/convex_merge.hpp"
+#include "cellmap/segment/fit.hpp"
 #include "cellmap/segment/region_growing.hpp"
 #include "cellmap/segment/supervoxel_split.hpp"
 

@@ -1,4 +1,4 @@
-#include "cellmap/planning/paper_figure.hpp"
+#include "cellmap/research/paper_figure.hpp"
 
 #include <gtest/gtest.h>
 

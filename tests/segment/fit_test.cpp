@@ -1,4 +1,4 @@
-#include "cellmap/boxes/fit.hpp"
+#include "cellmap/segment/fit.hpp"
 
 #include <gtest/gtest.h>
 
