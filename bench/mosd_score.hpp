@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 
 namespace cellmap::mosd {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sensor/depth_source.hpp"
-#include "cellmap/sensor/pose_buffer.hpp"
 #include "cellmap/sweep/sweep_assembler.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "daemon_config.hpp"

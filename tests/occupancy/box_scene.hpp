@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
 namespace cellmap::testing {

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 
 namespace cellmap::test {
 

@@ -13,8 +13,8 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sensor/depth_io.hpp"
-#include "cellmap/sensor/pose_buffer.hpp"
 #include "cellmap/sensor/replay_source.hpp"
 
 namespace cellmap {

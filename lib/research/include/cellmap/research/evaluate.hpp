@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 #include "cellmap/sim/scene.hpp"
 
 namespace cellmap::sim {

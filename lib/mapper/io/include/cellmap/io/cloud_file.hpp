@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 
 namespace cellmap {
 

@@ -7,7 +7,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 
 namespace cellmap {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Object-level merging: join segments across convex edges, keep concave edges as splits (LCCP's criterion).
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/neighbourhoods.hpp"
 #include "cellmap/segment/segments.hpp"
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
-#include "cellmap/common/cloud.hpp"
 #include "cellmap/common/yaml_map.hpp"
+#include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/outlier_removal.hpp"
 #include "cellmap/preprocess/workspace.hpp"
 #include "cellmap/segment/convex_merge.hpp"

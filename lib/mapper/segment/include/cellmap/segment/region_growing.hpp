@@ -1,7 +1,7 @@
 #pragma once
 // Region growing segmentation (paper Alg. 1) and the coverage of the points it leaves over.
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/neighbourhoods.hpp"
 #include "cellmap/segment/segments.hpp"
 

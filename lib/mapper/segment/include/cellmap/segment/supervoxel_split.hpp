@@ -1,7 +1,7 @@
 #pragma once
 // Splitting oversized segments into VCCS supervoxels (paper fig. 3/4).
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 #include "cellmap/segment/segments.hpp"
 
 namespace cellmap {

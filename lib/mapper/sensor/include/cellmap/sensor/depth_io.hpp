@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 
 namespace cellmap {
 

@@ -33,8 +33,8 @@
 #include <string>
 #include <vector>
 
+#include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sensor/depth_source.hpp"
-#include "cellmap/sensor/pose_buffer.hpp"
 
 namespace cellmap {
 

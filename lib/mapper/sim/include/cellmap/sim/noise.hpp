@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/sim/scene.hpp"
 
 namespace cellmap::sim {

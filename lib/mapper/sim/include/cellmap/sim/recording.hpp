@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
 namespace cellmap::sim {

@@ -10,8 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
-#include "cellmap/sensor/frame.hpp"
 
 namespace cellmap::sim {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/sim/noise.hpp"
 #include "cellmap/sim/ray_cast.hpp"
 #include "cellmap/sim/scene.hpp"

@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "cellmap/common/cloud.hpp"
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/cloud.hpp"
+#include "cellmap/frame/frame.hpp"
 
 namespace cellmap {
 

@@ -10,8 +10,8 @@
 #include <deque>
 #include <vector>
 
-#include "cellmap/sensor/frame.hpp"
-#include "cellmap/sensor/pose_buffer.hpp"
+#include "cellmap/frame/frame.hpp"
+#include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
 namespace cellmap {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cellmap/common/cloud.hpp"
+#include "cellmap/frame/cloud.hpp"
 
 namespace cellmap {
 

@@ -1,4 +1,4 @@
-#include "cellmap/sensor/pose_buffer.hpp"
+#include "cellmap/frame/pose_buffer.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// Robot pose input of the sensor stage: stamped end-effector poses, interpolated to frame times, and the
+// Robot pose input of the map maker: stamped end-effector poses, interpolated to frame times, and the
 // composition X_CS = X_CE * X_ES that gives every frame its sensor pose.
 
 #include <Eigen/Geometry>
@@ -9,8 +9,8 @@
 #include <deque>
 #include <mutex>
 
+#include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
-#include "cellmap/sensor/frame.hpp"
 
 namespace cellmap {
 

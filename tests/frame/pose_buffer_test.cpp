@@ -1,5 +1,5 @@
 // Robot pose input: interpolation to frame times and the drop-without-pose rule.
-#include "cellmap/sensor/pose_buffer.hpp"
+#include "cellmap/frame/pose_buffer.hpp"
 
 #include <gtest/gtest.h>
 

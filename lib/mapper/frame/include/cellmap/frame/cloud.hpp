@@ -1,5 +1,5 @@
 #pragma once
-// The point cloud type every stage exchanges.
+// The point cloud type the map-making stages exchange (PCL; the planner's client never sees it).
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

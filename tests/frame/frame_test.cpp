@@ -1,4 +1,4 @@
-#include "cellmap/sensor/frame.hpp"
+#include "cellmap/frame/frame.hpp"
 
 #include <gtest/gtest.h>
 
