@@ -3,7 +3,7 @@
 #include <set>
 
 #include "cellmap/common/atomic_file.hpp"
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap::daemon {
 namespace {
@@ -44,7 +44,7 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   c.noise = section.get<bool>("noise", c.noise);
 
   c.camera.name = c.sensor;
-  c.camera.X_ES = read_pose_yaml(section.child("X_ES"));
+  c.camera.X_ES = section.pose("X_ES");
   c.camera.pose_tolerance = section.number("pose_tolerance", c.camera.pose_tolerance, 1e-6, 10.0);
   c.grouping.period = sweep_period;
   c.grouping.max_frames = static_cast<std::size_t>(section.integer("sweep_frames", 0, 0, 100000));

@@ -13,7 +13,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap {
 namespace {

@@ -6,25 +6,6 @@
 
 namespace cellmap {
 
-Eigen::Isometry3d read_pose_yaml(YamlMap map) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  if (map.has("translation")) {
-    const auto t = map.require<std::vector<double>>("translation");
-    if (t.size() != 3) map.fail("translation", "must be [x, y, z]");
-    X.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
-  }
-  if (map.has("rotation")) {
-    const auto r = map.require<std::vector<double>>("rotation");
-    if (r.size() != 4) map.fail("rotation", "must be a quaternion [w, x, y, z]");
-    const Eigen::Quaterniond q(r[0], r[1], r[2], r[3]);
-    if (std::abs(q.norm() - 1.0) > 1e-3) map.fail("rotation", "must be a unit quaternion [w, x, y, z]");
-    X.linear() = q.normalized().toRotationMatrix();
-  }
-  if (!X.matrix().allFinite()) map.fail("translation", "must be finite");
-  map.expect_all_read();
-  return X;
-}
-
 namespace {
 
 DepthMode read_mode(YamlMap& map, const DepthMode& fallback) {
@@ -130,7 +111,7 @@ SensorConfig read_sensor_config(YamlMap& map, const std::string& name) {
   SensorConfig config;
   config.name = name;
   const std::string source = map.require<std::string>("source");
-  config.X_ES = read_pose_yaml(map.child("X_ES"));
+  config.X_ES = map.pose("X_ES");
   config.pose_tolerance = map.number("pose_tolerance", config.pose_tolerance, 1e-6, 10.0);
   if (source == "openni2") {
     config.source = read_openni2_config(map.child("openni2"), name);

@@ -8,7 +8,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -29,24 +29,8 @@ bool all_finite(const Eigen::Isometry3d& X) {
 
 // ---- YAML helpers: every failure names the key through YamlMap::fail.
 
-std::vector<double> numbers(YamlMap& map, const std::string& key, std::size_t count) {
-  const std::vector<double> values = map.require<std::vector<double>>(key);
-  if (count != 0 && values.size() != count) {
-    map.fail(key, "must have " + std::to_string(count) + " numbers, got " + std::to_string(values.size()));
-  }
-  for (double v : values) {
-    if (!std::isfinite(v)) map.fail(key, "must be finite numbers");
-  }
-  return values;
-}
-
-Eigen::Vector3d vec3(YamlMap& map, const std::string& key) {
-  const std::vector<double> v = numbers(map, key, 3);
-  return {v[0], v[1], v[2]};
-}
-
 Eigen::Vector3d positive_vec3(YamlMap& map, const std::string& key) {
-  const Eigen::Vector3d v = vec3(map, key);
+  const Eigen::Vector3d v = map.vector3(key);
   if (!(v.array() > 0).all()) map.fail(key, "must be positive, got " + format_vector(v));
   return v;
 }
@@ -59,24 +43,6 @@ double positive(YamlMap& map, const std::string& key) {
     map.fail(key, reason.str());
   }
   return value;
-}
-
-Eigen::Quaterniond quaternion(YamlMap& map, const std::string& key) {
-  const std::vector<double> v = numbers(map, key, 4);
-  Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
-  if (std::abs(q.norm() - 1.0) > 1e-3) {
-    map.fail(key, "must be a unit quaternion [w, x, y, z] (norm " + std::to_string(q.norm()) + ")");
-  }
-  return q.normalized();
-}
-
-// A pose map: {position: [x, y, z], rotation: [w, x, y, z]}, both optional.
-Eigen::Isometry3d pose(YamlMap map) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  if (map.has("position")) X.translation() = vec3(map, "position");
-  if (map.has("rotation")) X.linear() = quaternion(map, "rotation").toRotationMatrix();
-  map.expect_all_read();
-  return X;
 }
 
 Obstacle read_obstacle(YamlMap map) {
@@ -99,13 +65,13 @@ Obstacle read_obstacle(YamlMap map) {
     obstacle.shape = SphereShape{positive(sphere, "radius")};
     sphere.expect_all_read();
   }
-  obstacle.X_CO.translation() = vec3(map, "center");
+  obstacle.X_CO.translation() = map.vector3("center");
   if (map.has("yaw") && map.has("rotation")) map.fail("yaw", "give either yaw or rotation, not both");
   if (map.has("yaw")) {
     const double yaw = map.number("yaw", 0.0, -2 * kPi, 2 * kPi);
     obstacle.X_CO.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   } else if (map.has("rotation")) {
-    obstacle.X_CO.linear() = quaternion(map, "rotation").toRotationMatrix();
+    obstacle.X_CO.linear() = map.unit_quaternion("rotation").toRotationMatrix();
   }
   map.expect_all_read();
   return obstacle;
@@ -115,10 +81,10 @@ Robot read_robot(YamlMap map, const std::string& base_dir) {
   if (map.has("gantry") == map.has("urdf")) map.fail("gantry", "exactly one of gantry, urdf is required");
   if (map.has("gantry")) {
     YamlMap gantry = map.child("gantry");
-    const Eigen::Vector3d lower = vec3(gantry, "lower");
-    const Eigen::Vector3d upper = vec3(gantry, "upper");
+    const Eigen::Vector3d lower = gantry.vector3("lower");
+    const Eigen::Vector3d upper = gantry.vector3("upper");
     if (!(lower.array() <= upper.array()).all()) gantry.fail("upper", "must be >= lower on every axis");
-    const Eigen::Isometry3d X_CE_zero = pose(gantry.child("tool_at_zero"));
+    const Eigen::Isometry3d X_CE_zero = gantry.pose("tool_at_zero");
     gantry.expect_all_read();
     map.expect_all_read();
     return Robot::gantry(lower, upper, X_CE_zero);
@@ -127,14 +93,14 @@ Robot read_robot(YamlMap map, const std::string& base_dir) {
   std::filesystem::path file = urdf.require<std::string>("file");
   if (file.is_relative()) file = std::filesystem::path(base_dir) / file;
   const std::string tool_link = urdf.require<std::string>("tool_link");
-  const Eigen::Isometry3d X_C_root = pose(urdf.child("base"));
+  const Eigen::Isometry3d X_C_root = urdf.pose("base");
   urdf.expect_all_read();
   map.expect_all_read();
   return Robot::from_urdf_file(file.string(), tool_link, X_C_root);
 }
 
 Eigen::VectorXd joint_vector(YamlMap& map, const std::string& key, int dof) {
-  const std::vector<double> v = numbers(map, key, static_cast<std::size_t>(dof));
+  const std::vector<double> v = map.numbers(key, static_cast<std::size_t>(dof));
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
@@ -169,7 +135,7 @@ SweepPlan read_plan(YamlMap map, int dof) {
     YamlMap grid = map.child("grid");
     const Eigen::VectorXd from = joint_vector(grid, "from", dof);
     const Eigen::VectorXd to = joint_vector(grid, "to", dof);
-    const std::vector<double> counts = numbers(grid, "counts", static_cast<std::size_t>(dof));
+    const std::vector<double> counts = grid.numbers("counts", static_cast<std::size_t>(dof));
     std::vector<long> n(counts.size());
     long total = 1;
     for (std::size_t j = 0; j < counts.size(); ++j) {
@@ -240,7 +206,7 @@ SensorSpec read_sensor(YamlMap map, int dof) {
   } catch (const Error& e) {
     map.fail("model", e.what());
   }
-  s.X_ES = pose(map.child("mount"));
+  s.X_ES = map.pose("mount");
   if (s.is_camera()) {
     s.intrinsics = read_intrinsics(map.child("intrinsics"), s.model);
     if (map.has("scanner")) map.fail("scanner", "only for a line scanner (model os32c)");
@@ -511,7 +477,7 @@ void Scene::validate() const {
 Scene parse_scene(const std::string& yaml, const std::string& source, const std::string& base_dir) {
   YamlMap root = YamlMap::parse(yaml, source);
   YamlMap cell_map = root.child("cell");
-  Bounds cell{vec3(cell_map, "min"), vec3(cell_map, "max")};
+  Bounds cell{cell_map.vector3("min"), cell_map.vector3("max")};
   if (!(cell.min.array() < cell.max.array()).all()) cell_map.fail("max", "must be above min on every axis");
   cell_map.expect_all_read();
 

@@ -11,7 +11,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
 
 namespace cellmap {

@@ -2,7 +2,7 @@
 // Parameters of the occupancy map: OctoMap's probabilistic sensor model plus the range and threads of the
 // sweep fusion.
 
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/outlier_removal.hpp"
 #include "cellmap/preprocess/workspace.hpp"

@@ -4,7 +4,8 @@
 //
 // YAML (one map per sensor; unknown keys are refused; defaults in brackets):
 //   source: openni2 | v4l2 | replay              required
-//   X_ES: {translation: [x, y, z], rotation: [w, x, y, z]}   sensor pose in the tool frame [identity]
+//   X_ES: {position: [x, y, z], rotation: [w, x, y, z]}   sensor pose in the tool frame [identity]
+//         (YamlMap::pose; `translation` is read as another spelling of `position`)
 //   pose_tolerance: 0.05                          seconds between a frame and each bracketing robot pose
 //   openni2:  uri ["": first device; or a .oni file], width [640], height [480], fps [30],
 //             format [DEPTH_1_MM | DEPTH_100_UM], intrinsics {fx, fy, cx, cy} [from the device's field of
@@ -21,7 +22,7 @@
 #include <string>
 #include <variant>
 
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/sensor/depth_source.hpp"
 #include "cellmap/sensor/openni2_source.hpp"
 #include "cellmap/sensor/replay_source.hpp"
@@ -45,9 +46,6 @@ struct SensorConfig final {
 [[nodiscard]] V4l2Config read_v4l2_config(YamlMap settings, const std::string& name);
 /// The directory may be absent here (""): the caller decides whether a replay is configured.
 [[nodiscard]] ReplayConfig read_replay_config(YamlMap settings, const std::string& name);
-/// {translation: [x, y, z], rotation: [w, x, y, z]}, both optional (identity). @throws Error naming the key
-/// for a wrong length, a non-unit quaternion or non-finite values.
-[[nodiscard]] Eigen::Isometry3d read_pose_yaml(YamlMap map);
 
 /// Builds the configured source (not opened yet). @throws Error as the source's constructor.
 [[nodiscard]] std::unique_ptr<DepthSource> make_depth_source(const SensorConfig& config);

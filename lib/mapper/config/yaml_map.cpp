@@ -1,4 +1,4 @@
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -54,6 +54,45 @@ long YamlMap::integer(const std::string& key, long fallback, long min, long max)
     fail(key, reason.str());
   }
   return value;
+}
+
+std::vector<double> YamlMap::numbers(const std::string& key, std::size_t count) {
+  const std::vector<double> values = require<std::vector<double>>(key);
+  if (count != 0 && values.size() != count) {
+    fail(key, "must have " + std::to_string(count) + " numbers, got " + std::to_string(values.size()));
+  }
+  for (double v : values) {
+    if (!std::isfinite(v)) fail(key, "must be finite numbers");
+  }
+  return values;
+}
+
+Eigen::Vector3d YamlMap::vector3(const std::string& key) {
+  const std::vector<double> v = numbers(key, 3);
+  return {v[0], v[1], v[2]};
+}
+
+Eigen::Quaterniond YamlMap::unit_quaternion(const std::string& key) {
+  const std::vector<double> v = numbers(key, 4);
+  const Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
+  if (std::abs(q.norm() - 1.0) > 1e-3) {
+    fail(key, "must be a unit quaternion [w, x, y, z] (norm " + std::to_string(q.norm()) + ")");
+  }
+  return q.normalized();
+}
+
+Eigen::Isometry3d YamlMap::pose(const std::string& key) {
+  YamlMap map = child(key);
+  if (map.has("position") && map.has("translation")) {
+    map.fail("translation", "is another spelling of position: give one of them");
+  }
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  for (const char* position : {"position", "translation"}) {
+    if (map.has(position)) X.translation() = map.vector3(position);
+  }
+  if (map.has("rotation")) X.linear() = map.unit_quaternion("rotation").toRotationMatrix();
+  map.expect_all_read();
+  return X;
 }
 
 YamlMap YamlMap::child(const std::string& key) {

@@ -1,4 +1,4 @@
-#include "cellmap/common/yaml_map.hpp"
+#include "cellmap/config/yaml_map.hpp"
 
 #include <gtest/gtest.h>
 
@@ -54,6 +54,45 @@ TEST(YamlMapTest, NonMapDocumentIsRejected) {
   EXPECT_EQ(error_of([] { (void)YamlMap::parse("- 1\n- 2\n", "list.yaml"); }),
             "list.yaml: document: must be a mapping of keys");
   EXPECT_NO_THROW((void)YamlMap::parse("", "empty.yaml"));
+}
+
+// One pose schema for every pose in the configuration files; `translation` (the daemon's older X_ES spelling)
+// reads as `position`.
+TEST(YamlMapTest, PoseReadsPositionOrTranslationAndRotation) {
+  YamlMap root = YamlMap::parse(
+      "a: {position: [1, 2, 3], rotation: [0.7071067811865476, 0, 0, 0.7071067811865476]}
+      "
+      "b: {translation: [1, 2, 3]}
+      ",
+      "cfg.yaml");
+  const Eigen::Isometry3d a = root.pose("a");
+  EXPECT_TRUE(a.translation().isApprox(Eigen::Vector3d(1, 2, 3)));
+  EXPECT_TRUE((a.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(root.pose("b").translation().isApprox(Eigen::Vector3d(1, 2, 3)));
+  EXPECT_TRUE(root.pose("absent").isApprox(Eigen::Isometry3d::Identity()));
+  EXPECT_NO_THROW(root.expect_all_read());
+}
+
+TEST(YamlMapTest, PoseErrorsNameTheKey) {
+  YamlMap root = YamlMap::parse(
+      "both: {position: [0, 0, 0], translation: [0, 0, 0]}
+      "
+      "short: {position: [0, 0]}
+      "
+      "tilted: {rotation: [1, 1, 0, 0]}
+      "
+      "typo: {positon: [0, 0, 0]}
+      ",
+      "cfg.yaml");
+  EXPECT_EQ(error_of([&] { (void)root.pose("both"); }),
+            "cfg.yaml: both.translation: is another spelling of position: give one of them");
+  EXPECT_EQ(error_of([&] { (void)root.pose("short"); }),
+            "cfg.yaml: short.position: must have 3 numbers, got 2");
+  EXPECT_EQ(error_of([&] {
+              (void)root.pose("tilted");
+            }).rfind("cfg.yaml: tilted.rotation: must be a unit quaternion", 0),
+            0u);
+  EXPECT_EQ(error_of([&] { (void)root.pose("typo"); }), "cfg.yaml: typo.positon: unknown key");
 }
 
 }  // namespace

@@ -3,9 +3,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Geometry>
+
+#include <cstddef>
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "cellmap/common/error.hpp"
 
@@ -57,6 +61,19 @@ class YamlMap {
   [[nodiscard]] double number(const std::string& key, double fallback, double min, double max);
   /// An integer in [min, max]. @throws Error naming the key and the allowed range otherwise.
   [[nodiscard]] long integer(const std::string& key, long fallback, long min, long max);
+
+  /// A list of finite numbers; with `count` > 0 exactly that many. @throws Error naming the key otherwise.
+  [[nodiscard]] std::vector<double> numbers(const std::string& key, std::size_t count = 0);
+  /// [x, y, z], finite. @throws Error naming the key otherwise.
+  [[nodiscard]] Eigen::Vector3d vector3(const std::string& key);
+  /// A unit quaternion [w, x, y, z] (norm within 1e-3 of 1), returned normalized. @throws Error naming the
+  /// key.
+  [[nodiscard]] Eigen::Quaterniond unit_quaternion(const std::string& key);
+  /// The pose under `key`, identity when absent: `{position: [x, y, z], rotation: [w, x, y, z]}`, both
+  /// optional (identity parts); `translation` is read as another spelling of `position`. Every pose in the
+  /// configuration files (the sensor mount X_ES, a robot's base, the gantry's tool pose) uses this schema.
+  /// @throws Error naming the key for unknown keys, both spellings at once, or bad values.
+  [[nodiscard]] Eigen::Isometry3d pose(const std::string& key);
 
   /// The nested map under `key` (an empty map when absent). @throws Error if present but not a map.
   [[nodiscard]] YamlMap child(const std::string& key);
