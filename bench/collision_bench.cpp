@@ -138,7 +138,7 @@ struct BatchScene {
 };
 
 BatchScene make_batch_scene(int n_env) {
-  using cellmap::collision::LinkBox;
+  using cellmap::LinkBox;
   const auto at = [](double x, double y, double z) {
     Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
     X.translation() = Vector3d(x, y, z);

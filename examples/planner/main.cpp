@@ -85,7 +85,7 @@ class PathWatch {
   static cellmap::collision::RobotBoxes carried_box(const Eigen::Vector3d& half_extents) {
     const Eigen::Vector3d reach = Eigen::Vector3d::Constant(1e3);
     cellmap::Robot robot = cellmap::Robot::gantry(-reach, reach);
-    cellmap::collision::LinkBox box;
+    cellmap::LinkBox box;
     box.link = robot.link_names().back();
     box.half_extents = half_extents;
     return cellmap::collision::RobotBoxes(std::move(robot), {box});

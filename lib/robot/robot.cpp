@@ -1,11 +1,7 @@
 #include "cellmap/robot/robot.hpp"
 
-#include <console_bridge/console.h>
-#include <urdf_parser/urdf_parser.h>
-
 #include <cmath>
 
-#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 
 namespace cellmap {
@@ -13,15 +9,6 @@ namespace {
 
 bool all_finite(const Eigen::Isometry3d& X) {
   return X.matrix().allFinite();
-}
-
-Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
-  double w = 1, x = 0, y = 0, z = 0;
-  pose.rotation.getQuaternion(x, y, z, w);
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
-  X.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
-  return X;
 }
 
 }  // namespace
@@ -50,65 +37,22 @@ Robot Robot::gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
   return robot;
 }
 
-Robot Robot::from_urdf_file(const std::string& path, const std::string& tool_link,
-                            const Eigen::Isometry3d& X_C_root) {
-  return from_urdf_string(read_file(path), tool_link, X_C_root, path);
-}
-
-Robot Robot::from_urdf_string(const std::string& xml, const std::string& tool_link,
-                              const Eigen::Isometry3d& X_C_root, const std::string& source) {
-  // urdfdom reports parse problems through console_bridge on stderr; the library reports through Error only.
-  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(xml);
-  if (!model) throw Error(source + ": not a valid URDF robot description");
-  if (!all_finite(X_C_root)) throw Error(source + ": robot base pose must be finite");
-  urdf::LinkConstSharedPtr link = model->getLink(tool_link);
-  if (!link) throw Error(source + ": tool link '" + tool_link + "' is not in the URDF");
-
-  // Walk from the tool up to the root, then build the chain root first.
-  std::vector<urdf::LinkConstSharedPtr> chain;
-  for (; link; link = link->getParent()) chain.push_back(link);
-
+Robot Robot::serial(const std::string& root_link, const std::vector<ChainJoint>& joints,
+                    const Eigen::Isometry3d& X_C_root) {
+  if (!all_finite(X_C_root)) throw Error("robot base pose must be finite");
   Robot robot;
   robot.X_C_root_ = X_C_root;
-  robot.add_step(
-      {chain.back()->name, Eigen::Isometry3d::Identity(), JointType::kFixed, Eigen::Vector3d::UnitZ(), -1},
-      "", {});
-  for (auto it = chain.rbegin() + 1; it != chain.rend(); ++it) {
-    const urdf::JointConstSharedPtr joint = (*it)->parent_joint;
-    Step step;
-    step.link = (*it)->name;
-    step.origin = to_isometry(joint->parent_to_joint_origin_transform);
-    step.axis = Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-    JointLimits limits;
-    switch (joint->type) {
-      case urdf::Joint::FIXED:
-        step.type = JointType::kFixed;
-        break;
-      case urdf::Joint::PRISMATIC:
-      case urdf::Joint::REVOLUTE:
-        step.type = joint->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
-        if (!joint->limits) throw Error(source + ": joint '" + joint->name + "' has no <limit>");
-        limits = {joint->limits->lower, joint->limits->upper};
-        break;
-      case urdf::Joint::CONTINUOUS:
-        step.type = JointType::kRevolute;
-        limits = {-M_PI, M_PI};
-        break;
-      default:
-        throw Error(source + ": joint '" + joint->name + "' has an unsupported type (floating or planar)");
-    }
+  robot.add_step({root_link, Eigen::Isometry3d::Identity(), JointType::kFixed, Eigen::Vector3d::UnitZ(), -1},
+                 "", {});
+  for (const ChainJoint& joint : joints) {
+    Step step{joint.link, joint.origin, joint.type, joint.axis, -1};
     if (step.type != JointType::kFixed) {
-      if (!(step.axis.norm() > 0)) throw Error(source + ": joint '" + joint->name + "' has a zero axis");
+      if (!(step.axis.norm() > 0)) throw Error("joint '" + joint.joint + "' has a zero axis");
       step.axis.normalize();
     }
-    robot.add_step(step, joint->name, limits);
+    robot.add_step(step, joint.joint, joint.limits);
   }
-  try {
-    robot.validate();
-  } catch (const Error& e) {
-    throw Error(source + ": " + e.what());
-  }
+  robot.validate();
   return robot;
 }
 

@@ -7,6 +7,7 @@
 #include "cellmap/collision/box_tree.hpp"
 #include "cellmap/collision/robot_boxes.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/urdf/urdf_model.hpp"
 
 namespace cellmap::collision {
 namespace {
@@ -127,8 +128,9 @@ constexpr const char* kArm = R"(<?xml version="1.0"?>
 </robot>)";
 
 TEST(RobotBoxesTest, UrdfBoxGeometryFollowsTheJoints) {
-  const Robot arm = Robot::from_urdf_string(kArm, "flange");
-  const std::vector<LinkBox> boxes = link_boxes_from_urdf(kArm, arm, "arm.urdf");
+  const UrdfModel urdf = UrdfModel::parse(kArm, "arm.urdf");
+  const Robot arm = urdf.chain("flange");
+  const std::vector<LinkBox> boxes = urdf.link_boxes(arm);
   ASSERT_EQ(boxes.size(), 2u);
   const RobotBoxes robot(arm, boxes);
   // Shoulder at 90 degrees: the upper arm box points along +y, centred 0.3 m out at 0.5 m height.
@@ -143,14 +145,14 @@ TEST(RobotBoxesTest, UrdfBoxGeometryFollowsTheJoints) {
   std::string sphere_arm = kArm;
   const std::string upper_box = "<box size=\"0.6 0.1 0.1\"/>";
   sphere_arm.replace(sphere_arm.find(upper_box), upper_box.size(), "<sphere radius=\"0.1\"/>");
-  ASSERT_NO_THROW((void)Robot::from_urdf_string(sphere_arm, "flange"));  // still a valid URDF
+  ASSERT_NO_THROW((void)UrdfModel::parse(sphere_arm).chain("flange"));  // still a valid URDF
   try {
-    (void)link_boxes_from_urdf(sphere_arm, arm, "arm.urdf");
+    (void)UrdfModel::parse(sphere_arm, "arm.urdf").link_boxes(arm);
     ADD_FAILURE() << "a sphere must be refused";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "arm.urdf: link 'upper_arm' collision 0: only box geometry is supported");
   }
-  EXPECT_THROW((void)link_boxes_from_urdf("<robot", arm, "bad.urdf"), Error);
+  EXPECT_THROW((void)UrdfModel::parse("<robot", "bad.urdf"), Error);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/robot/robot.hpp"
+#include "cellmap/urdf/urdf_model.hpp"
 
 #include <cmath>
 
@@ -64,7 +65,7 @@ TEST(Workspace, ArmReachIsSampledAndVoxelised) {
   <joint name="flange" type="fixed"><parent link="fore"/><child link="tip"/><origin xyz="0.5 0 0"/></joint>
   <link name="tip"/>
 </robot>)";
-  const Robot arm = Robot::from_urdf_string(urdf, "tip");
+  const Robot arm = UrdfModel::parse(urdf).chain("tip");
   const Workspace w = workspace_from_robot(arm, 0.1, 60, 0.05);
   EXPECT_FALSE(w.is_box());
   // At elbow 0 the tip is 1.1 m out; at elbow 1 rad |tip| = |0.6 + 0.5 e^{i}| = 0.963 m.

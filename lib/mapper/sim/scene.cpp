@@ -9,6 +9,7 @@
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/config/yaml_map.hpp"
+#include "cellmap/urdf/urdf_model.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -96,7 +97,7 @@ Robot read_robot(YamlMap map, const std::string& base_dir) {
   const Eigen::Isometry3d X_C_root = urdf.pose("base");
   urdf.expect_all_read();
   map.expect_all_read();
-  return Robot::from_urdf_file(file.string(), tool_link, X_C_root);
+  return UrdfModel::load(file.string()).chain(tool_link, X_C_root);
 }
 
 Eigen::VectorXd joint_vector(YamlMap& map, const std::string& key, int dof) {

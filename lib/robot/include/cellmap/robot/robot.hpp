@@ -1,5 +1,7 @@
 #pragma once
-// Robot kinematics: joint vector q → pose of every link and of the tool in the cell frame.
+// Robot kinematics: joint vector q → pose of every link and of the tool in the cell frame; boxes fixed to
+// links. Reading a URDF is a separate stage (cellmap/urdf/urdf_model.hpp), so forward kinematics needs no
+// urdfdom.
 
 #include <Eigen/Geometry>
 
@@ -14,11 +16,24 @@ struct JointLimits final {
   double upper = 0.0;
 };
 
-/// A serial kinematic chain placed in the cell frame C: a linear/gantry robot (built in) or a serial arm read
-/// from URDF. Links are listed base first, tool last; each moving joint drives the link after it.
-/// Immutable after construction, so it can be shared between threads. An object that exists is valid.
+/// A serial kinematic chain placed in the cell frame C: a linear/gantry robot (built in) or a serial arm
+/// (e.g. read from URDF by UrdfModel). Links are listed base first, tool last; each moving joint drives the
+/// link after it. Immutable after construction, so it can be shared between threads. An object that exists is
+/// valid.
 class Robot final {
  public:
+  enum class JointType { kFixed, kPrismatic, kRevolute };
+
+  /// One joint of a serial chain with the link it carries (a URDF joint and its child link).
+  struct ChainJoint {
+    std::string joint;                                         ///< moving joints name the entries of q
+    std::string link;                                          ///< the child link
+    Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< joint frame in the parent link frame
+    JointType type = JointType::kFixed;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< in the joint frame, any length > 0 (moving joints)
+    JointLimits limits;                               ///< moving joints
+  };
+
   /// A gantry with three prismatic axes along the cell's x, y and z: the bridge (x), the carriage (y) and the
   /// ram (z). q = (x, y, z) in metres; the tool pose is X_CE(q) = Translation(q) * X_CE_zero, so `X_CE_zero`
   /// is the tool pose at q = 0 (its rotation fixes how the tool, and a sensor on it, looks down).
@@ -28,17 +43,12 @@ class Robot final {
   [[nodiscard]] static Robot gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
                                     const Eigen::Isometry3d& X_CE_zero = Eigen::Isometry3d::Identity());
 
-  /// The chain from the URDF's root link to `tool_link`, with the root placed at X_C_root. Fixed joints are
-  /// folded into their child link's pose; revolute, continuous and prismatic joints become moving joints.
-  /// @throws Error naming the file and the reason when the URDF does not parse, `tool_link` is missing, or a
-  /// joint type is not supported (floating, planar).
-  [[nodiscard]] static Robot from_urdf_file(
-      const std::string& path, const std::string& tool_link,
-      const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity());
-  /// As from_urdf_file, on URDF XML text; `source` names it in error messages.
-  [[nodiscard]] static Robot from_urdf_string(
-      const std::string& xml, const std::string& tool_link,
-      const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity(), const std::string& source = "urdf");
+  /// The chain `root_link` → joints[0].link → ... → joints.back().link (the tool), with the root link placed
+  /// at X_C_root. Fixed joints stay in the chain (their links get poses, no entry of q).
+  /// @throws Error naming the joint or link if a moving joint's axis is zero, its limits are not finite with
+  /// lower <= upper, or a pose is not finite.
+  [[nodiscard]] static Robot serial(const std::string& root_link, const std::vector<ChainJoint>& joints,
+                                    const Eigen::Isometry3d& X_C_root = Eigen::Isometry3d::Identity());
 
   /// Number of moving joints (the size of q).
   [[nodiscard]] int dof() const { return static_cast<int>(joint_names_.size()); }
@@ -56,7 +66,6 @@ class Robot final {
   /// X_CE: the pose of the tool (last) link. @throws Error as link_poses.
   [[nodiscard]] Eigen::Isometry3d tool_pose(const Eigen::VectorXd& q) const;
 
-  enum class JointType { kFixed, kPrismatic, kRevolute };
   /// One step of the chain: link i is placed at X_parent_link(i) = origin * motion(q_i) (motion is identity
   /// for fixed steps). Public so that tests and tools can inspect the chain.
   struct Step {
@@ -78,6 +87,14 @@ class Robot final {
   std::vector<std::string> joint_names_;
   std::vector<JointLimits> limits_;
   std::vector<std::string> link_names_;
+};
+
+/// A box fixed to link L of a robot (collision geometry): pose X_LB of the box in the link frame, half
+/// extents in metres.
+struct LinkBox final {
+  std::string link;
+  Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
 };
 
 }  // namespace cellmap

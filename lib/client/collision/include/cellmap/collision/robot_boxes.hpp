@@ -11,21 +11,8 @@
 
 namespace cellmap::collision {
 
-/// A box fixed to link L: pose X_LB of the box in the link frame, half extents in metres.
-struct LinkBox final {
-  std::string link;
-  Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
-};
-
-/// The box collision geometry of the robot's chain links from URDF XML: every <collision> of a link in
-/// robot.link_names() becomes a LinkBox (X_LB = the collision origin, half extents = size / 2); links outside
-/// the chain are ignored. `source` names the XML in errors. @throws Error if the XML does not parse or a
-/// chain link has non-box collision geometry (a skipped shape would silently hide an obstacle).
-[[nodiscard]] std::vector<LinkBox> link_boxes_from_urdf(const std::string& xml, const Robot& robot,
-                                                        const std::string& source = "urdf");
-
-/// A Robot with boxes on its links. Immutable and valid once built; safe to share between threads.
+/// A Robot with boxes on its links (from its URDF: UrdfModel::link_boxes). Immutable and valid once built;
+/// safe to share between threads.
 class RobotBoxes final {
  public:
   /// @throws Error naming the box index if its link is not one of robot.link_names(), a half extent is
