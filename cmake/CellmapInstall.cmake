@@ -4,6 +4,8 @@
 #   cellmap::cellmap  every stage (the umbrella target `cellmap`)
 #   cellmap::client   what a planner needs: subscribe to a cell (transport), environments, collision, paths
 #   cellmap::<stage>  each stage library, e.g. cellmap::transport
+# in two components: `client` (cellmap::client and the stages it links: needs Eigen and Cyclone DDS only) and
+# `mapper` (every other stage; needs PCL, OctoMap, urdfdom, yaml-cpp and the camera libraries).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -38,7 +40,31 @@ set_target_properties(cellmap_client PROPERTIES EXPORT_NAME client)
 set_target_properties(cellmap_pcl PROPERTIES EXPORT_NAME pcl)
 set_target_properties(cellmap_idl PROPERTIES EXPORT_NAME idl)
 
-install(TARGETS cellmap cellmap_client cellmap_pcl cellmap_idl ${CELLMAP_STAGES}
+# The client component: cellmap_client and every cellmap target it links, directly or through a stage.
+set(CELLMAP_CLIENT_TARGETS "")
+set(pending cellmap_client)
+while(pending)
+  list(POP_FRONT pending target)
+  if(target IN_LIST CELLMAP_CLIENT_TARGETS)
+    continue()
+  endif()
+  list(APPEND CELLMAP_CLIENT_TARGETS ${target})
+  get_target_property(links ${target} INTERFACE_LINK_LIBRARIES)
+  foreach(link IN LISTS links)
+    string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" link "${link}")
+    if(link MATCHES "^cellmap_" AND TARGET ${link})
+      list(APPEND pending ${link})
+    endif()
+  endforeach()
+endwhile()
+set(CELLMAP_MAPPER_TARGETS cellmap cellmap_pcl cellmap_idl ${CELLMAP_STAGES})
+list(REMOVE_ITEM CELLMAP_MAPPER_TARGETS ${CELLMAP_CLIENT_TARGETS})
+
+install(TARGETS ${CELLMAP_CLIENT_TARGETS}
+        EXPORT cellmapClientTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(TARGETS ${CELLMAP_MAPPER_TARGETS}
         EXPORT cellmapTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
@@ -51,6 +77,7 @@ endforeach()
 install(FILES ${PROJECT_SOURCE_DIR}/idl/cellmap.idl ${PROJECT_BINARY_DIR}/idl/cellmap.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cellmap/idl)
 
+install(EXPORT cellmapClientTargets NAMESPACE cellmap:: DESTINATION ${CELLMAP_INSTALL_CMAKEDIR})
 install(EXPORT cellmapTargets NAMESPACE cellmap:: DESTINATION ${CELLMAP_INSTALL_CMAKEDIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/cellmapConfig.cmake.in
   ${PROJECT_BINARY_DIR}/cellmapConfig.cmake
