@@ -22,7 +22,7 @@ Eigen::Vector3d obstacle_half_extents(const Obstacle& o) {
 
 class VoxelGrid {
  public:
-  VoxelGrid(const Bounds& region, double voxel) : region_(region), voxel_(voxel) {
+  VoxelGrid(const Region& region, double voxel) : region_(region), voxel_(voxel) {
     for (int i = 0; i < 3; ++i) {
       n_[i] = std::max(1, static_cast<int>(std::ceil((region.max[i] - region.min[i]) / voxel)));
     }
@@ -58,7 +58,7 @@ class VoxelGrid {
   }
 
  private:
-  Bounds region_;
+  Region region_;
   double voxel_;
   int n_[3];
   std::vector<std::uint8_t> flags_;
@@ -69,7 +69,7 @@ constexpr std::uint8_t kObstacle = 1, kBox = 2;
 }  // namespace
 
 BoxScore score_boxes(const std::vector<Obstacle>& obstacles, const std::vector<Box>& boxes,
-                     const Cloud& true_surface_C, const Bounds& region, double voxel, double tolerance) {
+                     const Cloud& true_surface_C, const Region& region, double voxel, double tolerance) {
   if (!(voxel > 0)) throw Error("score_boxes: voxel must be positive");
   if (!(region.min.array() < region.max.array()).all()) throw Error("score_boxes: empty region");
   VoxelGrid grid(region, voxel);

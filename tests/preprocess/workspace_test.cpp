@@ -48,8 +48,8 @@ TEST(Workspace, GantryReachIsItsAxisBoxGrownByTheEnvelope) {
   const Robot gantry = Robot::gantry({0.0, -1.0, 0.5}, {2.0, 1.0, 1.5}, X_CE_zero);
   const Workspace w = workspace_from_robot(gantry, 0.25, 10, 0.05);
   ASSERT_TRUE(w.is_box());
-  EXPECT_TRUE(w.lower().isApprox(Eigen::Vector3d(-0.25, -1.25, -0.05), 1e-12));
-  EXPECT_TRUE(w.upper().isApprox(Eigen::Vector3d(2.25, 1.25, 1.45), 1e-12));
+  EXPECT_TRUE(w.bounds().min.isApprox(Eigen::Vector3d(-0.25, -1.25, -0.05), 1e-12));
+  EXPECT_TRUE(w.bounds().max.isApprox(Eigen::Vector3d(2.25, 1.25, 1.45), 1e-12));
 }
 
 TEST(Workspace, ArmReachIsSampledAndVoxelised) {

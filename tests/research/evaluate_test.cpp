@@ -27,7 +27,7 @@ Cloud surface_of(const Obstacle& o) {
   return cloud;
 }
 
-const Bounds kRegion{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1)};
+const Region kRegion{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1)};
 
 TEST(ScoreBoxesTest, ThePerfectBoxCoversEverythingAndLosesNothing) {
   const Obstacle o = block();

@@ -96,7 +96,7 @@ TEST(SceneCasterTest, ConeCullingNeverDropsAHit) {
 }
 
 TEST(ExitDistanceTest, LeavesTheBoundsOnTheNearestFace) {
-  const Bounds bounds{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 2, 3)};
+  const Region bounds{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 2, 3)};
   EXPECT_DOUBLE_EQ(exit_distance(bounds, {1, 1, 1}, kX), 3.0);
   EXPECT_DOUBLE_EQ(exit_distance(bounds, {1, 1, 1}, -kZ), 1.0);
   EXPECT_DOUBLE_EQ(exit_distance(bounds, {5, 1, 1}, -kX), 0.0);  // starts outside

@@ -153,7 +153,7 @@ void compare(const ComparisonArgs& args) {
   SegmentConfig config = args.config.empty() ? SegmentConfig{} : load_segment_config(args.config);
   if (!args.boxes.empty()) config.box_kind = box_kind_from_string(args.boxes, "--boxes");
   const std::vector<double> r = parse_numbers(args.region, "--region", {6});
-  const sim::Bounds region{Eigen::Vector3d(r[0], r[1], r[2]), Eigen::Vector3d(r[3], r[4], r[5])};
+  const Region region{Eigen::Vector3d(r[0], r[1], r[2]), Eigen::Vector3d(r[3], r[4], r[5])};
 
   const sim::Simulator noisy(scene, sim::SimOptions{true, 2});
   const sim::Simulator exact(scene, sim::SimOptions{false, 2});

@@ -22,8 +22,7 @@ Workspace Workspace::box(const Eigen::Vector3d& lower, const Eigen::Vector3d& up
     throw Error(msg.str());
   }
   Workspace w;
-  w.lower_ = lower;
-  w.upper_ = upper;
+  w.bounds_ = {lower, upper};
   return w;
 }
 
@@ -34,8 +33,7 @@ Workspace Workspace::from_points(const std::vector<Eigen::Vector3d>& points_C, d
   if (!std::isfinite(envelope) || envelope < 0.0) throw Error("workspace: envelope must be >= 0");
   Workspace w;
   w.voxel_ = voxel;
-  w.lower_ = Eigen::Vector3d::Constant(INFINITY);
-  w.upper_ = Eigen::Vector3d::Constant(-INFINITY);
+  w.bounds_ = {Eigen::Vector3d::Constant(INFINITY), Eigen::Vector3d::Constant(-INFINITY)};
   // A voxel whose centre is within envelope + half its diagonal of a sample may hold points within envelope.
   const double reach = envelope + 0.5 * std::sqrt(3.0) * voxel;
   const int steps = static_cast<int>(std::ceil(reach / voxel));
@@ -50,8 +48,8 @@ Workspace Workspace::from_points(const std::vector<Eigen::Vector3d>& points_C, d
           const Eigen::Vector3d centre = (cell + Eigen::Vector3d(dx, dy, dz)).array() * voxel + 0.5 * voxel;
           if ((centre - p).norm() > reach) continue;
           w.voxels_.insert(w.key(centre));
-          w.lower_ = w.lower_.cwiseMin((centre.array() - 0.5 * voxel).matrix());
-          w.upper_ = w.upper_.cwiseMax((centre.array() + 0.5 * voxel).matrix());
+          w.bounds_.min = w.bounds_.min.cwiseMin((centre.array() - 0.5 * voxel).matrix());
+          w.bounds_.max = w.bounds_.max.cwiseMax((centre.array() + 0.5 * voxel).matrix());
         }
       }
     }
@@ -69,7 +67,7 @@ std::int64_t Workspace::key(const Eigen::Vector3d& p_C) const {
 }
 
 bool Workspace::contains(const Eigen::Vector3d& p_C) const {
-  if ((p_C.array() < lower_.array()).any() || (p_C.array() > upper_.array()).any()) return false;
+  if (!bounds_.contains(p_C)) return false;
   return is_box() || voxels_.count(key(p_C)) > 0;
 }
 

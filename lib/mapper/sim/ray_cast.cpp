@@ -145,7 +145,7 @@ RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C,
   return best;
 }
 
-double exit_distance(const Bounds& bounds, const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C) {
+double exit_distance(const Region& bounds, const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C) {
   if (!bounds.contains(o_C)) return 0.0;
   double t = kInf;
   for (int i = 0; i < 3; ++i) {

@@ -243,10 +243,6 @@ void check_shape(const Shape& shape, const std::string& what) {
 
 }  // namespace
 
-bool Bounds::contains(const Eigen::Vector3d& p_C, double tolerance) const {
-  return (p_C.array() >= min.array() - tolerance).all() && (p_C.array() <= max.array() + tolerance).all();
-}
-
 double Obstacle::volume() const {
   if (const auto* box = std::get_if<BoxShape>(&shape)) return 8.0 * box->half_extents.prod();
   if (const auto* cyl = std::get_if<CylinderShape>(&shape)) {
@@ -478,7 +474,7 @@ void Scene::validate() const {
 Scene parse_scene(const std::string& yaml, const std::string& source, const std::string& base_dir) {
   YamlMap root = YamlMap::parse(yaml, source);
   YamlMap cell_map = root.child("cell");
-  Bounds cell{cell_map.vector3("min"), cell_map.vector3("max")};
+  Region cell{cell_map.vector3("min"), cell_map.vector3("max")};
   if (!(cell.min.array() < cell.max.array()).all()) cell_map.fail("max", "must be above min on every axis");
   cell_map.expect_all_read();
 

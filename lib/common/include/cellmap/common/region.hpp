@@ -1,5 +1,6 @@
 #pragma once
-// An axis-aligned region of space.
+// An axis-aligned region of space: the one axis-aligned box type (cell bounds, change regions, workspace
+// boxes, evaluation regions).
 
 #include <Eigen/Core>
 
@@ -12,8 +13,9 @@ struct Region final {
 
   /// Volume in m³; 0 for an empty or inverted region.
   [[nodiscard]] double volume() const { return (max - min).cwiseMax(0.0).prod(); }
-  [[nodiscard]] bool contains(const Eigen::Vector3d& p) const {
-    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  /// True when p lies inside the region grown by `tolerance` on every side (boundary included).
+  [[nodiscard]] bool contains(const Eigen::Vector3d& p, double tolerance = 0.0) const {
+    return (p.array() >= min.array() - tolerance).all() && (p.array() <= max.array() + tolerance).all();
   }
   /// The common part (possibly empty: check volume()).
   [[nodiscard]] Region intersection(const Region& other) const {

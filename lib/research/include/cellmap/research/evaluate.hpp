@@ -30,7 +30,7 @@ struct BoxScore final {
 /// surface. Cost: one containment test per voxel inside each box's and obstacle's bounding box.
 /// @throws Error if `voxel` is not positive, the region is empty, or it holds no obstacle volume.
 [[nodiscard]] BoxScore score_boxes(const std::vector<Obstacle>& obstacles, const std::vector<Box>& boxes,
-                                   const Cloud& true_surface_C, const Bounds& region, double voxel = 0.01,
+                                   const Cloud& true_surface_C, const Region& region, double voxel = 0.01,
                                    double tolerance = 0.001);
 
 }  // namespace cellmap::sim

@@ -7,6 +7,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cellmap/common/region.hpp"
 #include "cellmap/frame/cloud.hpp"
 
 namespace cellmap {
@@ -29,16 +30,14 @@ class Workspace final {
   /// True if p_C lies inside the region.
   [[nodiscard]] bool contains(const Eigen::Vector3d& p_C) const;
   [[nodiscard]] bool is_box() const { return voxel_ == 0.0; }
-  [[nodiscard]] const Eigen::Vector3d& lower() const { return lower_; }  ///< bounding box of the region
-  [[nodiscard]] const Eigen::Vector3d& upper() const { return upper_; }
+  [[nodiscard]] const Region& bounds() const { return bounds_; }  ///< bounding box of the region
   [[nodiscard]] std::size_t voxel_count() const { return voxels_.size(); }
 
  private:
   Workspace() = default;
   [[nodiscard]] std::int64_t key(const Eigen::Vector3d& p_C) const;
 
-  Eigen::Vector3d lower_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d upper_ = Eigen::Vector3d::Zero();
+  Region bounds_;
   double voxel_ = 0.0;  // 0 for a box
   std::unordered_set<std::int64_t> voxels_;
 };

@@ -70,7 +70,7 @@ class SceneCaster final {
 };
 
 /// Distance along the ray o + t·d (d unit) at which it leaves the bounds; 0 if o is outside.
-[[nodiscard]] double exit_distance(const Bounds& bounds, const Eigen::Vector3d& o_C,
+[[nodiscard]] double exit_distance(const Region& bounds, const Eigen::Vector3d& o_C,
                                    const Eigen::Vector3d& d_C);
 
 }  // namespace cellmap::sim

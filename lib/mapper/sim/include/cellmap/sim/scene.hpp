@@ -10,19 +10,11 @@
 #include <variant>
 #include <vector>
 
+#include "cellmap/common/region.hpp"
 #include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
 
 namespace cellmap::sim {
-
-/// Axis-aligned bounds in the cell frame C, metres. Valid when min < max on every axis.
-struct Bounds final {
-  Eigen::Vector3d min = Eigen::Vector3d::Zero();
-  Eigen::Vector3d max = Eigen::Vector3d::Zero();
-
-  /// True when p_C lies inside the bounds grown by `tolerance` on every side.
-  [[nodiscard]] bool contains(const Eigen::Vector3d& p_C, double tolerance = 0.0) const;
-};
 
 /// A box centred on its frame O, with half extents along O's x, y and z axes (metres, > 0).
 struct BoxShape final {
@@ -107,7 +99,7 @@ struct SensorSpec final {
 /// A complete simulated cell. Plain value type; build it with load_scene/parse_scene or by hand and call
 /// validate().
 struct Scene final {
-  Bounds cell;
+  Region cell;
   std::vector<Obstacle> obstacles;
   Robot robot;
   std::vector<SensorSpec> sensors;
