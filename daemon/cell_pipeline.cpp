@@ -111,7 +111,7 @@ Reconciled CellPipeline::resegment(const ChangeSet& changes, std::size_t* eviden
   std::vector<Region> area;
   std::vector<Eigen::Vector3d> vanished_C;
   for (const ChangeRegion& region : changes.regions) {
-    area.push_back({region.min_C, region.max_C});
+    area.push_back(region.bounds);
     for (const octomap::OcTreeKey& key : region.vanished) vanished_C.push_back(map_.centre(key));
   }
   // A box re-fits only when it lost a tenth of its voxels: the table losing the few voxels an object removed

@@ -112,8 +112,8 @@ TEST(ChangeDetectorTest, ThousandNoiseOnlySweepsGiveNoRegion) {
     const ChangeSet changes = detector.update(update, map);
     regions += changes.regions.size();
     for (const ChangeRegion& r : changes.regions) {
-      ADD_FAILURE() << "sweep " << changes.sweep << ": region " << r.min_C.transpose() << " .. "
-                    << r.max_C.transpose() << " with " << r.appeared.size() << " appeared, "
+      ADD_FAILURE() << "sweep " << changes.sweep << ": region " << r.bounds.min.transpose() << " .. "
+                    << r.bounds.max.transpose() << " with " << r.appeared.size() << " appeared, "
                     << r.vanished.size() << " vanished";
     }
   }
@@ -143,12 +143,13 @@ TEST(ChangeDetectorTest, AddedAndRemovedBoxGiveOneRegionEach) {
         << "sweep " << i + 1 << " after adding";
   }
   const ChangeRegion& added = after_add[std::size_t(add_sweep) - 1].regions[0];
-  EXPECT_TRUE(added.contains(box.min_C)) << added.min_C.transpose();
-  EXPECT_TRUE(added.contains(box.max_C)) << added.max_C.transpose();
+  EXPECT_TRUE(added.bounds.contains(box.min_C)) << added.bounds.min.transpose();
+  EXPECT_TRUE(added.bounds.contains(box.max_C)) << added.bounds.max.transpose();
   EXPECT_TRUE(added.vanished.empty());
   EXPECT_GT(added.appeared.size(), 50u);
   // Not much bigger than the box: its visible faces plus the margin.
-  EXPECT_LT((added.max_C - added.min_C - (box.max_C - box.min_C)).maxCoeff(), 2 * config.margin + 0.05);
+  EXPECT_LT((added.bounds.max - added.bounds.min - (box.max_C - box.min_C)).maxCoeff(),
+            2 * config.margin + 0.05);
 
   // Let the box saturate, then take it away.
   for (int i = 0; i < 6; ++i)
@@ -165,8 +166,8 @@ TEST(ChangeDetectorTest, AddedAndRemovedBoxGiveOneRegionEach) {
     const ChangeRegion& removed = changes.regions[0];
     EXPECT_TRUE(removed.appeared.empty());
     EXPECT_GT(removed.vanished.size(), 50u);
-    EXPECT_TRUE(removed.contains(box.min_C + Eigen::Vector3d(0, 0.02, 0)));
-    EXPECT_TRUE(removed.contains(box.max_C - Eigen::Vector3d(0, 0.02, 0)));
+    EXPECT_TRUE(removed.bounds.contains(box.min_C + Eigen::Vector3d(0, 0.02, 0)));
+    EXPECT_TRUE(removed.bounds.contains(box.max_C - Eigen::Vector3d(0, 0.02, 0)));
   }
   EXPECT_EQ(detector.pending(), 0u);
 }
@@ -193,8 +194,9 @@ TEST(ChangeDetectorTest, FlipBackBeforePersistingIsForgotten) {
   ASSERT_EQ(changes.regions.size(), 1u);
   EXPECT_EQ(changes.sweep, 5u);
   const double lo = map.centre(key).x() - 0.01 - config.margin;
-  EXPECT_NEAR(changes.regions[0].min_C.x(), lo, 1e-9);
-  EXPECT_NEAR(changes.regions[0].max_C.x() - changes.regions[0].min_C.x(), 0.02 + 2 * config.margin, 1e-9);
+  EXPECT_NEAR(changes.regions[0].bounds.min.x(), lo, 1e-9);
+  EXPECT_NEAR(changes.regions[0].bounds.max.x() - changes.regions[0].bounds.min.x(), 0.02 + 2 * config.margin,
+              1e-9);
 }
 
 TEST(ChangeDetectorTest, ConnectedVoxelsFormOneRegionSeparateOnesTwo) {
@@ -212,8 +214,8 @@ TEST(ChangeDetectorTest, ConnectedVoxelsFormOneRegionSeparateOnesTwo) {
   const ChangeSet changes = detector.update(update, map);
   ASSERT_EQ(changes.regions.size(), 2u);
   EXPECT_EQ(changes.regions[0].appeared.size(), 3u);
-  EXPECT_NEAR(changes.regions[0].min_C.x(), 0.0, 1e-9);
-  EXPECT_NEAR(changes.regions[0].max_C.x(), 0.06, 1e-9);
+  EXPECT_NEAR(changes.regions[0].bounds.min.x(), 0.0, 1e-9);
+  EXPECT_NEAR(changes.regions[0].bounds.max.x(), 0.06, 1e-9);
   EXPECT_EQ(changes.regions[1].appeared.size(), 1u);
 }
 

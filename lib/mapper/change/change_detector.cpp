@@ -62,10 +62,6 @@ ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
   return c;
 }
 
-bool ChangeRegion::contains(const Eigen::Vector3d& p_C) const {
-  return (p_C.array() >= min_C.array()).all() && (p_C.array() <= max_C.array()).all();
-}
-
 ChangeDetector::ChangeDetector(const ChangeConfig& config) : config_(config) {
   config_.validate();
 }
@@ -142,8 +138,7 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
     for (const Key& key : region.appeared) reported_.emplace(key, sweep_);
     std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
     std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
-    region.min_C = lo.array() - half - config_.margin;
-    region.max_C = hi.array() + half + config_.margin;
+    region.bounds = Region{lo.array() - half, hi.array() + half}.grown(config_.margin);
     changes.regions.push_back(std::move(region));
   }
   return changes;

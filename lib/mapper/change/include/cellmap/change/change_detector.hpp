@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "cellmap/common/region.hpp"
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
 
@@ -45,15 +46,11 @@ struct ChangeConfig final {
 
 /// One connected group (26-connectivity) of voxels whose change was confirmed in the same sweep.
 struct ChangeRegion final {
-  Eigen::Vector3d min_C;  ///< lower corner of the changed voxels' extent minus the margin, metres, cell frame
-  Eigen::Vector3d max_C;  ///< upper corner plus the margin
+  Region bounds;  ///< the changed voxels' extent grown by the margin on every side, metres, cell frame
   /// Voxels (leaf keys of the map's tree) now occupied that were free or unknown, sorted (z, y, x).
   std::vector<octomap::OcTreeKey> appeared;
   /// Voxels now free that were occupied, sorted (z, y, x).
   std::vector<octomap::OcTreeKey> vanished;
-
-  /// Whether p_C lies inside the bounds.
-  [[nodiscard]] bool contains(const Eigen::Vector3d& p_C) const;
 };
 
 /// The changes confirmed after one sweep; regions in the (z, y, x) order of their first voxel.
