@@ -21,9 +21,9 @@
 
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
-#include "cellmap/transport/wire_size.hpp"
 #include "ratio_report.hpp"
-#include "wire.hpp"  // lib/transport's private wire types: the anchor writes raw snapshots
+#include "wire.hpp"       // the transport stage's private wire types: the anchor writes raw snapshots
+#include "wire_size.hpp"  // internal to the transport stage
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "cellmap/transport/wire_size.hpp"
+#include "wire_size.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Conversions between cellmap's value types and the idlc-generated wire types (private to lib/transport).
+// Conversions between cellmap's value types and the idlc-generated wire types (private to this stage).
 // Outgoing: a *Sample object builds the C struct pointing into its own storage (nothing is dds_alloc'ed), so
 // it must outlive the write. Incoming: from_wire() copies out of Cyclone's loaned sample and validates it.
 

@@ -1,7 +1,7 @@
 #pragma once
 // Value types for the status, scene-edit and robot-state topics (the environment ones are
 // cellmap::Environment and cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside
-// lib/transport.
+// lib/client/transport.
 
 #include <Eigen/Geometry>
 

@@ -1,5 +1,5 @@
 #pragma once
-// How many bytes an environment or a delta costs on the wire.
+// Internal (tests and the dds benchmark): how many bytes an environment or a delta costs on the wire.
 
 #include <cstddef>
 
