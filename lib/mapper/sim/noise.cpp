@@ -1,6 +1,6 @@
 #include "cellmap/sim/noise.hpp"
 
-#include "parallel.hpp"
+#include "cellmap/common/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "cellmap/common/error.hpp"
-#include "parallel.hpp"
+#include "cellmap/common/parallel.hpp"
 
 namespace cellmap::sim {
 namespace {
