@@ -6,9 +6,9 @@
 #include <limits>
 #include <map>
 #include <string>
-#include <thread>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 
 // Written here rather than taken from OctoMap: OcTree::insertPointCloud walks every ray into a per-ray KeyRay
 // and inserts every step into an unordered_set (about 1 s per 640×480 frame at 2 cm); this walks one ray per
@@ -338,14 +338,12 @@ std::vector<Key> distinct(const std::vector<std::uint64_t>& keys, const KeyBox& 
 // Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
 template <class Fn>
 void run_parallel(int threads, std::size_t n, Fn&& fn) {
-  const std::size_t count = std::size_t(std::max(threads, 1));
-  const std::size_t chunk = (n + count - 1) / count;
-  std::vector<std::thread> workers;
-  for (std::size_t t = 1; t < count; ++t) {
-    workers.emplace_back([&, t] { fn(std::min(n, t * chunk), std::min(n, (t + 1) * chunk), t); });
-  }
-  fn(0, std::min(n, chunk), 0);
-  for (std::thread& w : workers) w.join();
+  const int count = std::max(threads, 1);
+  const std::size_t chunk = (n + std::size_t(count) - 1) / std::size_t(count);
+  parallel_for(count, count, [&](int t) {
+    const std::size_t begin = std::min(n, std::size_t(t) * chunk);
+    fn(begin, std::min(n, begin + chunk), std::size_t(t));
+  });
 }
 
 }  // namespace
