@@ -7,6 +7,7 @@
 
 #include "cellmap/collision/box_distance.hpp"
 #include "cellmap/collision/spheres.hpp"
+#include "svg_plot.hpp"
 
 namespace cellmap::planning {
 
@@ -67,7 +68,6 @@ std::string paper_figure_csv(const PaperFigure& figure) {
 std::string paper_figure_svg(const PaperFigure& figure) {
   // Plot area in pixels and data ranges; the y range is padded to round 0.05 m steps.
   const double width = 720, height = 420, left = 70, right = 170, top = 30, bottom = 50;
-  const double x0 = figure.y.front(), x1 = figure.y.back();
   double lo = *std::min_element(figure.gjk.begin(), figure.gjk.end());
   double hi = *std::max_element(figure.gjk.begin(), figure.gjk.end());
   for (const auto& curve : figure.spheres) {
@@ -77,58 +77,33 @@ std::string paper_figure_svg(const PaperFigure& figure) {
   lo = std::floor(lo / 0.05) * 0.05;
   hi = std::ceil(hi / 0.05) * 0.05;
   const double plot_w = width - left - right, plot_h = height - top - bottom;
-  const auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * plot_w; };
-  const auto py = [&](double v) { return top + (hi - v) / (hi - lo) * plot_h; };
-  std::ostringstream svg;
-  char buffer[1024];
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  svg << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  // Grid and tick labels.
-  for (double v = lo; v <= hi + 1e-9; v += 0.05) {
-    std::snprintf(buffer, sizeof buffer,
-                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>"
-                  "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
-                  left, py(v), left + plot_w, py(v), std::abs(v) < 1e-9 ? "#888" : "#e4e4e4", left - 6,
-                  py(v) + 4, v);
-    svg << buffer;
+  const research::PlotAxis px{figure.y.front(), figure.y.back(), left, left + plot_w};
+  const research::PlotAxis py{hi, lo, top, top + plot_h};
+
+  research::SvgPlot svg(width, height);
+  svg.y_grid(
+      py, lo, hi, 0.05, left, left + plot_w, [](double v) { return research::fixed(v, 2); }, "#e4e4e4",
+      "#888");
+  for (double x = px.v0; x <= px.v1 + 1e-9; x += 0.5) {
+    svg.line(px(x), top, px(x), top + plot_h, "#e4e4e4");
+    svg.text(px(x), top + plot_h + 18, research::fixed(x, 1), "middle");
   }
-  for (double x = x0; x <= x1 + 1e-9; x += 0.5) {
-    std::snprintf(buffer, sizeof buffer,
-                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>"
-                  "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%.1f</text>\n",
-                  px(x), top, px(x), top + plot_h, px(x), top + plot_h + 18, x);
-    svg << buffer;
-  }
-  std::snprintf(
-      buffer, sizeof buffer,
-      "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"black\"/>\n"
-      "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">cube centre y [m]</text>\n"
-      "<text x=\"16\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.1f)\">minimum "
-      "distance [m]</text>\n",
-      left, top, plot_w, plot_h, left + plot_w / 2, height - 10, top + plot_h / 2, top + plot_h / 2);
-  svg << buffer;
+  svg.rect(left, top, plot_w, plot_h, "none", "black");
+  svg.text(left + plot_w / 2, height - 10, "cube centre y [m]", "middle");
+  svg.text(16, top + plot_h / 2, "minimum distance [m]", "middle", 0, -90);
   const std::vector<const std::vector<double>*> curves{&figure.gjk, &figure.spheres[0], &figure.spheres[1],
                                                        &figure.spheres[2]};
   const char* colours[] = {"#000000", "#d62728", "#1f77b4", "#2ca02c"};
   const char* names[] = {"GJK (exact)", "spheres N = 1", "spheres N = 2", "spheres N = 6"};
   for (std::size_t c = 0; c < curves.size(); ++c) {
-    svg << "<polyline fill=\"none\" stroke=\"" << colours[c] << "\" stroke-width=\"" << (c == 0 ? 2.0 : 1.5)
-        << "\" points=\"";
-    for (std::size_t k = 0; k < figure.y.size(); ++k) {
-      std::snprintf(buffer, sizeof buffer, "%.1f,%.1f ", px(figure.y[k]), py((*curves[c])[k]));
-      svg << buffer;
-    }
-    svg << "\"/>\n";
-    const double ly = top + 10 + 20.0 * c;
-    std::snprintf(buffer, sizeof buffer,
-                  "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"/>"
-                  "<text x=\"%.1f\" y=\"%.1f\">%s</text>\n",
-                  left + plot_w + 12, ly, left + plot_w + 36, ly, colours[c], left + plot_w + 42, ly + 4,
-                  names[c]);
-    svg << buffer;
+    std::vector<std::pair<double, double>> points;
+    for (std::size_t k = 0; k < figure.y.size(); ++k)
+      points.emplace_back(px(figure.y[k]), py((*curves[c])[k]));
+    svg.polyline(points, colours[c], c == 0 ? 2.0 : 1.5);
+    const double legend_y = top + 10 + 20.0 * c;
+    svg.line(left + plot_w + 12, legend_y, left + plot_w + 36, legend_y, colours[c], 2.0);
+    svg.text(left + plot_w + 42, legend_y + 4, names[c]);
   }
-  svg << "</svg>\n";
   return svg.str();
 }
 

@@ -1,0 +1,46 @@
+#pragma once
+// The paper's sensor comparison on a simulated cell: every sensor of the scene sweeps the same cell once, its
+// merged cloud (downsampled to equal density) goes through the batch pipeline, and the boxes are scored
+// against the scene's true obstacles (coverage of the surface the sensor saw, lost and blocked free space).
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "cellmap/common/region.hpp"
+#include "cellmap/research/evaluate.hpp"
+#include "cellmap/segment/pipeline.hpp"
+#include "cellmap/sim/scene.hpp"
+
+namespace cellmap::sim {
+
+struct SensorComparisonConfig final {
+  SegmentConfig segment;  ///< one parameter set for every sensor
+  double voxel = 0.02;    ///< downsampling voxel, metres (0: every point)
+  /// Where boxes are scored (default: above the table of config/cell.yaml).
+  Region region{Eigen::Vector3d(0, 0, 0.76), Eigen::Vector3d(3, 2, 2)};
+};
+
+/// One sensor's outcome.
+struct SensorComparisonRow final {
+  std::string sensor, model;
+  std::size_t points = 0, points_used = 0;  ///< merged sweep, and after downsampling
+  double seconds = 0;                       ///< the batch pipeline's wall time
+  SegmentResult result;                     ///< its boxes and statistics
+  BoxScore score;
+};
+
+/// Runs the comparison (both simulators on 2 threads); one row per scene sensor, in the scene's order.
+/// @throws Error as the simulator, the pipeline and score_boxes.
+[[nodiscard]] std::vector<SensorComparisonRow> compare_sensors(const Scene& scene,
+                                                               const SensorComparisonConfig& config);
+
+/// Markdown table: sensor, model, points (used), boxes, coverage, lost and blocked free space, segment time.
+[[nodiscard]] std::string sensor_comparison_table(const std::vector<SensorComparisonRow>& rows);
+/// CSV (`;`-separated, one header line).
+[[nodiscard]] std::string sensor_comparison_csv(const std::vector<SensorComparisonRow>& rows);
+/// Three bar charts side by side (coverage, lost free space, blocked free space) with `caption` below.
+[[nodiscard]] std::string sensor_comparison_svg(const std::vector<SensorComparisonRow>& rows,
+                                                const std::string& caption);
+
+}  // namespace cellmap::sim
