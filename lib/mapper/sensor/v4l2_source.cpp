@@ -97,6 +97,17 @@ bool is_capture_device(int fd, std::string* card = nullptr) {
   return (device_caps & V4L2_CAP_VIDEO_CAPTURE) && (device_caps & V4L2_CAP_STREAMING);
 }
 
+// Why one step of connecting failed: `retry` when the device may come (back) and a later attempt can succeed
+// (missing, busy, out of buffers), not when retrying cannot help (not a capture device, no such mode).
+struct ConnectFailure {
+  bool retry = true;
+  std::string reason;
+};
+
+[[noreturn]] void fail_connect(bool retry, const std::string& reason) {
+  throw ConnectFailure{retry, reason};
+}
+
 }  // namespace
 
 std::string fourcc_to_string(std::uint32_t fourcc) {
@@ -155,6 +166,8 @@ PinholeIntrinsics realsense_d435_intrinsics(int width, int height) {
   return k;
 }
 
+// The device's stream while connected; each step of connecting throws ConnectFailure naming `where`, and the
+// destructor releases whatever the steps so far acquired.
 struct V4l2Source::Stream {
   int fd = -1;
   struct Buffer {
@@ -164,6 +177,12 @@ struct V4l2Source::Stream {
   std::vector<Buffer> buffers;
   std::size_t bytes_per_line = 0;
   bool streaming = false;
+
+  void open(const std::string& device, const std::string& where);
+  void set_z16_format(const DepthMode& mode, const std::string& where);
+  void set_frame_rate(double fps);
+  void map_buffers(int count, const std::string& where);
+  void start(const std::string& where);
 
   ~Stream() {
     if (streaming) {
@@ -206,94 +225,113 @@ void V4l2Source::release() {
   stream_.reset();
 }
 
-void V4l2Source::connect(double now) {
-  release();
-  ++attempts_;
-  const std::string& device = config_.device;
-  auto stream = std::make_unique<Stream>();
-  const int fd = ::open(device.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+void V4l2Source::Stream::open(const std::string& device, const std::string& where) {
+  const int raw = ::open(device.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  if (raw < 0) {
+    const int error = errno;
+    fail_connect(true, where + ": cannot open: " + std::strerror(error));
+  }
+  if (!is_capture_device(raw)) {
+    ::close(raw);
+    fail_connect(false, where + ": not a streaming video capture device");
+  }
+  fd = v4l2_fd_open(raw, 0);
   if (fd < 0) {
     const int error = errno;
-    reconnector_.lost(now, "v4l2 " + device + ": cannot open: " + std::strerror(error));
-    return;
+    ::close(raw);
+    fail_connect(true, where + ": libv4l2 cannot use it: " + std::strerror(error));
   }
-  if (!is_capture_device(fd)) {
-    ::close(fd);
-    reconnector_.failed("v4l2 " + device + ": not a streaming video capture device");
-    return;
-  }
-  stream->fd = v4l2_fd_open(fd, 0);
-  if (stream->fd < 0) {
-    const int error = errno;
-    ::close(fd);
-    reconnector_.lost(now, "v4l2 " + device + ": libv4l2 cannot use it: " + std::strerror(error));
-    return;
-  }
-  DepthMode chosen;
-  try {
-    chosen = choose_depth_mode(enumerate_modes(stream->fd), config_.mode, "v4l2 " + device);
-  } catch (const Error& e) {
-    reconnector_.failed(e.what());
-    return;
-  }
+}
+
+void V4l2Source::Stream::set_z16_format(const DepthMode& mode, const std::string& where) {
   v4l2_format format{};
   format.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  format.fmt.pix.width = static_cast<std::uint32_t>(chosen.width);
-  format.fmt.pix.height = static_cast<std::uint32_t>(chosen.height);
+  format.fmt.pix.width = static_cast<std::uint32_t>(mode.width);
+  format.fmt.pix.height = static_cast<std::uint32_t>(mode.height);
   format.fmt.pix.pixelformat = V4L2_PIX_FMT_Z16;
   format.fmt.pix.field = V4L2_FIELD_NONE;
-  if (xioctl(stream->fd, VIDIOC_S_FMT, &format) != 0 || format.fmt.pix.pixelformat != V4L2_PIX_FMT_Z16 ||
-      static_cast<int>(format.fmt.pix.width) != chosen.width ||
-      static_cast<int>(format.fmt.pix.height) != chosen.height) {
-    reconnector_.failed("v4l2 " + device + ": refused format " + chosen.to_string() + ", gave " +
-                        std::to_string(format.fmt.pix.width) + "x" + std::to_string(format.fmt.pix.height) +
-                        " " + fourcc_to_string(format.fmt.pix.pixelformat));
-    return;
+  if (xioctl(fd, VIDIOC_S_FMT, &format) != 0 || format.fmt.pix.pixelformat != V4L2_PIX_FMT_Z16 ||
+      static_cast<int>(format.fmt.pix.width) != mode.width ||
+      static_cast<int>(format.fmt.pix.height) != mode.height) {
+    fail_connect(false, where + ": refused format " + mode.to_string() + ", gave " +
+                            std::to_string(format.fmt.pix.width) + "x" +
+                            std::to_string(format.fmt.pix.height) + " " +
+                            fourcc_to_string(format.fmt.pix.pixelformat));
   }
-  stream->bytes_per_line = std::max<std::size_t>(format.fmt.pix.bytesperline, 2u * format.fmt.pix.width);
-  if (chosen.fps > 0) {
-    v4l2_streamparm parm{};
-    parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    parm.parm.capture.timeperframe.numerator = 1000;
-    parm.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(std::lround(chosen.fps * 1000));
-    xioctl(stream->fd, VIDIOC_S_PARM, &parm);  // drivers without rate control keep their one rate
-  }
+  bytes_per_line = std::max<std::size_t>(format.fmt.pix.bytesperline, 2u * format.fmt.pix.width);
+}
+
+void V4l2Source::Stream::set_frame_rate(double fps) {
+  if (fps <= 0) return;
+  v4l2_streamparm parm{};
+  parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  parm.parm.capture.timeperframe.numerator = 1000;
+  parm.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(std::lround(fps * 1000));
+  xioctl(fd, VIDIOC_S_PARM, &parm);  // drivers without rate control keep their one rate
+}
+
+void V4l2Source::Stream::map_buffers(int count, const std::string& where) {
   v4l2_requestbuffers request{};
-  request.count = static_cast<std::uint32_t>(config_.buffers);
+  request.count = static_cast<std::uint32_t>(count);
   request.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   request.memory = V4L2_MEMORY_MMAP;
-  if (xioctl(stream->fd, VIDIOC_REQBUFS, &request) != 0 || request.count < 2) {
+  if (xioctl(fd, VIDIOC_REQBUFS, &request) != 0 || request.count < 2) {
     const int error = errno;
-    reconnector_.lost(now, "v4l2 " + device + ": cannot get mmap buffers: " + std::strerror(error));
-    return;
+    fail_connect(true, where + ": cannot get mmap buffers: " + std::strerror(error));
   }
-  stream->buffers.resize(request.count);
+  buffers.resize(request.count);
   for (std::uint32_t i = 0; i < request.count; ++i) {
     v4l2_buffer buffer{};
     buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     buffer.memory = V4L2_MEMORY_MMAP;
     buffer.index = i;
-    if (xioctl(stream->fd, VIDIOC_QUERYBUF, &buffer) != 0) {
-      reconnector_.lost(now, "v4l2 " + device + ": cannot query buffer " + std::to_string(i));
-      return;
+    if (xioctl(fd, VIDIOC_QUERYBUF, &buffer) != 0) {
+      fail_connect(true, where + ": cannot query buffer " + std::to_string(i));
     }
-    stream->buffers[i].length = buffer.length;
-    stream->buffers[i].start =
-        v4l2_mmap(nullptr, buffer.length, PROT_READ | PROT_WRITE, MAP_SHARED, stream->fd, buffer.m.offset);
-    if (stream->buffers[i].start == MAP_FAILED || xioctl(stream->fd, VIDIOC_QBUF, &buffer) != 0) {
+    buffers[i].length = buffer.length;
+    buffers[i].start =
+        v4l2_mmap(nullptr, buffer.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, buffer.m.offset);
+    if (buffers[i].start == MAP_FAILED || xioctl(fd, VIDIOC_QBUF, &buffer) != 0) {
       const int error = errno;
-      reconnector_.lost(
-          now, "v4l2 " + device + ": cannot map buffer " + std::to_string(i) + ": " + std::strerror(error));
-      return;
+      fail_connect(true, where + ": cannot map buffer " + std::to_string(i) + ": " + std::strerror(error));
     }
   }
+}
+
+void V4l2Source::Stream::start(const std::string& where) {
   v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (xioctl(stream->fd, VIDIOC_STREAMON, &type) != 0) {
+  if (xioctl(fd, VIDIOC_STREAMON, &type) != 0) {
     const int error = errno;
-    reconnector_.lost(now, "v4l2 " + device + ": cannot start streaming: " + std::strerror(error));
+    fail_connect(true, where + ": cannot start streaming: " + std::strerror(error));
+  }
+  streaming = true;
+}
+
+void V4l2Source::connect(double now) {
+  release();
+  ++attempts_;
+  const std::string where = "v4l2 " + config_.device;
+  auto stream = std::make_unique<Stream>();
+  try {
+    stream->open(config_.device, where);
+    DepthMode chosen;
+    try {
+      chosen = choose_depth_mode(enumerate_modes(stream->fd), config_.mode, where);
+    } catch (const Error& e) {
+      fail_connect(false, e.what());
+    }
+    stream->set_z16_format(chosen, where);
+    stream->set_frame_rate(chosen.fps);
+    stream->map_buffers(config_.buffers, where);
+    stream->start(where);
+  } catch (const ConnectFailure& failure) {
+    if (failure.retry) {
+      reconnector_.lost(now, failure.reason);
+    } else {
+      reconnector_.failed(failure.reason);
+    }
     return;
   }
-  stream->streaming = true;
   stream_ = std::move(stream);
   reconnector_.connected(now);
 }
