@@ -282,11 +282,9 @@ const ChangeFixture& change_fixture() {
       quiet = pipeline.process(next_sweep()).change ? (++version, 0) : quiet + 1;
     }
     f.current = Environment("bench", version, 0, pipeline.boxes());
-    sim::Obstacle added;
-    added.name = "added";
-    added.shape = sim::BoxShape{Eigen::Vector3d(0.1, 0.08, 0.12)};
-    added.X_CO.translation() = Eigen::Vector3d(2.1, 1.0, 0.87);
-    simulator.apply(sim::SceneEdit::add(added));
+    const transport::SceneEdit added = transport::SceneEdit::add_box("added", Eigen::Vector3d(2.1, 1.0, 0.87),
+                                                                     Eigen::Vector3d(0.1, 0.08, 0.12));
+    simulator.apply(added);
     while (f.sweeps_to_publish < 30) {
       const std::vector<Box> boxes_before = pipeline.boxes();
       const std::uint64_t next_id_before = pipeline.next_box_id();
@@ -294,7 +292,7 @@ const ChangeFixture& change_fixture() {
       ++f.sweeps_to_publish;
       if (!report.change) continue;
       // Its top is seen first (the sides collect their hits a sweep or two later).
-      const Eigen::Vector3d top = added.X_CO.translation() + Eigen::Vector3d(0, 0, 0.11);
+      const Eigen::Vector3d top = added.center + Eigen::Vector3d(0, 0, 0.11);
       const auto is_added = [&](const Box& box) { return box.contains(top); };
       if (std::none_of(report.change->added.begin(), report.change->added.end(), is_added)) {
         // A version from something else (the map still settling): it becomes the current environment.

@@ -30,21 +30,7 @@ Sweep SimulatedCell::next_sweep(double start_stamp) {
 }
 
 std::string SimulatedCell::apply(const transport::SceneEdit& edit) {
-  switch (edit.kind) {
-    case transport::SceneEdit::Kind::kAddBox: {
-      sim::Obstacle obstacle;
-      obstacle.name = edit.name;
-      obstacle.shape = sim::BoxShape{edit.half_extents};
-      obstacle.X_CO.translation() = edit.center;
-      obstacle.X_CO.linear() = Eigen::AngleAxisd(edit.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      return simulator_.apply(sim::SceneEdit::add(obstacle));
-    }
-    case transport::SceneEdit::Kind::kRemove:
-      return simulator_.apply(sim::SceneEdit::remove(edit.name));
-    case transport::SceneEdit::Kind::kMove:
-      return simulator_.apply(sim::SceneEdit::move(edit.name, edit.center));
-  }
-  throw Error("scene edit: unknown kind");
+  return simulator_.apply(edit);
 }
 
 }  // namespace cellmap::daemon

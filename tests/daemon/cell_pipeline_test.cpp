@@ -65,7 +65,7 @@ class Cell {
     return {std::nullopt, limit};
   }
 
-  void edit(const sim::SceneEdit& e) {
+  void edit(const transport::SceneEdit& e) {
     simulator_.apply(e);
     exact_.apply(e);
   }
@@ -98,15 +98,6 @@ class Cell {
   CellPipeline pipeline_;
   int versions_ = 0;
 };
-
-sim::Obstacle box_obstacle(const std::string& name, const Eigen::Vector3d& centre,
-                           const Eigen::Vector3d& half_extents) {
-  sim::Obstacle o;
-  o.name = name;
-  o.shape = sim::BoxShape{half_extents};
-  o.X_CO.translation() = centre;
-  return o;
-}
 
 const Box* box_holding(const std::vector<Box>& boxes, const Eigen::Vector3d& p_C) {
   const auto it = std::find_if(boxes.begin(), boxes.end(), [&](const Box& b) { return b.contains(p_C); });
@@ -156,7 +147,7 @@ Versions run(Cell& cell, int sweeps) {
 // Plants the test's box (0.2 × 0.16 × 0.24 m) standing at `at` and runs 15 sweeps: it must arrive as one
 // added id, which is returned (0 on failure, recorded by the test).
 std::uint64_t plant(Cell& cell, const Eigen::Vector3d& at) {
-  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
+  cell.edit(transport::SceneEdit::add_box("planted", at, {0.1, 0.08, 0.12}));
   const Versions add = run(cell, 15);
   EXPECT_EQ(add.added.size(), 1u);
   return add.added.empty() ? 0 : add.added[0];
@@ -182,7 +173,7 @@ TEST(CellPipelineTest, AddedObjectIsOneNewBoxAndRemovedOneIsGoneWithinElevenSwee
   // id. Boxes away from it keep id and content.
   const Eigen::Vector3d at(1.9, 0.7, 0.87), top = at + Eigen::Vector3d(0, 0, 0.11);
   const std::vector<Box> before_add = cell.pipeline().boxes();
-  cell.edit(sim::SceneEdit::add(box_obstacle("planted", at, {0.1, 0.08, 0.12})));
+  cell.edit(transport::SceneEdit::add_box("planted", at, {0.1, 0.08, 0.12}));
   const Versions add = run(cell, 15);
   EXPECT_GE(add.first_at, 5);
   EXPECT_LE(add.first_at, 6);
@@ -196,7 +187,7 @@ TEST(CellPipelineTest, AddedObjectIsOneNewBoxAndRemovedOneIsGoneWithinElevenSwee
 
   // Remove: its id is removed within sweeps_to_clear() + persist_sweeps − 1 = 11 sweeps; nothing is added.
   const std::vector<Box> before_remove = cell.pipeline().boxes();
-  cell.edit(sim::SceneEdit::remove("planted"));
+  cell.edit(transport::SceneEdit::remove("planted"));
   const Versions remove = run(cell, 11);
   EXPECT_EQ(remove.removed, std::vector<std::uint64_t>{planted_id});
   EXPECT_TRUE(remove.added.empty());
@@ -215,7 +206,7 @@ TEST(CellPipelineTest, FarMoveIsOneRemovedAndOneAdded) {
   // 1.2 m away, no overlap with the old box: documented as one removed and one added id (the new place is
   // confirmed after 5–6 sweeps, the old one cleared after 11).
   const Eigen::Vector3d moved_to(0.8, 1.2, 0.87);
-  cell.edit(sim::SceneEdit::move("planted", moved_to));
+  cell.edit(transport::SceneEdit::move("planted", moved_to));
   const Versions move = run(cell, 15);
   EXPECT_EQ(move.removed, std::vector<std::uint64_t>{planted_id});
   ASSERT_EQ(move.added.size(), 1u);
@@ -241,7 +232,7 @@ TEST(CellPipelineTest, SmallMoveKeepsTheIdAndEndsAsOneBox) {
   // modified. The part that appears first gets a box of its own (an added id); once the old place clears,
   // that box lies inside the re-fitted area, is fitted again with the object and removed.
   const Eigen::Vector3d moved_to = at + Eigen::Vector3d(0.05, 0, 0);
-  cell.edit(sim::SceneEdit::move("planted", moved_to));
+  cell.edit(transport::SceneEdit::move("planted", moved_to));
   const Versions move = run(cell, 15);
   EXPECT_NE(std::find(move.modified.begin(), move.modified.end(), planted_id), move.modified.end());
   EXPECT_EQ(std::find(move.removed.begin(), move.removed.end(), planted_id), move.removed.end());

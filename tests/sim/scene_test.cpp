@@ -155,10 +155,10 @@ TEST(ObstacleTest, SignedDistanceVolumeAndSurfaceSamples) {
 
 TEST(SceneEditTest, AddRemoveMoveByName) {
   Scene scene = parse_scene(kScene, "scene.yaml");
-  Obstacle crate{"", BoxShape{Eigen::Vector3d(0.1, 0.1, 0.1)}, Eigen::Isometry3d::Identity()};
-  crate.X_CO.translation() = Eigen::Vector3d(1, 1, 0.85);
-  EXPECT_EQ(apply(scene, SceneEdit::add(crate)), "added_1");
-  EXPECT_EQ(apply(scene, SceneEdit::add(crate)), "added_2");
+  using transport::SceneEdit;
+  SceneEdit crate = SceneEdit::add_box("", {1, 1, 0.85}, {0.1, 0.1, 0.1});
+  EXPECT_EQ(apply(scene, crate), "added_1");
+  EXPECT_EQ(apply(scene, crate), "added_2");
   EXPECT_EQ(scene.obstacles.size(), 5u);
   EXPECT_EQ(apply(scene, SceneEdit::move("drum", {1.0, 2.0, 0.95})), "drum");
   EXPECT_TRUE(scene.obstacles[1].X_CO.translation().isApprox(Eigen::Vector3d(1.0, 2.0, 0.95)));
@@ -174,11 +174,11 @@ TEST(SceneEditTest, AddRemoveMoveByName) {
             }),
             "scene edit: move: no obstacle named 'nothing'");
   crate.name = "table";
-  EXPECT_EQ(error_of([&] { (void)apply(scene, SceneEdit::add(crate)); }),
+  EXPECT_EQ(error_of([&] { (void)apply(scene, crate); }),
             "scene edit: add: an obstacle named 'table' already exists");
   crate.name = "flat";
-  crate.shape = BoxShape{Eigen::Vector3d(0.1, 0.0, 0.1)};
-  EXPECT_NE(error_of([&] { (void)apply(scene, SceneEdit::add(crate)); }), "");
+  crate.half_extents = Eigen::Vector3d(0.1, 0.0, 0.1);
+  EXPECT_NE(error_of([&] { (void)apply(scene, crate); }), "");
   EXPECT_NE(error_of([&] { (void)apply(scene, SceneEdit::move("drum", {NAN, 0, 0})); }), "");
   EXPECT_EQ(scene.obstacles.size(), before.obstacles.size());  // failed edits change nothing
   EXPECT_TRUE(scene.obstacles[1].X_CO.isApprox(before.obstacles[1].X_CO));

@@ -222,8 +222,8 @@ TEST(SimulatorTest, SceneEditChangesExactlyThePointsOfTheEditedObstacle) {
   // Move the carton 15 cm along x and raise it 5 cm; remove the top box of the stack.
   const Eigen::Vector3d moved =
       scene.obstacles[static_cast<std::size_t>(carton)].X_CO.translation() + Eigen::Vector3d(0.15, 0.0, 0.05);
-  simulator.apply(SceneEdit::move("carton", moved));
-  simulator.apply(SceneEdit::remove("stack_3"));
+  simulator.apply(transport::SceneEdit::move("carton", moved));
+  simulator.apply(transport::SceneEdit::remove("stack_3"));
   const std::vector<SimFrame> after = simulator.sweep(cam);  // same seed, same sweep index
   const int carton_after = simulator.scene().find_obstacle("carton");
 

@@ -68,35 +68,23 @@ void add_inject_command(CLI::App& app) {
   add->add_option("--half-extents", options->half_extents, "A,B,C, metres")->required();
   add->add_option("--yaw", options->yaw, "rotation about the cell's z axis, radians");
   add->callback([options] {
-    transport::SceneEdit edit;
-    edit.kind = transport::SceneEdit::Kind::kAddBox;
-    edit.name = fresh_name();
-    edit.center = vector3(options->center, "--center");
-    edit.half_extents = vector3(options->half_extents, "--half-extents");
+    const transport::SceneEdit edit =
+        transport::SceneEdit::add_box(fresh_name(), vector3(options->center, "--center"),
+                                      vector3(options->half_extents, "--half-extents"), options->yaw);
     if (edit.half_extents.minCoeff() <= 0) throw Error("--half-extents: must be positive");
-    edit.yaw = options->yaw;
     send(*options, edit);
     std::cout << edit.name << std::endl;
   });
 
   CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name");
   remove->add_option("--name", options->name, "obstacle name")->required();
-  remove->callback([options] {
-    transport::SceneEdit edit;
-    edit.kind = transport::SceneEdit::Kind::kRemove;
-    edit.name = options->name;
-    send(*options, edit);
-  });
+  remove->callback([options] { send(*options, transport::SceneEdit::remove(options->name)); });
 
   CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre");
   move->add_option("--name", options->name, "obstacle name")->required();
   move->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
   move->callback([options] {
-    transport::SceneEdit edit;
-    edit.kind = transport::SceneEdit::Kind::kMove;
-    edit.name = options->name;
-    edit.center = vector3(options->center, "--center");
-    send(*options, edit);
+    send(*options, transport::SceneEdit::move(options->name, vector3(options->center, "--center")));
   });
 }
 

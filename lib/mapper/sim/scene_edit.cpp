@@ -4,34 +4,23 @@
 
 namespace cellmap::sim {
 
-SceneEdit SceneEdit::add(Obstacle obstacle) {
-  SceneEdit edit;
-  edit.kind = Kind::kAdd;
-  edit.obstacle = std::move(obstacle);
-  return edit;
+namespace {
+
+Obstacle box_obstacle(const transport::SceneEdit& edit) {
+  Obstacle obstacle;
+  obstacle.name = edit.name;
+  obstacle.shape = BoxShape{edit.half_extents};
+  obstacle.X_CO.translation() = edit.center;
+  obstacle.X_CO.linear() = Eigen::AngleAxisd(edit.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return obstacle;
 }
 
-SceneEdit SceneEdit::remove(std::string name) {
-  SceneEdit edit;
-  edit.kind = Kind::kRemove;
-  edit.name = std::move(name);
-  return edit;
-}
+}  // namespace
 
-SceneEdit SceneEdit::move(std::string name, const Eigen::Vector3d& center,
-                          std::optional<Eigen::Quaterniond> rotation) {
-  SceneEdit edit;
-  edit.kind = Kind::kMove;
-  edit.name = std::move(name);
-  edit.center = center;
-  edit.rotation = rotation;
-  return edit;
-}
-
-std::string apply(Scene& scene, const SceneEdit& edit) {
+std::string apply(Scene& scene, const transport::SceneEdit& edit) {
   switch (edit.kind) {
-    case SceneEdit::Kind::kAdd: {
-      Obstacle obstacle = edit.obstacle;
+    case transport::SceneEdit::Kind::kAddBox: {
+      Obstacle obstacle = box_obstacle(edit);
       if (obstacle.name.empty()) {
         for (int k = 1; obstacle.name.empty(); ++k) {
           const std::string candidate = "added_" + std::to_string(k);
@@ -50,25 +39,18 @@ std::string apply(Scene& scene, const SceneEdit& edit) {
       scene = std::move(edited);
       return obstacle.name;
     }
-    case SceneEdit::Kind::kRemove: {
+    case transport::SceneEdit::Kind::kRemove: {
       const int index = scene.find_obstacle(edit.name);
       if (index < 0) throw Error("scene edit: remove: no obstacle named '" + edit.name + "'");
       scene.obstacles.erase(scene.obstacles.begin() + index);
       return edit.name;
     }
-    case SceneEdit::Kind::kMove: {
+    case transport::SceneEdit::Kind::kMove: {
       const int index = scene.find_obstacle(edit.name);
       if (index < 0) throw Error("scene edit: move: no obstacle named '" + edit.name + "'");
       if (!edit.center.allFinite())
         throw Error("scene edit: move '" + edit.name + "': center must be finite");
       Obstacle& obstacle = scene.obstacles[static_cast<std::size_t>(index)];
-      if (edit.rotation) {
-        const Eigen::Quaterniond& q = *edit.rotation;
-        if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
-          throw Error("scene edit: move '" + edit.name + "': rotation must be a unit quaternion");
-        }
-        obstacle.X_CO.linear() = q.normalized().toRotationMatrix();
-      }
       obstacle.X_CO.translation() = edit.center;
       return edit.name;
     }

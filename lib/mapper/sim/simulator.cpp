@@ -21,7 +21,7 @@ Scene validated(Scene scene) {
 Simulator::Simulator(Scene scene, SimOptions options)
     : scene_(validated(std::move(scene))), options_(options), caster_(scene_.obstacles) {}
 
-std::string Simulator::apply(const SceneEdit& edit) {
+std::string Simulator::apply(const transport::SceneEdit& edit) {
   std::string name = sim::apply(scene_, edit);
   caster_ = SceneCaster(scene_.obstacles);
   return name;

@@ -28,15 +28,39 @@ struct CellStatus final {
   std::uint64_t version = 0;
 };
 
-/// cellmap/sim/scene_edits: one edit of a simulated scene (what `cellmap inject` sends).
+/// cellmap/sim/scene_edits: one edit of a simulated scene (what `cellmap inject` sends, what tests plant;
+/// sim::apply applies it). The one scene-edit type.
 struct SceneEdit final {
   enum class Kind { kAddBox, kRemove, kMove };
   std::string cell;  ///< empty: every simulated cell on the domain
   Kind kind = Kind::kAddBox;
-  std::string name;                                        ///< the obstacle's name
+  std::string name;  ///< the obstacle's name (add-box: empty lets the simulator choose one)
   Eigen::Vector3d center = Eigen::Vector3d::Zero();        ///< p_CB, metres (add-box, move)
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< metres (add-box)
   double yaw = 0.0;                                        ///< about the cell's z axis, radians (add-box)
+
+  [[nodiscard]] static SceneEdit add_box(std::string name, const Eigen::Vector3d& center,
+                                         const Eigen::Vector3d& half_extents, double yaw = 0.0) {
+    SceneEdit edit;
+    edit.name = std::move(name);
+    edit.center = center;
+    edit.half_extents = half_extents;
+    edit.yaw = yaw;
+    return edit;
+  }
+  [[nodiscard]] static SceneEdit remove(std::string name) {
+    SceneEdit edit;
+    edit.kind = Kind::kRemove;
+    edit.name = std::move(name);
+    return edit;
+  }
+  [[nodiscard]] static SceneEdit move(std::string name, const Eigen::Vector3d& center) {
+    SceneEdit edit;
+    edit.kind = Kind::kMove;
+    edit.name = std::move(name);
+    edit.center = center;
+    return edit;
+  }
 };
 
 /// cellmap/robot_state: the robot's tool pose at one instant (what the robot controller sends).

@@ -44,7 +44,7 @@ class Simulator final {
   [[nodiscard]] const SimOptions& options() const { return options_; }
 
   /// Applies a scene edit (see sim::apply) for the following frames. @throws Error as sim::apply.
-  std::string apply(const SceneEdit& edit);
+  std::string apply(const transport::SceneEdit& edit);
 
   /// One frame of sensor `sensor` (index into scene().sensors) at joint vector q. Rays are cast through pixel
   /// centres (pixel (u, v) looks along ((u − cx)/fx, (v − cy)/fy, 1)) or along the scanner's beams. Depths
