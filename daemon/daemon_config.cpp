@@ -18,10 +18,16 @@ ReconcileOptions reconcile_from_yaml(YamlMap section) {
   return o;
 }
 
-// Lays `overlay` over `base`: maps merge key by key, anything else replaces.
+// A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by the
+// user replaces the default pose whole instead of merging into it.
+bool is_pose(const YAML::Node& map) {
+  return map["position"] || map["translation"] || map["rotation"];
+}
+
+// Lays `overlay` over `base`: maps merge key by key, anything else (and a pose) replaces.
 YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay) {
   if (!overlay || overlay.IsNull()) return YAML::Clone(base);
-  if (!base.IsDefined() || !base.IsMap() || !overlay.IsMap()) return YAML::Clone(overlay);
+  if (!base.IsDefined() || !base.IsMap() || !overlay.IsMap() || is_pose(overlay)) return YAML::Clone(overlay);
   YAML::Node merged = YAML::Clone(base);
   for (const auto& entry : overlay) {
     const std::string key = entry.first.as<std::string>();

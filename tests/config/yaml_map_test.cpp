@@ -60,10 +60,8 @@ TEST(YamlMapTest, NonMapDocumentIsRejected) {
 // reads as `position`.
 TEST(YamlMapTest, PoseReadsPositionOrTranslationAndRotation) {
   YamlMap root = YamlMap::parse(
-      "a: {position: [1, 2, 3], rotation: [0.7071067811865476, 0, 0, 0.7071067811865476]}
-      "
-      "b: {translation: [1, 2, 3]}
-      ",
+      "a: {position: [1, 2, 3], rotation: [0.7071067811865476, 0, 0, 0.7071067811865476]}\n"
+      "b: {translation: [1, 2, 3]}\n",
       "cfg.yaml");
   const Eigen::Isometry3d a = root.pose("a");
   EXPECT_TRUE(a.translation().isApprox(Eigen::Vector3d(1, 2, 3)));
@@ -75,14 +73,10 @@ TEST(YamlMapTest, PoseReadsPositionOrTranslationAndRotation) {
 
 TEST(YamlMapTest, PoseErrorsNameTheKey) {
   YamlMap root = YamlMap::parse(
-      "both: {position: [0, 0, 0], translation: [0, 0, 0]}
-      "
-      "short: {position: [0, 0]}
-      "
-      "tilted: {rotation: [1, 1, 0, 0]}
-      "
-      "typo: {positon: [0, 0, 0]}
-      ",
+      "both: {position: [0, 0, 0], translation: [0, 0, 0]}\n"
+      "short: {position: [0, 0]}\n"
+      "tilted: {rotation: [1, 1, 0, 0]}\n"
+      "typo: {positon: [0, 0, 0]}\n",
       "cfg.yaml");
   EXPECT_EQ(error_of([&] { (void)root.pose("both"); }),
             "cfg.yaml: both.translation: is another spelling of position: give one of them");
