@@ -30,7 +30,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cell_pipeline.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/environment/environment.hpp"
 #include "cellmap/io/cloud_file.hpp"

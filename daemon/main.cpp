@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "camera_input.hpp"
-#include "cell_pipeline.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/environment/version_store.hpp"

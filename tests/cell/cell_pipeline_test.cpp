@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "cell_pipeline.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/environment/reconcile.hpp"
 #include "cellmap/sim/default_scene.hpp"

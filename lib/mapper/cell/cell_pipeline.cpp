@@ -1,4 +1,4 @@
-#include "cell_pipeline.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
