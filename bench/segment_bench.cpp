@@ -7,10 +7,10 @@
 //   obb              ours (PCA + axis refinement)      vs pcl::MomentOfInertiaEstimation::getOBB
 // on the segments of our own pipeline for the OBB stage. A ratio above 1 means ours is faster.
 //
-// And the incremental pipeline of cellmapd (daemon/cell_pipeline.hpp) on a simulated 30-object cell (the
-// default cell's floor, table and legs plus 24 objects on the table, Kinect model with noise): the map is
-// converged (the first version, then sweeps until 10 in a row publish nothing), one box is added in a free
-// spot, and sweeps run until the pipeline publishes it. On the state of that sweep (map fused, boxes as
+// And the cell pipeline (cellmap/cell/cell_pipeline.hpp, with cellmapd's defaults) on a simulated 30-object
+// cell (the default cell's floor, table and legs plus 24 objects on the table, Kinect model with noise): the
+// map is converged (the first version, then sweeps until 10 in a row publish nothing), one box is added in a
+// free spot, and sweeps run until the pipeline publishes it. On the state of that sweep (map fused, boxes as
 // before it) both ways of publishing the change are timed, and both end in the delta against the current
 // environment:
 //   incremental   change detection of that sweep (measured once, added to each iteration) + re-segmenting the
@@ -32,11 +32,13 @@
 
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/environment/environment.hpp"
 #include "cellmap/io/cloud_file.hpp"
 #include "cellmap/segment/pipeline.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/simulator.hpp"
+#include "daemon_config.hpp"
 #include "ratio_report.hpp"
 
 namespace cellmap {
@@ -253,10 +255,10 @@ sim::Scene thirty_object_cell() {
 
 // The pipeline state just after the sweep that confirmed the added object, before its boxes were applied.
 struct ChangeFixture {
-  std::unique_ptr<daemon::CellPipeline> pipeline;  // map after the sweep, boxes before it
-  ChangeSet changes;                               // what that sweep confirmed
-  double t_change = 0;                             // seconds its change detection took
-  Environment current;                             // the environment published before the change
+  std::unique_ptr<CellPipeline> pipeline;  // map after the sweep, boxes before it
+  ChangeSet changes;                       // what that sweep confirmed
+  double t_change = 0;                     // seconds its change detection took
+  Environment current;                     // the environment published before the change
   int sweeps_to_converge = 0;
   int sweeps_to_publish = 0;
   int other_versions = 0;  // versions between the edit and the one with the added object
@@ -266,8 +268,8 @@ struct ChangeFixture {
 const ChangeFixture& change_fixture() {
   static const ChangeFixture fixture = [] {
     ChangeFixture f;
-    const daemon::DaemonConfig config =
-        daemon::DaemonConfig::parse(daemon::default_config_yaml(), "cellmapd defaults", ".");
+    const CellPipelineConfig config =
+        daemon::DaemonConfig::parse(daemon::default_config_yaml(), "cellmapd defaults", ".").pipeline;
     sim::Simulator simulator(thirty_object_cell());
     const int sensor = simulator.scene().find_sensor("kinect");
     std::uint64_t index = 0;
@@ -276,7 +278,7 @@ const ChangeFixture& change_fixture() {
       for (sim::SimFrame& frame : simulator.sweep(sensor, index++)) frames.push_back(std::move(frame.frame));
       return merge_frames(frames);
     };
-    daemon::CellPipeline pipeline(config, {}, 1);
+    CellPipeline pipeline(config);
     std::uint64_t version = 0;
     for (int quiet = 0; (version == 0 || quiet < 10) && f.sweeps_to_converge < 200; ++f.sweeps_to_converge) {
       quiet = pipeline.process(next_sweep()).change ? (++version, 0) : quiet + 1;
@@ -288,7 +290,7 @@ const ChangeFixture& change_fixture() {
     while (f.sweeps_to_publish < 30) {
       const std::vector<Box> boxes_before = pipeline.boxes();
       const std::uint64_t next_id_before = pipeline.next_box_id();
-      daemon::SweepReport report = pipeline.process(next_sweep());
+      SweepReport report = pipeline.process(next_sweep());
       ++f.sweeps_to_publish;
       if (!report.change) continue;
       // Its top is seen first (the sides collect their hits a sweep or two later).
@@ -300,8 +302,7 @@ const ChangeFixture& change_fixture() {
         ++f.other_versions;
         continue;
       }
-      f.pipeline =
-          std::make_unique<daemon::CellPipeline>(config, boxes_before, next_id_before, pipeline.map_state());
+      f.pipeline = std::make_unique<CellPipeline>(config, boxes_before, next_id_before, pipeline.map_state());
       f.changes = std::move(report.changes);
       f.t_change = report.t_change;
       return f;
@@ -325,7 +326,9 @@ void BM_PublishChangeIncremental(benchmark::State& state) {
   std::size_t evidence = 0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    const Reconciled r = f.pipeline->resegment(f.changes, &evidence);
+    const Resegmentation resegmentation = f.pipeline->resegment(f.changes);
+    const Reconciled& r = resegmentation.reconciled;
+    evidence = resegmentation.evidence;
     const EnvironmentDelta delta = diff(f.current, Environment("bench", f.current.version() + 1, 0, r.boxes));
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() +
                            f.t_change);
@@ -344,7 +347,7 @@ void BM_PublishChangeFull(benchmark::State& state) {
   if (!f.failure.empty()) return state.SkipWithError(f.failure.c_str());
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    const Reconciled r = f.pipeline->resegment_everything();
+    const Reconciled r = f.pipeline->resegment_everything().reconciled;
     const EnvironmentDelta delta = diff(f.current, Environment("bench", f.current.version() + 1, 0, r.boxes));
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     count_delta(state, r, delta);

@@ -8,16 +8,6 @@
 namespace cellmap::daemon {
 namespace {
 
-ReconcileOptions reconcile_from_yaml(YamlMap section) {
-  ReconcileOptions o;
-  o.min_overlap = section.number("min_overlap", o.min_overlap, 0.0, 1.0);
-  o.position_tolerance = section.number("position_tolerance", o.position_tolerance, 0.0, 1.0);
-  o.rotation_tolerance = section.number("rotation_tolerance", o.rotation_tolerance, 0.0, 3.2);
-  o.redundant_tolerance = section.number("redundant_tolerance", o.redundant_tolerance, 0.0, 1.0);
-  section.expect_all_read();
-  return o;
-}
-
 // A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by the
 // user replaces the default pose whole instead of merging into it.
 bool is_pose(const YAML::Node& map) {
@@ -94,10 +84,7 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
     root.fail("log_level", "must be one of trace, debug, info, warn, error");
 
   c.source = read_source(root.child("source"), c.sweep_period, base_dir);
-  c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
-  c.change = ChangeConfig::from_yaml(root.child("change"));
-  c.segment = segment_config_from_yaml(root.child("segment"));
-  c.reconcile = reconcile_from_yaml(root.child("reconcile"));
+  c.pipeline = CellPipelineConfig::from_yaml(root);
   root.expect_all_read();
   return c;
 }

@@ -6,10 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "cellmap/change/change_detector.hpp"
-#include "cellmap/environment/reconcile.hpp"
-#include "cellmap/occupancy/occupancy_config.hpp"
-#include "cellmap/segment/pipeline.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/sensor/sensor_config.hpp"
 #include "cellmap/sweep/sweep_assembler.hpp"
 
@@ -51,10 +48,8 @@ struct DaemonConfig final {
   std::uint32_t delta_depth = 16;  ///< `delta_depth`: deltas kept for late joiners
   std::string log_level = "info";  ///< `log_level`: trace | debug | info | warn | error
   SourceConfig source;
-  OccupancyConfig occupancy;   ///< `occupancy` section
-  ChangeConfig change;         ///< `change` section
-  SegmentConfig segment;       ///< `segment` section: the keys of config/segment.yaml
-  ReconcileOptions reconcile;  ///< `reconcile` section
+  /// The sections `occupancy`, `change`, `segment` and `reconcile`: what makes the map and the boxes.
+  CellPipelineConfig pipeline;
 
   /// Reads a config file laid over the built-in defaults (default_config_yaml(), key by key), so every key is
   /// optional.

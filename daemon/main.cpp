@@ -80,10 +80,10 @@ class Daemon {
     std::uint64_t next_id = 1;
     for (const Box& box : boxes) next_id = std::max(next_id, box.id + 1);
     try {
-      pipeline_.emplace(config_, boxes, next_id, map_state);
+      pipeline_.emplace(config_.pipeline, boxes, next_id, map_state);
     } catch (const Error& e) {
       spdlog::warn("state: {}; starting with an empty map", e.what());
-      pipeline_.emplace(config_, boxes, next_id);
+      pipeline_.emplace(config_.pipeline, boxes, next_id);
     }
     current_ = recovered.environment;
     if (current_.version() > 0) resume();

@@ -1,4 +1,4 @@
-// cellmapd's per-sweep pipeline (fusion → change → re-segmentation → reconcile) on the simulated cell with
+// The cell pipeline (fusion → change → re-segmentation → reconcile) on the simulated cell with
 // planted changes: exact deltas with stable ids, every change covered, removals within the documented sweeps,
 // and no versions from sensor noise.
 #include <gtest/gtest.h>
@@ -8,19 +8,22 @@
 
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/environment/reconcile.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/simulator.hpp"
 
-namespace cellmap::daemon {
+namespace cellmap {
 namespace {
 
 // Share of the true surface every state must keep covered. Every occupied voxel is inside a box; a surface
 // point can still lie in a voxel that noise left free (measured: 1 of ~61 000 points, 99.998 %).
 constexpr double kCoverage = 0.9999;
 
-DaemonConfig defaults() {
-  return DaemonConfig::parse(default_config_yaml(), "cellmapd defaults", ".");
+// The pipeline as cellmapd runs it: the sections of its shipped defaults.
+CellPipelineConfig defaults() {
+  YamlMap root = YamlMap::load(CELLMAP_SOURCE_DIR "/config/cellmapd.yaml");
+  return CellPipelineConfig::from_yaml(root);
 }
 
 // The default cell seen by its Kinect binned 4× (128 × 106; 1.8 cm pixels on the table, still below the
@@ -41,7 +44,7 @@ sim::Scene coarse_cell() {
 // A simulated cell swept by its Kinect, and the pipeline fed with its sweeps.
 class Cell {
  public:
-  explicit Cell(sim::Scene scene, bool noise = true, const DaemonConfig& config = defaults())
+  explicit Cell(sim::Scene scene, bool noise = true, const CellPipelineConfig& config = defaults())
       : simulator_(std::move(scene), sim::SimOptions{noise, 2}),
         exact_(simulator_.scene(), sim::SimOptions{false, 2}),
         sensor_(simulator_.scene().find_sensor("kinect")),
@@ -119,10 +122,10 @@ void expect_kept(const std::vector<Box>& before, const std::vector<Box>& after,
 
 // Settled: the first version, then quiet sweeps.
 void settle(Cell& cell) {
-  const DaemonConfig config = defaults();
-  const auto [first, sweeps] = cell.until_version(config.change.settle_sweeps);
+  const CellPipelineConfig config = defaults();
+  const auto [first, sweeps] = cell.until_version(config.settle_sweeps);
   ASSERT_TRUE(first) << "no first version within change.settle_sweeps";
-  EXPECT_EQ(sweeps, config.change.settle_sweeps) << "the first version must wait for the map to settle";
+  EXPECT_EQ(sweeps, config.settle_sweeps) << "the first version must wait for the map to settle";
   EXPECT_EQ(first->removed.size() + first->modified.size(), 0u);
 }
 
@@ -267,4 +270,4 @@ TEST(CellPipelineNoiseTest, StaticNoisyCellMakesNoVersionAfterTheFirst) {
 }
 
 }  // namespace
-}  // namespace cellmap::daemon
+}  // namespace cellmap

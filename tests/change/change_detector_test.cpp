@@ -52,13 +52,12 @@ Sweep sweep_of(const std::vector<AlignedBox>& scene, const PinholeIntrinsics& ca
 }
 
 TEST(ChangeConfigTest, ReadsKeysAndNamesBadOnes) {
-  YamlMap root = YamlMap::parse(
-      "change:\n  persist_sweeps: 5\n  margin: 0.1\n  min_voxels: 3\n  settle_sweeps: 7\n", "cell.yaml");
+  YamlMap root =
+      YamlMap::parse("change:\n  persist_sweeps: 5\n  margin: 0.1\n  min_voxels: 3\n", "cell.yaml");
   const ChangeConfig c = ChangeConfig::from_yaml(root.child("change"));
   EXPECT_EQ(c.persist_sweeps, 5);
   EXPECT_DOUBLE_EQ(c.margin, 0.1);
   EXPECT_EQ(c.min_voxels, 3);
-  EXPECT_EQ(c.settle_sweeps, 7);
   const ChangeConfig defaults;
   EXPECT_EQ(defaults.persist_sweeps, 3);
   EXPECT_DOUBLE_EQ(defaults.margin, 0.05);
@@ -72,8 +71,6 @@ TEST(ChangeConfigTest, ReadsKeysAndNamesBadOnes) {
             "cell.yaml: change.persist_sweeps: must be an integer in [1, 1000], got 0");
   EXPECT_EQ(error_of([&] { (void)parse("change:\n  margin: -0.1\n"); }),
             "cell.yaml: change.margin: must be in [0, 10], got -0.1");
-  EXPECT_EQ(error_of([&] { (void)parse("change:\n  settle_sweeps: -1\n"); }),
-            "cell.yaml: change.settle_sweeps: must be an integer in [0, 100000], got -1");
   ChangeConfig bad;
   bad.min_voxels = 0;
   EXPECT_EQ(error_of([&] { ChangeDetector{bad}; }),

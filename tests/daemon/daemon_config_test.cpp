@@ -21,11 +21,11 @@ TEST(DaemonConfigTest, BuiltInDefaultsAreTheShippedFile) {
   EXPECT_EQ(c.cell, "cell-1");
   EXPECT_EQ(c.source.kind, "sim");
   EXPECT_TRUE(c.source.scene.empty());
-  EXPECT_DOUBLE_EQ(c.occupancy.resolution, 0.02);
-  EXPECT_EQ(c.change.persist_sweeps, 3);
+  EXPECT_DOUBLE_EQ(c.pipeline.occupancy.resolution, 0.02);
+  EXPECT_EQ(c.pipeline.change.persist_sweeps, 3);
   // The voxel-tuned segmentation of config/cellmapd.yaml, not the batch defaults of config/segment.yaml.
-  EXPECT_EQ(c.segment.k, 26);
-  EXPECT_DOUBLE_EQ(c.segment.region_growing.gap, 0.035);
+  EXPECT_EQ(c.pipeline.segment.k, 26);
+  EXPECT_DOUBLE_EQ(c.pipeline.segment.region_growing.gap, 0.035);
 }
 
 TEST(DaemonConfigTest, FileOverlaysDefaultsKeyByKey) {
@@ -35,8 +35,8 @@ TEST(DaemonConfigTest, FileOverlaysDefaultsKeyByKey) {
   EXPECT_EQ(c.cell, "press-3");
   EXPECT_EQ(c.source.scene, std::filesystem::path("/etc/cellmap/scenes/small.yaml"));
   EXPECT_EQ(c.source.sensor, "kinect");  // untouched sibling key keeps its default
-  EXPECT_DOUBLE_EQ(c.segment.region_growing.gap, 0.05);
-  EXPECT_EQ(c.segment.k, 26);
+  EXPECT_DOUBLE_EQ(c.pipeline.segment.region_growing.gap, 0.05);
+  EXPECT_EQ(c.pipeline.segment.k, 26);
 }
 
 TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {

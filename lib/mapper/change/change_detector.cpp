@@ -48,8 +48,6 @@ void ChangeConfig::validate() const {
   if (!(margin >= 0.0 && margin <= 10.0)) bad("margin", "must be in [0, 10] m", margin);
   if (min_voxels < 1 || min_voxels > 1000000)
     bad("min_voxels", "must be an integer in [1, 1000000]", min_voxels);
-  if (settle_sweeps < 0 || settle_sweeps > 100000)
-    bad("settle_sweeps", "must be an integer in [0, 100000]", settle_sweeps);
 }
 
 ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
@@ -57,7 +55,6 @@ ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
   c.persist_sweeps = static_cast<int>(section.integer("persist_sweeps", c.persist_sweeps, 1, 1000));
   c.margin = section.number("margin", c.margin, 0.0, 10.0);
   c.min_voxels = static_cast<int>(section.integer("min_voxels", c.min_voxels, 1, 1000000));
-  c.settle_sweeps = static_cast<int>(section.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   section.expect_all_read();
   return c;
 }

@@ -29,17 +29,11 @@ struct ChangeConfig final {
   /// default 2 here, 3 in cellmapd's config). Depth noise mostly moves a surface by a voxel, so its flips
   /// touch the surface they belong to and do not make a region.
   int min_voxels = 2;
-  /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, ≥ 0; default 15). Read
-  /// by the daemon's pipeline, not by ChangeDetector: a fresh map keeps gaining voxels for a while (surfaces
-  /// seen at grazing angles need several sweeps to collect two hits, flying pixels in unobserved space decay
-  /// slowly), so the first version is one segmentation of the settled map instead of a trickle of small
-  /// versions. 0 = the first sweep makes the first version.
-  int settle_sweeps = 15;
 
   /// @throws Error naming the field if a value is out of range.
   void validate() const;
-  /// Reads the `change` section (keys persist_sweeps, margin, min_voxels,
-  /// settle_sweeps; absent keys keep their defaults).
+  /// Reads the `change` section (keys persist_sweeps, margin, min_voxels; absent keys keep their defaults).
+  /// Keys the caller read from `section` before (the cell pipeline's settle_sweeps) are not unknown.
   /// @throws Error naming the key ("change.margin: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static ChangeConfig from_yaml(YamlMap section);
 };

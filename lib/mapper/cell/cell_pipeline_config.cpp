@@ -1,0 +1,31 @@
+#include "cellmap/cell/cell_pipeline.hpp"
+
+namespace cellmap {
+namespace {
+
+ReconcileOptions read_reconcile(YamlMap section) {
+  ReconcileOptions o;
+  o.min_overlap = section.number("min_overlap", o.min_overlap, 0.0, 1.0);
+  o.position_tolerance = section.number("position_tolerance", o.position_tolerance, 0.0, 1.0);
+  o.rotation_tolerance = section.number("rotation_tolerance", o.rotation_tolerance, 0.0, 3.2);
+  o.redundant_tolerance = section.number("redundant_tolerance", o.redundant_tolerance, 0.0, 1.0);
+  section.expect_all_read();
+  return o;
+}
+
+}  // namespace
+
+CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
+  CellPipelineConfig c;
+  c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
+  // settle_sweeps sits in the `change` section (where operators look for it) but is the pipeline's policy:
+  // read it here, the rest of the section by the change detector's reader.
+  YamlMap change = root.child("change");
+  c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
+  c.change = ChangeConfig::from_yaml(change);
+  c.segment = segment_config_from_yaml(root.child("segment"));
+  c.reconcile = read_reconcile(root.child("reconcile"));
+  return c;
+}
+
+}  // namespace cellmap
