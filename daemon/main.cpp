@@ -77,8 +77,7 @@ class Daemon {
       }
     }
     const std::vector<Box>& boxes = recovered.environment.boxes();
-    std::uint64_t next_id = 1;
-    for (const Box& box : boxes) next_id = std::max(next_id, box.id + 1);
+    const std::uint64_t next_id = recovered.next_box_id;
     try {
       pipeline_.emplace(config_.pipeline, boxes, next_id, map_state);
     } catch (const Error& e) {
@@ -135,13 +134,9 @@ class Daemon {
   }
 
  private:
-  // A restart resumes at the persisted version. If a number was reserved beyond it (a crash between reserve
-  // and save), the same boxes go out again under a fresh number so no subscriber keeps a lost version.
+  // A restart resumes at the persisted version (VersionStore::resume() says under which number).
   void resume() {
-    if (store_.next_version() > current_.version() + 1) {
-      current_ = Environment(config_.cell, store_.next_version(), now_ns(), current_.boxes());
-      store_.save(current_, pipeline_->map_state());
-    }
+    current_ = store_.resume(now_ns(), pipeline_->map_state());
     publisher_.publish(current_);
     spdlog::info("resumed version {} with {} boxes", current_.version(), current_.boxes().size());
   }
@@ -301,7 +296,7 @@ class Daemon {
   void publish_version(const Reconciled& change) {
     const Environment next(config_.cell, store_.next_version(), now_ns(), pipeline_->boxes());
     const EnvironmentDelta delta = diff(current_, next);
-    store_.save(next, pipeline_->map_state());
+    store_.save(next, pipeline_->map_state(), pipeline_->next_box_id());
     publisher_.publish(next, delta);
     current_ = next;
     current_version_ = next.version();

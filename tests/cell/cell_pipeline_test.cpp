@@ -257,6 +257,21 @@ TEST(CellPipelineTest, MapStateRoundTripsWithItsViewpointAndRejectsGarbage) {
   EXPECT_THROW(CellPipeline(defaults(), {}, 1, std::string("not a state\n")), Error);
 }
 
+// The box-id counter lives with the versions, not in the map state: a restored pipeline goes on from the
+// counter it is given. A state written before (version 2, with the counter) still raises it.
+TEST(CellPipelineTest, MapStateLeavesTheBoxIdCounterToTheCallerAndOlderStatesStillRaiseIt) {
+  Cell cell(coarse_cell());
+  (void)cell.sweep();
+  const std::string state = cell.pipeline().map_state();
+  ASSERT_EQ(state.rfind("cellmap-map-state 3\n", 0), 0u);
+  EXPECT_EQ(CellPipeline(defaults(), {}, 9, state).next_box_id(), 9u);
+  const std::string older = "cellmap-map-state 2\n12\n" + state.substr(state.find('\n') + 1);
+  const CellPipeline from_older(defaults(), {}, 9, older);
+  EXPECT_EQ(from_older.next_box_id(), 12u);
+  EXPECT_EQ(from_older.map_state(), state);  // same map and viewpoint, written in the current format
+  EXPECT_EQ(CellPipeline(defaults(), {}, 20, older).next_box_id(), 20u);
+}
+
 // Sensor noise (Kinect model: depth noise and flying pixels at edges) on a static cell: after the first
 // version no other may appear. 300 sweeps of the coarse cell (~1 min in Release; the 1 000 on the
 // default cell were run by hand, see README).

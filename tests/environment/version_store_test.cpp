@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "cellmap/common/atomic_file.hpp"
@@ -83,10 +84,6 @@ TEST(VersionStoreTest, RefusesBackwardsAndForeignCells) {
   EXPECT_THROW(store.save(content(3)), Error);
   EXPECT_THROW(store.save(content(2)), Error);
   EXPECT_THROW(store.save(Environment("cell-b", 9, 0, {})), Error);
-  store.reserve(7);
-  EXPECT_THROW(store.save(content(6)), Error);  // 7 may be out already; 6 would be published after it
-  EXPECT_THROW(store.reserve(5), Error);
-  EXPECT_EQ(store.next_version(), 8u);
   EXPECT_THROW(VersionStore(dir.path(), "cell-b"), Error);
 }
 
@@ -157,38 +154,20 @@ TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
   EXPECT_TRUE(fs::exists(dir.path() / "notes.txt"));
 }
 
-TEST(VersionStoreTest, ReservationSurvivesWithoutSnapshot) {
-  test::TempDir dir;
-  {
-    VersionStore store(dir.path(), "cell-a");
-    store.save(content(1));
-    store.reserve(2);  // published 2, then crashed before saving it
-  }
-  VersionStore store(dir.path(), "cell-a");
-  EXPECT_EQ(store.recovered().environment, content(1));
-  EXPECT_EQ(store.next_version(), 3u);
-}
-
-// Runs in a forked child until killed: each loop publishes one version, in the order the store documents.
-// The "publication" is the version number written to `fd`.
-[[noreturn]] void write_versions_forever(const fs::path& dir, int fd, bool reserve_first) {
+// Runs in a forked child until killed: each loop publishes one version, in the order the store documents
+// (saved, then published). The "publication" is the version number written to `fd`.
+[[noreturn]] void write_versions_forever(const fs::path& dir, int fd) {
   VersionStore store(dir, "cell-a");
   for (;;) {
     const std::uint64_t v = store.next_version();
-    if (reserve_first) {
-      store.reserve(v);
-      if (::write(fd, &v, sizeof v) != sizeof v) ::_exit(3);
-      store.save(content(v), blob_of(v));
-    } else {
-      store.save(content(v), blob_of(v));
-      if (::write(fd, &v, sizeof v) != sizeof v) ::_exit(3);
-    }
+    store.save(content(v), blob_of(v), v + 10);
+    if (::write(fd, &v, sizeof v) != sizeof v) ::_exit(3);
   }
 }
 
-void kill_during_writes(bool reserve_first) {
+TEST(VersionStoreTest, KillDuringWritesNeverReusesAVersion) {
   test::TempDir dir;
-  std::mt19937 random(reserve_first ? 11 : 12);
+  std::mt19937 random(12);
   std::uniform_int_distribution<int> delay_us(0, 40'000);
   std::uint64_t published = 0;
   std::uint64_t loaded_before = 0;
@@ -200,7 +179,7 @@ void kill_during_writes(bool reserve_first) {
     if (child == 0) {
       ::close(fds[0]);
       try {
-        write_versions_forever(dir.path(), fds[1], reserve_first);
+        write_versions_forever(dir.path(), fds[1]);
       } catch (...) {
         ::_exit(2);
       }
@@ -208,7 +187,6 @@ void kill_during_writes(bool reserve_first) {
     ::close(fds[1]);
     // Let the child get a few versions out (it must have started writing), then kill it at a random instant.
     std::uint64_t v = 0;
-    std::uint64_t before_last = 0;  // the publication before this round's last one
     ASSERT_EQ(::read(fds[0], &v, sizeof v), static_cast<ssize_t>(sizeof v));
     published = std::max(published, v);
     ::usleep(static_cast<useconds_t>(delay_us(random)));
@@ -216,39 +194,149 @@ void kill_during_writes(bool reserve_first) {
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
     ASSERT_TRUE(WIFSIGNALED(status)) << "child failed on its own, exit " << WEXITSTATUS(status);
-    while (::read(fds[0], &v, sizeof v) == static_cast<ssize_t>(sizeof v)) {
-      before_last = published;
-      published = std::max(published, v);
-    }
+    while (::read(fds[0], &v, sizeof v) == static_cast<ssize_t>(sizeof v)) published = std::max(published, v);
     ::close(fds[0]);
 
     VersionStore store(dir.path(), "cell-a");
     const Environment& env = store.recovered().environment;
     EXPECT_TRUE(store.recovered().problems.empty()) << store.recovered().problems.front();
-    if (env.version() == 0) {  // killed before the first save completed (reserve-first only)
-      EXPECT_TRUE(reserve_first);
-      EXPECT_EQ(env, Environment("cell-a"));
-    } else {
-      EXPECT_EQ(env, content(env.version())) << "round " << round;
-      ASSERT_TRUE(store.recovered().blob.has_value());
-      EXPECT_EQ(read_file(*store.recovered().blob), blob_of(env.version()));
-    }
+    ASSERT_NE(env.version(), 0u) << "round " << round;
+    EXPECT_EQ(env, content(env.version())) << "round " << round;
+    ASSERT_TRUE(store.recovered().blob.has_value());
+    EXPECT_EQ(read_file(*store.recovered().blob), blob_of(env.version()));
     EXPECT_GE(env.version(), loaded_before);
-    // Saved before published: nothing published is lost. Reserved first: the version published before the
-    // last one was saved before the last one was reserved.
-    EXPECT_GE(env.version(), reserve_first ? before_last : published) << "round " << round;
+    // Saved before published: nothing published is lost.
+    EXPECT_GE(env.version(), published) << "round " << round;
     EXPECT_GT(store.next_version(), published)
         << "round " << round << ": a published version would be reused";
+    // Every id a saved version handed out (its counter, v + 10) stays handed out.
+    EXPECT_GE(store.recovered().next_box_id, published + 10) << "round " << round;
     loaded_before = env.version();
   }
   EXPECT_GE(published, 25u);  // every round published at least once
 }
 
-TEST(VersionStoreTest, KillDuringWritesNeverReusesAVersionSaveFirst) {
-  kill_during_writes(false);
+Box box_with_id(std::uint64_t id) {
+  Box box;
+  box.id = id;
+  box.center = {0.5 * static_cast<double>(id), 0.0, 0.5};
+  box.half_extents = {0.1, 0.1, 0.1};
+  return box;
 }
-TEST(VersionStoreTest, KillDuringWritesNeverReusesAVersionReserveFirst) {
-  kill_during_writes(true);
+
+// Versions 1-3 of a cell whose box 4 appeared in version 2 and went again in 3; the counter is at 5.
+void save_removed_box_history(VersionStore& store) {
+  store.save(Environment("cell-a", 1, 1, {box_with_id(1), box_with_id(2), box_with_id(3)}), blob_of(1), 4);
+  store.save(Environment("cell-a", 2, 2, {box_with_id(1), box_with_id(2), box_with_id(3), box_with_id(4)}),
+             blob_of(2), 5);
+  store.save(Environment("cell-a", 3, 3, {box_with_id(1), box_with_id(2), box_with_id(3)}), blob_of(3), 5);
+}
+
+TEST(VersionStoreTest, BoxIdCounterIsKeptWithTheVersionsAndNeverGoesBack) {
+  test::TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    EXPECT_EQ(store.next_box_id(), 1u);
+    save_removed_box_history(store);
+    EXPECT_EQ(store.next_box_id(), 5u);
+    store.save(Environment("cell-a", 4, 4, {box_with_id(1)}));  // no counter given: it stays where it was
+    EXPECT_EQ(store.next_box_id(), 5u);
+    store.save(Environment("cell-a", 5, 5, {box_with_id(1), box_with_id(7)}), std::nullopt, 2);
+    EXPECT_EQ(store.next_box_id(), 8u);  // never below the ids of the version itself
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().next_box_id, 8u);
+  EXPECT_EQ(store.next_box_id(), 8u);
+  EXPECT_TRUE(store.recovered().problems.empty());
+}
+
+// Version 4 added box 5 and is lost (its blob or its JSON): the store falls back to version 3, whose boxes
+// end at id 3 and whose own counter says 5. Both ids 4 (removed in 3) and 5 (added in 4) may have been
+// published, and the counter is above them.
+TEST(VersionStoreTest, LostNewestVersionDoesNotBringBackItsBoxIds) {
+  for (const char* lost :
+       {"environment-00000000000000000004.blob", "environment-00000000000000000004.json"}) {
+    test::TempDir dir;
+    {
+      VersionStore store(dir.path(), "cell-a");
+      save_removed_box_history(store);
+      store.save(
+          Environment("cell-a", 4, 4, {box_with_id(1), box_with_id(2), box_with_id(3), box_with_id(5)}),
+          blob_of(4), 6);
+    }
+    std::ofstream(dir.path() / lost, std::ios::trunc) << "garbage";
+    VersionStore store(dir.path(), "cell-a");
+    EXPECT_EQ(store.recovered().environment.version(), 3u) << lost;
+    EXPECT_EQ(store.recovered().next_box_id, 6u) << lost << ": an id handed out before would come again";
+    EXPECT_EQ(store.next_version(), 5u) << lost;
+  }
+}
+
+TEST(VersionStoreTest, SnapshotsOfAnOlderVersionWithoutTheCounterStillOpen) {
+  test::TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    store.save(content(3), blob_of(3), 40);
+  }
+  // What an older cellmapd wrote: no next_box_id in the snapshot, no marker.
+  const fs::path snapshot = dir.path() / "environment-00000000000000000003.json";
+  nlohmann::json doc = nlohmann::json::parse(read_file(snapshot));
+  doc.erase("next_box_id");
+  std::ofstream(snapshot, std::ios::trunc) << doc.dump(1);
+  fs::remove(dir.path() / "next-box-id-00000000000000000040");
+
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(3));
+  EXPECT_EQ(read_file(*store.recovered().blob), blob_of(3));
+  EXPECT_EQ(store.recovered().next_box_id, content(3).boxes().back().id + 1);  // above the ids it holds
+  ASSERT_EQ(store.recovered().problems.size(), 1u);
+  EXPECT_NE(store.recovered().problems[0].find("no next_box_id"), std::string::npos)
+      << store.recovered().problems[0];
+}
+
+TEST(VersionStoreTest, ResumeSavesTheRecoveredBoxesAgainAboveALostNumber) {
+  test::TempDir dir;
+  {
+    VersionStore fresh(dir.path(), "cell-a");
+    EXPECT_EQ(fresh.resume(99), Environment("cell-a"));  // nothing to announce
+    fresh.save(content(1), blob_of(1));
+    fresh.save(content(2), blob_of(2));
+  }
+  {
+    VersionStore store(dir.path(), "cell-a");
+    EXPECT_EQ(store.resume(99), content(2));  // nothing lost: announced as it was
+    EXPECT_EQ(store.next_version(), 3u);
+  }
+  std::ofstream(dir.path() / "environment-00000000000000000002.json", std::ios::trunc) << "{";
+  {
+    // 2 may have been published: version 1's boxes go out again as 3, stamped now, with the given blob.
+    VersionStore store(dir.path(), "cell-a");
+    const Environment resumed = store.resume(99, "map");
+    EXPECT_EQ(resumed, Environment("cell-a", 3, 99, content(1).boxes()));
+    EXPECT_EQ(store.next_version(), 4u);
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, Environment("cell-a", 3, 99, content(1).boxes()));
+  EXPECT_EQ(read_file(*store.recovered().blob), "map");
+}
+
+TEST(VersionStoreTest, RemovedDirectoryIsNoticedAndRecreatedByTheNextSave) {
+  test::TempDir dir;
+  const fs::path state = dir.path() / "state";
+  {
+    VersionStore store(state, "cell-a");
+    EXPECT_TRUE(store.holds_last_saved());  // nothing saved yet: nothing to lose
+    store.save(content(1), blob_of(1), 20);
+    EXPECT_TRUE(store.holds_last_saved());
+    fs::remove_all(state);
+    EXPECT_FALSE(store.holds_last_saved());
+    store.save(content(2), blob_of(2));
+    EXPECT_TRUE(store.holds_last_saved());
+  }
+  VersionStore store(state, "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(2));
+  EXPECT_EQ(store.recovered().next_box_id, 20u);
+  EXPECT_TRUE(fs::exists(state / "next-box-id-00000000000000000020"));
 }
 
 }  // namespace

@@ -46,11 +46,7 @@ int main(int argc, char** argv) {
     const cellmap::dds::Participant participant(domain);
     cellmap::transport::EnvironmentPublisher publisher(participant, "cell-e2e");
     if (env.version() > 0) {
-      if (store.next_version() > env.version() + 1) {
-        // A higher number may have gone out unsaved: resume under a fresh number, never an old one.
-        env = cellmap::Environment(env.cell(), store.next_version(), now_ns(), env.boxes());
-        store.save(env);
-      }
+      env = store.resume(now_ns());
       std::cout << "republished " << env.version() << std::endl;
       publisher.publish(env);
     }

@@ -3,16 +3,19 @@
 #include <algorithm>
 #include <chrono>
 #include <sstream>
+#include <string_view>
 
 #include "cellmap/common/error.hpp"
 
 namespace cellmap {
 namespace {
 
-// Version 2 adds the viewpoint line (normals are oriented towards it, so a restart re-fits boxes alike);
-// version 1 states (no viewpoint) are still read.
-constexpr const char* kStateMagicV1 = "cellmap-map-state 1";
-constexpr const char* kStateMagic = "cellmap-map-state 2";
+// The map state's first line. Version 3 leaves out the box-id counter (it is kept with the versions, where
+// a lost map cannot take it along); versions 2 (counter + viewpoint) and 1 (counter only) are still read,
+// their counter raising the one the pipeline was given.
+constexpr std::string_view kStateMagicV1 = "cellmap-map-state 1";
+constexpr std::string_view kStateMagicV2 = "cellmap-map-state 2";
+constexpr std::string_view kStateMagic = "cellmap-map-state 3";
 
 // A box re-fits only when it lost a tenth of its voxels: the table losing the few voxels an object removed
 // from it shared with its top layer keeps its boxes (still covering all it holds) instead of being split
@@ -54,11 +57,14 @@ void CellPipeline::restore(const std::string& map_state) {
   std::istringstream in(map_state);
   std::string magic;
   std::getline(in, magic);
-  std::uint64_t stored_next_id = 0;
-  if ((magic != kStateMagic && magic != kStateMagicV1) || !(in >> stored_next_id) || in.get() != '\n') {
+  if (magic != kStateMagic && magic != kStateMagicV2 && magic != kStateMagicV1)
     throw Error("map state: not a cellmap map state (bad header)");
+  if (magic != kStateMagic) {
+    std::uint64_t legacy_next_id = 0;
+    if (!(in >> legacy_next_id) || in.get() != '\n') throw Error("map state: bad box-id counter line");
+    next_box_id_ = std::max(next_box_id_, legacy_next_id);
   }
-  if (magic == kStateMagic) {
+  if (magic != kStateMagicV1) {
     Eigen::Vector3d viewpoint;
     if (!(in >> viewpoint.x() >> viewpoint.y() >> viewpoint.z()) || in.get() != '\n' ||
         !viewpoint.allFinite()) {
@@ -66,13 +72,12 @@ void CellPipeline::restore(const std::string& map_state) {
     }
     viewpoint_C_ = viewpoint;
   }
-  next_box_id_ = std::max(next_box_id_, stored_next_id);
   map_.read(in);
 }
 
 std::string CellPipeline::map_state() const {
   std::ostringstream out;
-  out << kStateMagic << "\n" << next_box_id_ << "\n";
+  out << kStateMagic << "\n";
   out.precision(17);
   out << viewpoint_C_.x() << " " << viewpoint_C_.y() << " " << viewpoint_C_.z() << "\n";
   map_.write(out);

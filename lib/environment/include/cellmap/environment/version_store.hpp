@@ -16,29 +16,32 @@ namespace cellmap {
 struct RecoveredState final {
   /// The newest snapshot that read back intact, or the empty environment (version 0) of a fresh directory.
   Environment environment;
-  /// The opaque blob saved with that snapshot (the daemon's OcTree .bt), if one was saved.
+  /// The opaque blob saved with that snapshot (the daemon's map state), if one was saved.
   std::optional<std::filesystem::path> blob;
+  /// Above every box id the cell ever handed out, as far as the directory tells (>= 1): the highest
+  /// `next-box-id-<n>` marker, the snapshot's `next_box_id` and its boxes' ids + 1. Corrupt snapshots or a
+  /// lost blob do not lower it.
+  std::uint64_t next_box_id = 1;
   /// One line per state file that was corrupt, truncated or unreadable and was skipped (then renamed to
-  /// `<name>.corrupt` so an operator can inspect it). Empty when everything read back.
+  /// `<name>.corrupt` so an operator can inspect it), and one per snapshot in an older format. Empty when
+  /// everything read back.
   std::vector<std::string> problems;
 };
 
 /// Persists environment versions of one cell in `state_dir` so that after a crash at any instant (SIGKILL
-/// mid-write included) the newest intact version is loaded and version numbers are never reused.
+/// mid-write included) the newest intact version is loaded, and neither version numbers nor box ids are ever
+/// reused.
 ///
-/// Files: `environment-<version>.json` (the boxes JSON of ARCHITECTURE.md plus "cell", "stamp_ns" and the
-/// blob's size/checksum), `environment-<version>.blob` (opaque, optional) and `reserved-<version>` (an empty
-/// marker whose name is the highest version that may have been published). Every file is written with
-/// write_file_atomically; the snapshot JSON is written last and is the commit point of a version. The newest
-/// two intact versions are kept (the current one and the previous good one); older ones are deleted.
+/// Files: `environment-<version>.json` (the boxes JSON plus "cell", "stamp_ns", "next_box_id" and the blob's
+/// size/checksum), `environment-<version>.blob` (opaque, optional) and `next-box-id-<n>` (an empty marker
+/// whose name is above every box id handed out so far; a name survives what corrupts a file's content). Every
+/// file is written with write_file_atomically; the snapshot JSON is written last and is the commit point of
+/// a version. The newest two intact versions are kept (the current one and the previous good one); older
+/// ones are deleted.
 ///
 /// Publishing rule for the caller, so that a number seen by subscribers is never given to other content:
-/// either save(v) before publishing v, or reserve(v) before publishing and save(v) after. After a crash
-/// next_version() is above every version that was saved or reserved.
-///
-/// On restart: if next_version() > recovered().environment.version() + 1, a reserved number may have gone
-/// out unsaved; save the recovered boxes again under next_version() before republishing them, so subscribers
-/// that saw the lost version move forward (tests/transport/publisher_helper.cpp does exactly this).
+/// save(v) before publishing v. next_version() is above every version any file names (corrupt ones too).
+/// After a restart, announce resume()'s environment first.
 ///
 /// Not thread-safe; one VersionStore per state directory (no inter-process locking).
 class VersionStore final {
@@ -51,30 +54,52 @@ class VersionStore final {
   /// What was loaded when the store opened.
   [[nodiscard]] const RecoveredState& recovered() const { return recovered_; }
 
-  /// The smallest version number never saved nor reserved in this directory (>= 1).
+  /// The smallest version number never saved in this directory nor named by any of its files (>= 1).
   [[nodiscard]] std::uint64_t next_version() const { return highest_used_ + 1; }
+  /// Above every box id handed out so far: recovered().next_box_id, raised by each save().
+  [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
 
-  /// Durably records that `version` may be published; returns once the marker is on disk (a file create and
-  /// two fsyncs, cheaper than save() with a large blob).
-  /// @throws Error if version < next_version() - 1 (reserving backwards) or on I/O failure.
-  void reserve(std::uint64_t version);
+  /// The restart rule, in one place: the environment to announce first after opening. That is the recovered
+  /// one, unless a number above it may have gone out (next_version() > its version + 1: a newer snapshot was
+  /// corrupt or its blob lost); then its boxes are saved again under next_version() with `stamp_ns` and
+  /// `blob`, so subscribers that saw the lost number move forward. Version 0 (nothing recovered) comes back
+  /// as it is: nothing to announce.
+  /// @throws Error as save(); the store is then unchanged and resume() can be called again.
+  [[nodiscard]] Environment resume(std::int64_t stamp_ns,
+                                   std::optional<std::string_view> blob = std::nullopt);
 
   /// Durably stores `env` (and `blob`, if given) as the newest version, then deletes versions older than the
-  /// previous good one.
-  /// @throws Error if env.cell() is not this store's cell, env.version() is not above the last saved version
-  /// or is below the highest reserved one, or on I/O failure (the previous state is then untouched).
-  void save(const Environment& env, std::optional<std::string_view> blob = std::nullopt);
+  /// previous good one. `next_box_id` is the caller's id counter (0: none); the store keeps the highest of
+  /// it, env's ids + 1 and what it held, marker first, so after any crash next_box_id() is above every id of
+  /// every version that was saved.
+  /// @throws Error if env.cell() is not this store's cell or env.version() is not above the last saved
+  /// version, or on I/O failure (the previous state is then untouched and the same version can be saved
+  /// again).
+  void save(const Environment& env, std::optional<std::string_view> blob = std::nullopt,
+            std::uint64_t next_box_id = 0);
+
+  /// False once the newest saved version's snapshot is no longer on disk (the state directory was removed or
+  /// emptied by hand): a restart would not find it, so the caller should save its environment again. True
+  /// before anything was saved. One stat() call.
+  [[nodiscard]] bool holds_last_saved() const;
 
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
 
  private:
+  struct Listing;
+  [[nodiscard]] Listing list_directory();
+  void load_newest_intact(Listing& listing);
+  void remove_superseded(const Listing& listing) const;
+  void raise_box_id_marker(std::uint64_t next_box_id);
+
   std::filesystem::path dir_;
   std::string cell_;
   RecoveredState recovered_;
-  std::uint64_t highest_used_ = 0;  // max version saved, reserved, or named by any file (corrupt included)
-  std::uint64_t highest_reserved_ = 0;  // max version named by a reserved-<v> marker
-  std::uint64_t last_saved_ = 0;        // version of the newest intact snapshot
-  std::vector<std::uint64_t> good_;     // intact versions, oldest first; the last two are kept on disk
+  std::uint64_t highest_used_ = 0;  // max version saved or named by any file (corrupt included)
+  std::uint64_t last_saved_ = 0;    // version of the newest intact snapshot
+  std::uint64_t next_box_id_ = 1;
+  std::uint64_t box_id_marker_ = 0;  // the n of the newest next-box-id-<n> on disk, 0 = none
+  std::vector<std::uint64_t> good_;  // intact versions, oldest first; the last two are kept on disk
 };
 
 }  // namespace cellmap
