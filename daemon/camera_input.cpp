@@ -57,14 +57,6 @@ std::vector<Sweep> CameraInput::step(std::chrono::milliseconds timeout) {
   return sweeps;
 }
 
-std::string CameraInput::sensor_state() const {
-  const SourceStatus status = source_->status();
-  if (status.state == SourceState::kConnected) return "streaming";
-  std::string state = to_string(status.state);
-  if (!status.reason.empty()) state += ": " + status.reason;
-  return state;
-}
-
 std::uint64_t CameraInput::poses_rejected() const {
   return poses_refused_ + (robot_ ? robot_->rejected() : 0);
 }

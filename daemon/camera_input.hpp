@@ -33,8 +33,6 @@ class CameraInput final {
   [[nodiscard]] std::vector<Sweep> step(std::chrono::milliseconds timeout);
 
   [[nodiscard]] SourceStatus status() const { return source_->status(); }
-  /// "streaming", or the source state and its reason ("disconnected: openni2: no devices found").
-  [[nodiscard]] std::string sensor_state() const;
   [[nodiscard]] const std::string& name() const { return source_->name(); }
   /// Frames dropped for want of a pose.
   [[nodiscard]] std::uint64_t dropped_frames() const { return assembler_.dropped(); }

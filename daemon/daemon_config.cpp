@@ -8,6 +8,16 @@
 namespace cellmap::daemon {
 namespace {
 
+constexpr SourceKind kSourceKinds[] = {SourceKind::kSim, SourceKind::kReplay, SourceKind::kOpenNI2,
+                                       SourceKind::kV4l2};
+
+std::optional<SourceKind> source_kind(const std::string& text) {
+  for (const SourceKind kind : kSourceKinds) {
+    if (text == to_string(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
 // A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by the
 // user replaces the default pose whole instead of merging into it.
 bool is_pose(const YAML::Node& map) {
@@ -30,9 +40,9 @@ YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay) {
 // chosen); the chosen kind's become the camera.
 SourceConfig read_source(YamlMap section, double sweep_period, const std::filesystem::path& base_dir) {
   SourceConfig c;
-  c.kind = section.get<std::string>("kind", c.kind);
-  static const std::set<std::string> kinds{"sim", "replay", "openni2", "v4l2"};
-  if (kinds.count(c.kind) == 0) section.fail("kind", "must be one of sim, replay, openni2, v4l2");
+  const std::optional<SourceKind> kind = source_kind(section.get<std::string>("kind", to_string(c.kind)));
+  if (!kind) section.fail("kind", "must be one of sim, replay, openni2, v4l2");
+  c.kind = *kind;
   const std::string scene = section.get<std::string>("scene", "");
   if (!scene.empty()) c.scene = base_dir / scene;  // an absolute scene path replaces base_dir
   c.sensor = section.get<std::string>("sensor", c.sensor);
@@ -48,9 +58,9 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   const OpenNI2Config openni2 = read_openni2_config(section.child("openni2"), c.sensor);
   const V4l2Config v4l2 = read_v4l2_config(section.child("v4l2"), c.sensor);
   ReplayConfig replay = read_replay_config(section.child("replay"), c.sensor);
-  if (c.kind == "openni2") c.camera.source = openni2;
-  if (c.kind == "v4l2") c.camera.source = v4l2;
-  if (c.kind == "replay") {
+  if (c.kind == SourceKind::kOpenNI2) c.camera.source = openni2;
+  if (c.kind == SourceKind::kV4l2) c.camera.source = v4l2;
+  if (c.kind == SourceKind::kReplay) {
     if (replay.directory.empty()) section.child("replay").fail("directory", "is required for kind replay");
     replay.directory = (base_dir / replay.directory).string();  // an absolute directory replaces base_dir
     c.camera.source = replay;
@@ -60,6 +70,20 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
 }
 
 }  // namespace
+
+const char* to_string(SourceKind kind) {
+  switch (kind) {
+    case SourceKind::kSim:
+      return "sim";
+    case SourceKind::kReplay:
+      return "replay";
+    case SourceKind::kOpenNI2:
+      return "openni2";
+    case SourceKind::kV4l2:
+      return "v4l2";
+  }
+  return "?";
+}
 
 DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
   return parse(read_file(file), file.string(), file.parent_path());

@@ -12,10 +12,14 @@
 
 namespace cellmap::daemon {
 
-/// Where sweeps come from: the simulated cell (the default: no hardware needed) or one depth camera on the
-/// robot (an OpenNI2 or V4L2 device, or a replay directory).
+/// Where sweeps come from (`source.kind`): the simulated cell (the default: no hardware needed) or one depth
+/// camera on the robot (a replay directory, an OpenNI2 or a V4L2 device).
+enum class SourceKind { kSim, kReplay, kOpenNI2, kV4l2 };
+/// The config's spelling: sim | replay | openni2 | v4l2.
+[[nodiscard]] const char* to_string(SourceKind kind);
+
 struct SourceConfig final {
-  std::string kind = "sim";  ///< `source.kind`: sim | replay | openni2 | v4l2
+  SourceKind kind = SourceKind::kSim;  ///< `source.kind`
   /// `source.scene` (sim): scene YAML (relative paths are relative to the config file); empty = the embedded
   /// default cell (config/cell.yaml).
   std::filesystem::path scene;
@@ -30,7 +34,7 @@ struct SourceConfig final {
   /// pose_wait = `source.pose_wait`.
   SweepGrouping grouping;
 
-  [[nodiscard]] bool is_camera() const { return kind != "sim"; }
+  [[nodiscard]] bool is_camera() const { return kind != SourceKind::kSim; }
 };
 
 /// The text of config/cellmapd.yaml, embedded at build time: the built-in defaults.

@@ -19,7 +19,7 @@ std::string error_of(const std::string& yaml) {
 TEST(DaemonConfigTest, BuiltInDefaultsAreTheShippedFile) {
   const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
   EXPECT_EQ(c.cell, "cell-1");
-  EXPECT_EQ(c.source.kind, "sim");
+  EXPECT_EQ(c.source.kind, SourceKind::kSim);
   EXPECT_TRUE(c.source.scene.empty());
   EXPECT_DOUBLE_EQ(c.pipeline.occupancy.resolution, 0.02);
   EXPECT_EQ(c.pipeline.change.persist_sweeps, 3);

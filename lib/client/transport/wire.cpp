@@ -115,6 +115,7 @@ StatusSample::StatusSample(const CellStatus& status) : status_(status) {
   msg_.dropped_frames = status_.dropped_frames;
   msg_.boxes = status_.boxes;
   msg_.version = status_.version;
+  msg_.reason = text(status_.reason);
 }
 
 SceneEditSample::SceneEditSample(const SceneEdit& edit) : edit_(edit) {
@@ -183,6 +184,7 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
   status.dropped_frames = msg.dropped_frames;
   status.boxes = msg.boxes;
   status.version = msg.version;
+  status.reason = msg.reason ? msg.reason : "";
   return status;
 }
 

@@ -13,19 +13,20 @@ namespace cellmap::transport {
 
 struct SensorStatus final {
   std::string name;
-  std::string state;  ///< e.g. "streaming", "no device", "error: <reason>"
+  std::string state;  ///< "starting", "streaming", or the source state and reason ("disconnected: ...")
 };
 
 /// cellmap/status: one cell daemon's health.
 struct CellStatus final {
   std::string cell;
-  std::string state;  ///< e.g. "starting", "running", "degraded", "stopping"
+  std::string state;  ///< "starting", "running", "degraded" or "stopped"
   std::vector<SensorStatus> sensors;
   std::int64_t last_sweep_ns = 0;  ///< end of the last sweep, ns since the Unix epoch; 0 before the first
   std::uint64_t sweeps = 0;
   std::uint64_t dropped_frames = 0;
   std::uint64_t boxes = 0;
   std::uint64_t version = 0;
+  std::string reason;  ///< why the state is "degraded" (one line); empty otherwise
 };
 
 /// cellmap/sim/scene_edits: one edit of a simulated scene (what `cellmap inject` sends, what tests plant;

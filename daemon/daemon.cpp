@@ -1,0 +1,129 @@
+#include "daemon.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
+
+#include "cellmap/common/error.hpp"
+#include "reload.hpp"
+
+namespace cellmap::daemon {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+}  // namespace
+
+Daemon::Daemon(DaemonConfig config, RunOptions options)
+    : config_(std::move(config)),
+      options_(std::move(options)),
+      store_(config_.state_dir, config_.cell),
+      participant_(static_cast<std::uint32_t>(config_.domain)),
+      publisher_(participant_, config_.cell, config_.delta_depth),
+      pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
+      keeper_(store_, [this](const Environment& env,
+                             const EnvironmentDelta& delta) { publisher_.publish(env, delta); }),
+      health_(config_.cell, config_.source.sensor) {
+  keeper_.resume(pipeline_);
+  published_version_ = keeper_.published().version();
+  acquisition_ = make_acquisition(config_, participant_, {mailbox_, health_, published_version_});
+  spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
+               store_.directory().string(), acquisition_->describe(), keeper_.published().version());
+}
+
+void Daemon::run(const Signals& signals) {
+  std::thread acquisition([this] { acquire(); });
+  std::thread processing([this] { process(); });
+  while (!stop_) {
+    const std::optional<int> signal = signals.wait_for(milliseconds(200));
+    if (!signal) continue;
+    if (*signal == SIGHUP) {
+      const std::optional<double> period = reload_config(options_.config_file, !config_.source.is_camera());
+      if (period) acquisition_->set_sweep_period(*period);
+    } else {
+      spdlog::info("signal {}: stopping", *signal);
+      stop_ = true;
+    }
+  }
+  mailbox_.close();
+  acquisition.join();
+  processing.join();
+  health_.stop();
+  publish_status();
+  spdlog::info("stopped at version {}", keeper_.published().version());
+}
+
+void Daemon::acquire() {
+  try {
+    acquisition_->run(stop_, options_.max_sweeps);
+    acquisition_done_ = true;
+  } catch (const std::exception& e) {
+    // Degrade, don't die: the last environment stays published and the status says why.
+    spdlog::error("sweep source stopped: {}; keeping version {}", e.what(), published_version_.load());
+    health_.set_sensor(SourceState::kError, e.what());
+  }
+}
+
+void Daemon::process() {
+  auto next_status = Clock::now();
+  std::uint64_t processed = 0;
+  for (;;) {
+    // Read before take(): a sweep put just before acquisition ended is then still taken.
+    const bool acquisition_was_done = acquisition_done_;
+    std::optional<Sweep> sweep = mailbox_.take(milliseconds(100));
+    if (sweep) {
+      handle(*sweep, ++processed);
+      if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
+    } else if (stop_ || acquisition_was_done) {
+      // With --sweeps, acquisition ends after N sweeps; some may have been replaced in the mailbox, so
+      // processing ends when the mailbox is empty, not only after N.
+      stop_ = true;
+      break;
+    }
+    if (Clock::now() >= next_status) {
+      // A version that did not go out is retried here too, so it does not wait for a sweep.
+      if (keeper_.pending()) keeper_.flush(pipeline_);
+      published_version_ = keeper_.published().version();
+      publish_status();
+      next_status = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(config_.status_period));
+    }
+  }
+}
+
+void Daemon::handle(const Sweep& sweep, std::uint64_t number) {
+  try {
+    const SweepReport report = pipeline_.process(sweep);
+    health_.sweep_processed(number, system_now_ns());
+    spdlog::info(
+        "sweep {}: {} points, {} hit / {} free voxels, {} flipped, {} change regions, {} boxes; "
+        "fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; {} sweeps dropped",
+        number, report.points, report.hit_voxels, report.free_voxels, report.flipped, report.regions,
+        report.boxes, report.t_fuse, report.t_change, report.t_segment, mailbox_.dropped());
+  } catch (const Error& e) {
+    health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
+    spdlog::error("sweep {}: {}; keeping version {}", number, e.what(), keeper_.published().version());
+  }
+  keeper_.flush(pipeline_);
+  published_version_ = keeper_.published().version();
+}
+
+void Daemon::publish_status() {
+  health_.set_version_fault(keeper_.fault());
+  transport::CellStatus status = health_.status();
+  // Sweeps the processing thread had no time for, plus camera frames that had no robot pose.
+  status.dropped_frames = mailbox_.dropped() + acquisition_->dropped_frames();
+  status.boxes = keeper_.published().boxes().size();
+  status.version = keeper_.published().version();
+  try {
+    publisher_.publish_status(status);
+    status_fault_.clear();
+  } catch (const Error& e) {
+    if (status_fault_ != e.what()) spdlog::warn("status not published: {}", e.what());
+    status_fault_ = e.what();
+  }
+}
+
+}  // namespace cellmap::daemon

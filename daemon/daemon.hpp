@@ -1,0 +1,63 @@
+#pragma once
+// cellmapd's wiring: the state directory, the cell pipeline, DDS, the sweep source and the threads.
+//
+// Threads: acquisition (sweeps from the source → a latest-wins mailbox), processing (cell pipeline → version
+// kept, saved and published → status), and the caller's (signals: SIGTERM/SIGINT stop, SIGHUP reloads).
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+
+#include "acquisition.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/environment/version_store.hpp"
+#include "cellmap/transport/environment_publisher.hpp"
+#include "daemon_config.hpp"
+#include "health.hpp"
+#include "latest_mailbox.hpp"
+#include "signals.hpp"
+#include "versions.hpp"
+
+namespace cellmap::daemon {
+
+/// What the command line adds to the config.
+struct RunOptions {
+  std::filesystem::path config_file;  ///< re-read on SIGHUP; empty = the built-in defaults
+  std::uint64_t max_sweeps = 0;       ///< stop after this many sweeps (0 = until SIGTERM/SIGINT)
+};
+
+class Daemon final {
+ public:
+  /// Opens the state directory, recovers the pipeline, joins the DDS domain, announces the recovered version
+  /// and sets up the sweep source. @throws Error if any of that fails (the state directory of another cell,
+  /// an invalid scene, DDS refused).
+  Daemon(DaemonConfig config, RunOptions options);
+
+  /// Runs until a stop signal (or, with max_sweeps, until the sweeps are processed); then publishes the
+  /// status `stopped`.
+  void run(const Signals& signals);
+
+ private:
+  void acquire();
+  void process();
+  void handle(const Sweep& sweep, std::uint64_t number);
+  void publish_status();
+
+  DaemonConfig config_;
+  RunOptions options_;
+  VersionStore store_;
+  dds::Participant participant_;
+  transport::EnvironmentPublisher publisher_;
+  CellPipeline pipeline_;
+  VersionKeeper keeper_;
+  LatestMailbox<Sweep> mailbox_;
+  Health health_;
+  std::atomic<std::uint64_t> published_version_{0};  // for the acquisition thread's log lines
+  std::unique_ptr<Acquisition> acquisition_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> acquisition_done_{false};
+  std::string status_fault_;  // the last reason a status was not published, logged once
+};
+
+}  // namespace cellmap::daemon

@@ -1,0 +1,73 @@
+// cellmapd's acquisition of the simulated cell: sweeps into the mailbox, scene edits over real DDS applied
+// when they are for this cell (or every cell) and ignored when they are for another.
+#include "acquisition.hpp"
+
+#include <gtest/gtest.h>
+
+#include "cellmap/transport/scene_edits.hpp"
+#include "transport/loopback.hpp"
+
+namespace cellmap::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr int kSimDomain = 187;
+
+// Points of `sweep` inside the axis-aligned box at `centre` with `half_extents` grown by 5 mm, leaving out
+// the 5 cm above the table it stands on.
+std::size_t points_above_table(const Sweep& sweep, const Eigen::Vector3d& centre,
+                               const Eigen::Vector3d& half_extents) {
+  std::size_t inside = 0;
+  for (const Scan& scan : sweep.scans) {
+    for (const pcl::PointXYZ& p : scan.points_C) {
+      const Eigen::Vector3d d = p.getVector3fMap().cast<double>() - centre;
+      const bool above_table = d.z() > 0.05 - half_extents.z();
+      if (above_table && (d.cwiseAbs().array() <= half_extents.array() + 0.005).all()) ++inside;
+    }
+  }
+  return inside;
+}
+
+transport::SceneEdit add_box(const std::string& cell, const std::string& name,
+                             const Eigen::Vector3d& centre) {
+  transport::SceneEdit edit;
+  edit.cell = cell;
+  edit.kind = transport::SceneEdit::Kind::kAddBox;
+  edit.name = name;
+  edit.center = centre;
+  edit.half_extents = Eigen::Vector3d(0.1, 0.1, 0.15);
+  return edit;
+}
+
+TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
+  test::use_loopback();
+  DaemonConfig config =
+      DaemonConfig::parse("cell: bench-7\nsweep_period: 0\nsource: {noise: false}\n", "test.yaml", ".");
+  const dds::Participant participant(kSimDomain);
+  LatestMailbox<Sweep> mailbox;
+  Health health(config.cell, config.source.sensor);
+  const std::atomic<std::uint64_t> version{0};
+  const std::unique_ptr<Acquisition> acquisition =
+      make_acquisition(config, participant, {mailbox, health, version});
+  EXPECT_EQ(acquisition->describe().rfind("sim (sensor 'kinect', ", 0), 0u) << acquisition->describe();
+
+  // Two free spots on the table (top at z = 0.75), both in the Kinect's view.
+  const Eigen::Vector3d mine(2.12, 0.45, 0.9), theirs(0.5, 1.5, 0.9), half(0.1, 0.1, 0.15);
+  const transport::SceneEditWriter writer(participant);
+  ASSERT_TRUE(writer.wait_for_reader(30s));
+  writer.write(add_box("bench-7", "mine", mine));
+  writer.write(add_box("bench-8", "theirs", theirs));
+  ASSERT_TRUE(writer.wait_for_acks(30s));
+
+  const std::atomic<bool> stop{false};
+  acquisition->run(stop, 2);  // returns after two sweeps
+  const std::optional<Sweep> sweep = mailbox.take(0ms);
+  ASSERT_TRUE(sweep.has_value());
+  EXPECT_EQ(mailbox.dropped(), 1u);  // the first was replaced: nobody took it
+  EXPECT_GT(points_above_table(*sweep, mine, half), 100u) << "the edit for this cell was not applied";
+  EXPECT_EQ(points_above_table(*sweep, theirs, half), 0u) << "the edit for another cell was applied";
+  EXPECT_EQ(health.status().sensors[0].state, "streaming");
+}
+
+}  // namespace
+}  // namespace cellmap::daemon
