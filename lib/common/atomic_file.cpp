@@ -15,8 +15,8 @@
 namespace cellmap {
 namespace {
 
-[[noreturn]] void fail(const std::filesystem::path& path, const char* what) {
-  throw Error(path.string() + ": " + what + ": " + std::strerror(errno));
+[[noreturn]] void fail(const std::filesystem::path& path, const char* what, int error) {
+  throw Error(path.string() + ": " + what + ": " + std::strerror(error));
 }
 
 // Owns a POSIX descriptor so every exit path closes it.
@@ -43,39 +43,32 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error(dir.string() + ": cannot create directory: " + ec.message());
 
+  // Errors name `path`, not the temporary file: its random name would make every retry's message differ.
   std::string tmp_name = (dir / ("." + path.filename().string() + ".XXXXXX")).string();
   Descriptor fd(::mkstemp(tmp_name.data()));
-  if (fd.get() < 0) fail(tmp_name, "cannot create temporary file");
+  if (fd.get() < 0) fail(path, "cannot create a temporary file", errno);
   const std::filesystem::path tmp(tmp_name);
-  auto remove_tmp = [&] { std::filesystem::remove(tmp, ec); };
+  auto fail_and_remove_tmp = [&](const char* what) {
+    const int error = errno;
+    std::filesystem::remove(tmp, ec);
+    fail(path, what, error);
+  };
 
   const char* data = contents.data();
   std::size_t left = contents.size();
   while (left > 0) {
     const ssize_t n = ::write(fd.get(), data, left);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      remove_tmp();
-      fail(tmp, "write failed");
-    }
+    if (n < 0) fail_and_remove_tmp("write failed");
     data += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (::fchmod(fd.get(), 0644) != 0 || ::fsync(fd.get()) != 0) {
-    remove_tmp();
-    fail(tmp, "fsync failed");
-  }
-  if (::close(fd.release()) != 0) {
-    remove_tmp();
-    fail(tmp, "close failed");
-  }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    remove_tmp();
-    fail(path, "rename failed");
-  }
+  if (::fchmod(fd.get(), 0644) != 0 || ::fsync(fd.get()) != 0) fail_and_remove_tmp("fsync failed");
+  if (::close(fd.release()) != 0) fail_and_remove_tmp("close failed");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) fail_and_remove_tmp("rename failed");
   // The rename itself is durable only once the directory entry is on disk.
   Descriptor dir_fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY));
-  if (dir_fd.get() < 0 || ::fsync(dir_fd.get()) != 0) fail(dir, "directory fsync failed");
+  if (dir_fd.get() < 0 || ::fsync(dir_fd.get()) != 0) fail(dir, "directory fsync failed", errno);
 }
 
 std::string read_file(const std::filesystem::path& path) {

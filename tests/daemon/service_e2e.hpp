@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,12 +24,16 @@ inline constexpr std::chrono::seconds kPatience{90};
 
 /// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:
 /// these tests are about versions and deltas; noise robustness is tested where the noise is modelled.
+/// `extra_yaml` is appended to the config; `state_dir` replaces the private one.
 class ServiceFixture {
  public:
-  explicit ServiceFixture(std::string cell) : cell_(std::move(cell)) {
+  explicit ServiceFixture(std::string cell, const std::string& extra_yaml = "",
+                          std::optional<std::filesystem::path> state_dir = std::nullopt)
+      : cell_(std::move(cell)), state_dir_(state_dir.value_or(dir_.path() / "state")) {
     config_ = dir_.path() / "cellmapd.yaml";
     std::ofstream(config_) << "cell: " << cell_
-                           << "\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n";
+                           << "\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n"
+                           << extra_yaml;
   }
 
   /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess.
@@ -39,12 +44,13 @@ class ServiceFixture {
     if (log_on_stdout) argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
     return std::make_unique<ChildProcess>(argv);
   }
-  [[nodiscard]] std::filesystem::path state_dir() const { return dir_.path() / "state"; }
+  [[nodiscard]] const std::filesystem::path& state_dir() const { return state_dir_; }
   [[nodiscard]] const std::string& cell() const { return cell_; }
 
  private:
   std::string cell_;
   TempDir dir_;
+  std::filesystem::path state_dir_;
   std::filesystem::path config_;
 };
 

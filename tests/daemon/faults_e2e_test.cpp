@@ -1,0 +1,193 @@
+// cellmapd as a real process with its state directory on a small tmpfs (tests run as root; without the
+// right to mount they skip): the disk full when the first version is due and when a later one is, the state
+// directory read-only and removed. Each time the status says degraded with the reason, subscribers (a late
+// joiner too) keep the last version that went out, and the held version goes out once the disk works again,
+// without a restart.
+#include <gtest/gtest.h>
+#include <sys/mount.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+
+#include "cellmap/environment/version_store.hpp"
+#include "cellmap/transport/status_reader.hpp"
+#include "daemon/service_e2e.hpp"
+
+namespace cellmap {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+constexpr int kFirstVersionDomain = 188;
+constexpr int kLaterVersionDomain = 189;
+// The first version's map state is about 0.5 MB: room for three versions and a filler.
+constexpr const char* kTmpfsOptions = "size=4m";
+// A short settling (exact depths fill the map in a few sweeps): the tests are about what follows.
+constexpr const char* kShortSettling = "change: {settle_sweeps: 3}\n";
+
+// A tmpfs mounted for the test's lifetime, with the state directory inside it.
+class SmallDisk {
+ public:
+  SmallDisk() {
+    if (::mount("tmpfs", dir_.path().c_str(), "tmpfs", 0, kTmpfsOptions) != 0) {
+      error_ = std::string("cannot mount a tmpfs (needs root): ") + std::strerror(errno);
+      return;
+    }
+    fs::create_directories(state_dir());
+  }
+  ~SmallDisk() {
+    if (error_.empty()) ::umount2(dir_.path().c_str(), MNT_DETACH);
+  }
+  SmallDisk(const SmallDisk&) = delete;
+  SmallDisk& operator=(const SmallDisk&) = delete;
+
+  [[nodiscard]] const std::string& error() const { return error_; }
+  [[nodiscard]] fs::path state_dir() const { return dir_.path() / "state"; }
+
+  // Takes every free byte with a file beside the state directory.
+  void fill() const {
+    std::ofstream filler(filler_path(), std::ios::binary | std::ios::trunc);
+    const std::string chunk(64 * 1024, 'x');
+    while (filler.write(chunk.data(), static_cast<std::streamsize>(chunk.size()))) {
+    }
+  }
+  void free() const { fs::remove(filler_path()); }
+
+  void make_read_only(bool read_only) const {
+    const unsigned long flags = MS_REMOUNT | (read_only ? MS_RDONLY : 0);
+    ASSERT_EQ(::mount("tmpfs", dir_.path().c_str(), "tmpfs", flags, kTmpfsOptions), 0)
+        << std::strerror(errno);
+  }
+
+ private:
+  [[nodiscard]] fs::path filler_path() const { return dir_.path() / "filler"; }
+
+  test::TempDir dir_{"cellmap-small-disk"};
+  std::string error_;
+};
+
+// Takes status reports of `cell` until one satisfies `accept` (returned) or the patience runs out.
+std::optional<transport::CellStatus> wait_for_status(
+    transport::StatusReader& reader, const std::string& cell,
+    const std::function<bool(const transport::CellStatus&)>& accept) {
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const transport::CellStatus& status : reader.take(200ms)) {
+      if (status.cell == cell && accept(status)) return status;
+    }
+  }
+  return std::nullopt;
+}
+
+std::function<bool(const transport::CellStatus&)> degraded_by(const std::string& cause) {
+  return [cause](const transport::CellStatus& s) {
+    return s.state == "degraded" && s.reason.find(cause) != std::string::npos;
+  };
+}
+
+bool running(const transport::CellStatus& s) {
+  return s.state == "running" && s.reason.empty();
+}
+
+bool holds(const Environment& env, const Eigen::Vector3d& p_C) {
+  return std::any_of(env.boxes().begin(), env.boxes().end(),
+                     [&](const Box& box) { return box.contains(p_C); });
+}
+
+class FaultsE2eTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { test::use_loopback(); }
+  void SetUp() override {
+    if (!disk_.error().empty()) GTEST_SKIP() << disk_.error();
+  }
+
+  SmallDisk disk_;
+};
+
+TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnlyHoldsTheNext) {
+  const test::ServiceFixture service("full-first", kShortSettling, disk_.state_dir());
+  const dds::Participant participant(kFirstVersionDomain);
+  transport::StatusReader reader(participant);
+  transport::EnvironmentSubscriber planner(participant, service.cell());
+  disk_.fill();
+  auto daemon = service.start_daemon(kFirstVersionDomain);
+
+  const auto full = wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
+  ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
+  EXPECT_EQ(full->reason.rfind("version 1 not saved: ", 0), 0u) << full->reason;
+  EXPECT_EQ(full->version, 0u);
+  EXPECT_FALSE(planner.environment().has_value()) << "a version went out unsaved";
+
+  disk_.free();
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
+  EXPECT_FALSE(planner.environment()->boxes().empty());
+  ASSERT_TRUE(wait_for_status(reader, service.cell(), running).has_value()) << "never running again";
+  const Environment before = test::settled(planner, 3s);
+
+  // Read-only: the version with the injected box is held until the directory can be written again.
+  disk_.make_read_only(true);
+  const Eigen::Vector3d centre(2.12, 0.45, 0.9);
+  ASSERT_FALSE(test::inject(kFirstVersionDomain,
+                            {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"})
+                   .empty());
+  const auto read_only = wait_for_status(reader, service.cell(), degraded_by("Read-only file system"));
+  ASSERT_TRUE(read_only.has_value()) << "no degraded status while the state directory is read-only";
+  EXPECT_EQ(read_only->version, before.version());
+  EXPECT_EQ(planner.environment()->version(), before.version());
+
+  disk_.make_read_only(false);
+  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kPatience)) << "nothing went out after rw";
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (!holds(*planner.environment(), centre) && std::chrono::steady_clock::now() < deadline)
+    planner.wait_for_version(planner.environment()->version() + 1, 1s);
+  EXPECT_TRUE(holds(*planner.environment(), centre)) << "the box injected while read-only never arrived";
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+}
+
+TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAgain) {
+  const test::ServiceFixture service("full-later", kShortSettling, disk_.state_dir());
+  const dds::Participant participant(kLaterVersionDomain);
+  transport::StatusReader reader(participant);
+  transport::EnvironmentSubscriber planner(participant, service.cell());
+  auto daemon = service.start_daemon(kLaterVersionDomain);
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version";
+  const Environment before = test::settled(planner, 3s);
+
+  disk_.fill();
+  const Eigen::Vector3d centre(0.5, 1.5, 0.95);
+  ASSERT_FALSE(test::inject(kLaterVersionDomain,
+                            {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
+                   .empty());
+  const auto full = wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
+  ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
+  EXPECT_EQ(full->version, before.version());
+  {
+    // A planner that joins now gets the last version that went out.
+    transport::EnvironmentSubscriber late(participant, service.cell());
+    ASSERT_TRUE(late.wait_for_version(before.version(), test::kPatience));
+    EXPECT_TRUE(*late.environment() == before);
+  }
+
+  disk_.free();
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (!holds(*planner.environment(), centre) && std::chrono::steady_clock::now() < deadline)
+    planner.wait_for_version(planner.environment()->version() + 1, 1s);
+  ASSERT_TRUE(holds(*planner.environment(), centre))
+      << "the box injected while the disk was full never arrived";
+  const Environment with_box = test::settled(planner, 3s);
+
+  // The state directory removed under the running daemon: its boxes are saved again as the next version.
+  fs::remove_all(disk_.state_dir());
+  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, test::kPatience)) << "not saved again";
+  const Environment again = *planner.environment();
+  EXPECT_TRUE(diff(with_box, again).empty()) << "the boxes changed";
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+  EXPECT_EQ(VersionStore(disk_.state_dir(), service.cell()).recovered().environment.version(),
+            again.version());
+}
+
+}  // namespace
+}  // namespace cellmap
