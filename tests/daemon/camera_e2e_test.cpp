@@ -16,9 +16,8 @@
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "cellmap/transport/status_reader.hpp"
+#include "daemon/service_e2e.hpp"
 #include "support/test_support.hpp"
-#include "transport/child_process.hpp"
-#include "transport/loopback.hpp"
 
 namespace cellmap {
 namespace {
@@ -28,7 +27,6 @@ using namespace std::chrono_literals;
 constexpr int kReplayDomain = 182;
 constexpr int kNoDeviceDomain = 183;
 constexpr int kRobotPoseDomain = 184;
-constexpr auto kPatience = 90s;
 
 // The tool 1.5 m above the floor at (1, 2), the camera looking along the cell's +x: camera x (right) = cell
 // -y, camera y (down) = cell -z, camera z (forward) = cell +x.
@@ -50,19 +48,6 @@ class CameraE2eTest : public ::testing::Test {
       argv.push_back(std::to_string(sweeps));
     }
     return std::make_unique<test::ChildProcess>(argv);
-  }
-
-  // Takes status reports of `cell` until `accept` holds for one (returned) or the patience runs out.
-  static std::optional<transport::CellStatus> wait_for_status(
-      transport::StatusReader& reader, const std::string& cell,
-      const std::function<bool(const transport::CellStatus&)>& accept) {
-    const auto deadline = std::chrono::steady_clock::now() + kPatience;
-    while (std::chrono::steady_clock::now() < deadline) {
-      for (const transport::CellStatus& status : reader.take(200ms)) {
-        if (status.cell == cell && accept(status)) return status;
-      }
-    }
-    return std::nullopt;
   }
 
   fs::path state_dir() const { return dir_.path() / "state"; }
@@ -99,7 +84,7 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
   const dds::Participant participant(kReplayDomain);
   transport::EnvironmentSubscriber planner(participant, "replay");
   auto daemon = start_daemon(yaml, kReplayDomain, kSweeps);
-  EXPECT_TRUE(planner.wait_for_version(1, kPatience)) << "no version published from the replay";
+  EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version published from the replay";
   const int status = daemon->wait();
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
       << "cellmapd --sweeps " << kSweeps << " did not exit cleanly";
@@ -153,7 +138,7 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
   const dds::Participant participant(kNoDeviceDomain);
   transport::StatusReader reader(participant);
   auto daemon = start_daemon(yaml, kNoDeviceDomain);
-  const auto degraded = wait_for_status(reader, "no-device", [](const transport::CellStatus& s) {
+  const auto degraded = test::wait_for_status(reader, "no-device", [](const transport::CellStatus& s) {
     return s.state == "degraded" && s.sensors.size() == 1 && s.sensors[0].state.rfind("disconnected", 0) == 0;
   });
   ASSERT_TRUE(degraded.has_value()) << "no degraded/disconnected status";
@@ -165,8 +150,8 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
   // Still running (and still reporting) a while later: retrying with back-off, not exiting.
   std::this_thread::sleep_for(1500ms);
   EXPECT_TRUE(daemon->running()) << "cellmapd exited without a device";
-  const auto later = wait_for_status(reader, "no-device",
-                                     [](const transport::CellStatus& s) { return s.state == "degraded"; });
+  const auto later = test::wait_for_status(
+      reader, "no-device", [](const transport::CellStatus& s) { return s.state == "degraded"; });
   ASSERT_TRUE(later.has_value()) << "the daemon stopped reporting";
   daemon->signal(SIGTERM);
   const int status = daemon->wait();
@@ -186,8 +171,8 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
   auto daemon = start_daemon(yaml, kRobotPoseDomain);
 
   // No robot poses yet: frames stream but are dropped, none is fused.
-  const auto unposed = wait_for_status(reader, "wrist-cell",
-                                       [](const transport::CellStatus& s) { return s.dropped_frames >= 10; });
+  const auto unposed = test::wait_for_status(
+      reader, "wrist-cell", [](const transport::CellStatus& s) { return s.dropped_frames >= 10; });
   ASSERT_TRUE(unposed.has_value()) << "frames without a pose were not counted as dropped";
   EXPECT_EQ(unposed->sweeps, 0u) << "a frame without a pose was fused";
   ASSERT_EQ(unposed->sensors.size(), 1u);
@@ -208,8 +193,8 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
       std::this_thread::sleep_for(10ms);
     }
   });
-  const auto posed =
-      wait_for_status(reader, "wrist-cell", [](const transport::CellStatus& s) { return s.sweeps >= 3; });
+  const auto posed = test::wait_for_status(reader, "wrist-cell",
+                                           [](const transport::CellStatus& s) { return s.sweeps >= 3; });
   stop = true;
   controller.join();
   ASSERT_TRUE(posed.has_value()) << "no sweep was fused with poses from cellmap/robot_state";

@@ -11,7 +11,6 @@
 #include <fstream>
 
 #include "cellmap/environment/version_store.hpp"
-#include "cellmap/transport/status_reader.hpp"
 #include "daemon/service_e2e.hpp"
 
 namespace cellmap {
@@ -67,19 +66,6 @@ class SmallDisk {
   std::string error_;
 };
 
-// Takes status reports of `cell` until one satisfies `accept` (returned) or the patience runs out.
-std::optional<transport::CellStatus> wait_for_status(
-    transport::StatusReader& reader, const std::string& cell,
-    const std::function<bool(const transport::CellStatus&)>& accept) {
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
-  while (std::chrono::steady_clock::now() < deadline) {
-    for (const transport::CellStatus& status : reader.take(200ms)) {
-      if (status.cell == cell && accept(status)) return status;
-    }
-  }
-  return std::nullopt;
-}
-
 std::function<bool(const transport::CellStatus&)> degraded_by(const std::string& cause) {
   return [cause](const transport::CellStatus& s) {
     return s.state == "degraded" && s.reason.find(cause) != std::string::npos;
@@ -88,11 +74,6 @@ std::function<bool(const transport::CellStatus&)> degraded_by(const std::string&
 
 bool running(const transport::CellStatus& s) {
   return s.state == "running" && s.reason.empty();
-}
-
-bool holds(const Environment& env, const Eigen::Vector3d& p_C) {
-  return std::any_of(env.boxes().begin(), env.boxes().end(),
-                     [&](const Box& box) { return box.contains(p_C); });
 }
 
 class FaultsE2eTest : public ::testing::Test {
@@ -113,7 +94,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   disk_.fill();
   auto daemon = service.start_daemon(kFirstVersionDomain);
 
-  const auto full = wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
+  const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
   ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
   EXPECT_EQ(full->reason.rfind("version 1 not saved: ", 0), 0u) << full->reason;
   EXPECT_EQ(full->version, 0u);
@@ -122,7 +103,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   disk_.free();
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
   EXPECT_FALSE(planner.environment()->boxes().empty());
-  ASSERT_TRUE(wait_for_status(reader, service.cell(), running).has_value()) << "never running again";
+  ASSERT_TRUE(test::wait_for_status(reader, service.cell(), running).has_value()) << "never running again";
   const Environment before = test::settled(planner, 3s);
 
   // Read-only: the version with the injected box is held until the directory can be written again.
@@ -131,17 +112,14 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   ASSERT_FALSE(test::inject(kFirstVersionDomain,
                             {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"})
                    .empty());
-  const auto read_only = wait_for_status(reader, service.cell(), degraded_by("Read-only file system"));
+  const auto read_only = test::wait_for_status(reader, service.cell(), degraded_by("Read-only file system"));
   ASSERT_TRUE(read_only.has_value()) << "no degraded status while the state directory is read-only";
   EXPECT_EQ(read_only->version, before.version());
   EXPECT_EQ(planner.environment()->version(), before.version());
 
   disk_.make_read_only(false);
   ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kPatience)) << "nothing went out after rw";
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
-  while (!holds(*planner.environment(), centre) && std::chrono::steady_clock::now() < deadline)
-    planner.wait_for_version(planner.environment()->version() + 1, 1s);
-  EXPECT_TRUE(holds(*planner.environment(), centre)) << "the box injected while read-only never arrived";
+  EXPECT_TRUE(test::wait_until_boxed(planner, centre)) << "the box injected while read-only never arrived";
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
 }
@@ -160,7 +138,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   ASSERT_FALSE(test::inject(kLaterVersionDomain,
                             {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
                    .empty());
-  const auto full = wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
+  const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
   ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
   EXPECT_EQ(full->version, before.version());
   {
@@ -171,10 +149,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   }
 
   disk_.free();
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
-  while (!holds(*planner.environment(), centre) && std::chrono::steady_clock::now() < deadline)
-    planner.wait_for_version(planner.environment()->version() + 1, 1s);
-  ASSERT_TRUE(holds(*planner.environment(), centre))
+  ASSERT_TRUE(test::wait_until_boxed(planner, centre))
       << "the box injected while the disk was full never arrived";
   const Environment with_box = test::settled(planner, 3s);
 

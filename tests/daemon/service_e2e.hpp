@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "cellmap/transport/environment_subscriber.hpp"
+#include "cellmap/transport/status_reader.hpp"
 #include "support/test_support.hpp"
 #include "transport/child_process.hpp"
 #include "transport/loopback.hpp"
@@ -74,6 +77,35 @@ inline Environment settled(const transport::EnvironmentSubscriber& planner, std:
   }
   ADD_FAILURE() << "the environment never settled";
   return *planner.environment();
+}
+
+/// Waits until some box of the subscriber's environment holds `p_C` (a box injected into the simulated cell
+/// arrived, possibly after other versions); false if it did not within the patience.
+inline bool wait_until_boxed(const transport::EnvironmentSubscriber& planner, const Eigen::Vector3d& p_C) {
+  const auto boxed = [&] {
+    const std::optional<Environment> env = planner.environment();
+    return env && std::any_of(env->boxes().begin(), env->boxes().end(),
+                              [&](const Box& box) { return box.contains(p_C); });
+  };
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (!boxed() && std::chrono::steady_clock::now() < deadline) {
+    const std::uint64_t version = planner.environment() ? planner.environment()->version() : 0;
+    planner.wait_for_version(version + 1, std::chrono::seconds(1));
+  }
+  return boxed();
+}
+
+/// Takes status reports of `cell` until one satisfies `accept` (returned) or the patience runs out.
+inline std::optional<transport::CellStatus> wait_for_status(
+    transport::StatusReader& reader, const std::string& cell,
+    const std::function<bool(const transport::CellStatus&)>& accept) {
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const transport::CellStatus& status : reader.take(std::chrono::milliseconds(200))) {
+      if (status.cell == cell && accept(status)) return status;
+    }
+  }
+  return std::nullopt;
 }
 
 /// An on_change callback that records every delta the subscriber applied.

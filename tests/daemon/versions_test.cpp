@@ -59,8 +59,9 @@ CellPipeline holding(std::initializer_list<std::uint64_t> ids, std::uint64_t nex
   return CellPipeline(CellPipelineConfig{}, boxes_with_ids(ids), next_box_id);
 }
 
-// A real publisher and subscriber for cell "keeper"; publications fail while `refuse` is set, as a refused
-// DDS write does, and each checks that its version was on disk before it went out.
+// A real publisher and subscriber for a cell named after the test (ctest runs the tests of this domain side
+// by side); publications fail while `refuse` is set, as a refused DDS write does, and each checks that its
+// version was on disk before it went out.
 class KeeperTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { test::use_loopback(); }
@@ -88,14 +89,15 @@ class KeeperTest : public ::testing::Test {
   }
 
   bool refuse = false;
+  const std::string cell_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   test::TempDir dir_;
   dds::Participant participant_{kKeeperDomain};
-  transport::EnvironmentPublisher publisher_{participant_, "keeper"};
-  transport::EnvironmentSubscriber subscriber_{participant_, "keeper"};
+  transport::EnvironmentPublisher publisher_{participant_, cell_};
+  transport::EnvironmentSubscriber subscriber_{participant_, cell_};
 };
 
 TEST_F(KeeperTest, SavesEachVersionBeforePublishingAndRetriesARefusedWrite) {
-  VersionStore store(state_dir(), "keeper");
+  VersionStore store(state_dir(), cell_);
   VersionKeeper keeper(store, publish());
   keeper.flush(holding({}));  // nothing yet: no version
   EXPECT_EQ(keeper.published().version(), 0u);
@@ -125,7 +127,7 @@ TEST_F(KeeperTest, SavesEachVersionBeforePublishingAndRetriesARefusedWrite) {
 }
 
 TEST_F(KeeperTest, UnusableStateDirectoryIsRetriedUntilItWorksAgain) {
-  VersionStore store(state_dir(), "keeper");
+  VersionStore store(state_dir(), cell_);
   VersionKeeper keeper(store, publish());
   keeper.flush(holding({1}));
   ASSERT_EQ(received(1), (std::vector<std::uint64_t>{1}));
@@ -150,7 +152,7 @@ TEST_F(KeeperTest, UnusableStateDirectoryIsRetriedUntilItWorksAgain) {
 
 TEST_F(KeeperTest, RemovedStateDirectoryIsSavedAgainAtOnce) {
   {
-    VersionStore store(state_dir(), "keeper");
+    VersionStore store(state_dir(), cell_);
     VersionKeeper keeper(store, publish());
     keeper.flush(holding({1, 2}, 7));
     ASSERT_EQ(received(1), (std::vector<std::uint64_t>{1, 2}));
@@ -158,14 +160,14 @@ TEST_F(KeeperTest, RemovedStateDirectoryIsSavedAgainAtOnce) {
     keeper.flush(holding({1, 2}, 7));  // nothing changed in the cell, but a restart would find nothing
     EXPECT_EQ(received(2), (std::vector<std::uint64_t>{1, 2}));
   }
-  VersionStore reopened(state_dir(), "keeper");
+  VersionStore reopened(state_dir(), cell_);
   EXPECT_EQ(reopened.recovered().environment.version(), 2u);
   EXPECT_EQ(reopened.recovered().next_box_id, 7u);
 }
 
 TEST_F(KeeperTest, ClockSteppedBackStillGivesRisingStamps) {
   std::int64_t now = 5'000'000'000;
-  VersionStore store(state_dir(), "keeper");
+  VersionStore store(state_dir(), cell_);
   VersionKeeper keeper(store, publish(), [&now] { return now; });
   keeper.flush(holding({1}));
   EXPECT_EQ(keeper.published().stamp_ns(), 5'000'000'000);
@@ -181,12 +183,12 @@ TEST_F(KeeperTest, ClockSteppedBackStillGivesRisingStamps) {
 
 TEST_F(KeeperTest, ResumeAnnouncesTheRecoveredVersionOrItsBoxesAboveALostNumber) {
   {
-    VersionStore store(state_dir(), "keeper");
-    store.save(Environment("keeper", 1, 1, boxes_with_ids({1})));
-    store.save(Environment("keeper", 2, 2, boxes_with_ids({1, 2})));
+    VersionStore store(state_dir(), cell_);
+    store.save(Environment(cell_, 1, 1, boxes_with_ids({1})));
+    store.save(Environment(cell_, 2, 2, boxes_with_ids({1, 2})));
   }
   std::ofstream(snapshot(2), std::ios::trunc) << "{";  // version 2 may have been published, then lost
-  VersionStore store(state_dir(), "keeper");
+  VersionStore store(state_dir(), cell_);
   VersionKeeper keeper(store, publish());
   keeper.resume(recover_pipeline(CellPipelineConfig{}, store.recovered()));
   EXPECT_EQ(received(3), (std::vector<std::uint64_t>{1}));
