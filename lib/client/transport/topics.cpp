@@ -25,4 +25,13 @@ dds::Qos robot_state_qos() {
   return dds::Qos::make(false, 256);
 }
 
+std::map<security::Role, security::TopicGrants> role_grants() {
+  using security::Role;
+  const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
+  return {{Role::kDaemon, {environment, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
+          {Role::kPlanner, {{}, environment}},
+          {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}}},
+          {Role::kTool, {{kSceneEditTopic}, environment}}};
+}
+
 }  // namespace cellmap::transport

@@ -11,8 +11,11 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "cellmap/security/credentials.hpp"
 
 namespace cellmap::dds {
 
@@ -35,6 +38,8 @@ class Qos final {
   /// Writers only: when false, deleting the writer (a daemon restart) unregisters its instances without
   /// disposing them, so readers keep the data instead of seeing it removed.
   Qos& autodispose(bool on);
+  /// Sets a named property (participants: e.g. DDS Security's "dds.sec.*").
+  Qos& property(const std::string& name, const std::string& value);
   [[nodiscard]] const dds_qos_t* get() const { return qos_; }
 
  private:
@@ -61,10 +66,23 @@ class Entity {
 };
 
 /// A domain participant. The configuration comes from CYCLONEDDS_URI as usual.
+///
+/// With a security setting it joins with DDS Security on (Cyclone's auth, access-control and crypto plugins,
+/// configured through participant properties): it then talks only to participants of the same cell's CAs,
+/// and creating a writer or reader its role's permissions do not grant throws ("Not Allowed By Security").
+/// Every class of lib/transport takes its participant, so this one setting secures all of them.
 class Participant final : public Entity {
  public:
-  /// @throws Error if the domain cannot be joined (bad id, bad CYCLONEDDS_URI, no usable interface).
-  explicit Participant(std::uint32_t domain);
+  /// @throws Error if the credentials are refused (security::check: "<file>: <reason>") or the domain cannot
+  /// be joined (bad id, bad CYCLONEDDS_URI, no usable interface).
+  explicit Participant(std::uint32_t domain, const std::optional<security::Setting>& security = std::nullopt);
+  /// The credentials it joined with; nullopt when DDS Security is off.
+  [[nodiscard]] const std::optional<security::Credentials>& credentials() const { return credentials_; }
+
+ private:
+  struct Checked {};
+  Participant(std::uint32_t domain, std::optional<security::Credentials> credentials, Checked);
+  std::optional<security::Credentials> credentials_;
 };
 
 /// A topic of one generated type (its idlc descriptor, e.g. &cellmap_msg_Environment_desc).

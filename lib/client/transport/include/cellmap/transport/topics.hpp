@@ -3,7 +3,9 @@
 // these, so a reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
 
 #include <cstdint>
+#include <map>
 
+#include "cellmap/security/cell_setup.hpp"
 #include "cellmap/transport/dds.hpp"
 
 namespace cellmap::transport {
@@ -13,6 +15,9 @@ inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta
 inline constexpr const char* kStatusTopic = "cellmap/status";
 inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
 inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
+/// Reserved for the robot's joint states (no type yet): already in the DDS Security grants (robot writes,
+/// daemon reads), so credentials issued now stay valid when it arrives.
+inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
@@ -28,5 +33,12 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
 /// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
 [[nodiscard]] dds::Qos robot_state_qos();
+
+/// What each DDS Security role may write and read (`cellmap security init` signs these into the permissions):
+///   daemon   writes environment, delta, status;  reads robot state and joints, scene edits (simulator)
+///   planner  writes nothing;                     reads environment, delta, status
+///   robot    writes robot state and joints;      reads nothing
+///   tool     writes scene edits (`inject`);      reads environment, delta, status (`echo`)
+[[nodiscard]] std::map<security::Role, security::TopicGrants> role_grants();
 
 }  // namespace cellmap::transport
