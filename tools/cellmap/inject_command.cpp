@@ -67,7 +67,8 @@ void add_inject_command(CLI::App& app) {
   add_security_options(inject, options->security, security::Role::kTool);
   inject->require_subcommand(1);
 
-  CLI::App* add = inject->add_subcommand("add-box", "Add a box obstacle; prints its name");
+  // Each edit lets --domain, --security ... through to inject, so they may come after it too.
+  CLI::App* add = inject->add_subcommand("add-box", "Add a box obstacle; prints its name")->fallthrough();
   add->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
   add->add_option("--half-extents", options->half_extents, "A,B,C, metres")->required();
   add->add_option("--yaw", options->yaw, "rotation about the cell's z axis, radians");
@@ -80,11 +81,11 @@ void add_inject_command(CLI::App& app) {
     std::cout << edit.name << std::endl;
   });
 
-  CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name");
+  CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name")->fallthrough();
   remove->add_option("--name", options->name, "obstacle name")->required();
   remove->callback([options] { send(*options, transport::SceneEdit::remove(options->name)); });
 
-  CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre");
+  CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre")->fallthrough();
   move->add_option("--name", options->name, "obstacle name")->required();
   move->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
   move->callback([options] {
