@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "support/test_support.hpp"
-#include "wire.hpp"  // lib/transport's private wire conversion: the samples exactly as DDS delivers them
+#include "wire.hpp"  // lib/client/transport's private wire conversion: the samples exactly as DDS delivers them
 
 namespace cellmap::transport {
 namespace {

@@ -70,7 +70,7 @@ class Entity {
 /// With a security setting it joins with DDS Security on (Cyclone's auth, access-control and crypto plugins,
 /// configured through participant properties): it then talks only to participants of the same cell's CAs,
 /// and creating a writer or reader its role's permissions do not grant throws ("Not Allowed By Security").
-/// Every class of lib/transport takes its participant, so this one setting secures all of them.
+/// Every class of lib/client/transport takes its participant, so this one setting secures all of them.
 ///
 /// Cyclone DDS 0.10 loads DDS Security once per domain and process, from the first participant's setting,
 /// and gives every later participant of that process on that domain the same identity whatever it asked
