@@ -108,8 +108,8 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
 
   for (int round = 0; round < kRounds; ++round) {
     const char* spot = kSpots[rng() % std::size(kSpots)];
-    EXPECT_FALSE(
-        service.inject(kKillDomain, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"}).empty());
+    EXPECT_FALSE(service.inject(kKillDomain, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"})
+                     .empty());
     // The daemon reports a new box within about five sweeps (1 s): the kill lands before, during (fusion,
     // persisting, publishing) or after that version.
     std::this_thread::sleep_for(uniform(0.0, 2.5));

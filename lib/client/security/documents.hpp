@@ -1,6 +1,6 @@
 #pragma once
 // The governance and permissions documents of DDS Security 1.1 (9.4.1.2.3 and 9.4.1.3), written for one cell,
-// and their S/MIME signature (private to lib/security).
+// and their S/MIME signature (private to lib/client/security).
 
 #include <chrono>
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
 // OpenSSL objects owned by unique_ptr, and the conversions the credential check and the setup share
-// (private to lib/security).
+// (private to lib/client/security).
 
 #include <openssl/bio.h>
 #include <openssl/evp.h>
