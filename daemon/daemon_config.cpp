@@ -33,8 +33,8 @@ std::optional<security::Setting> read_security(YamlMap section, const std::files
   return setting;
 }
 
-// A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by the
-// user replaces the default pose whole instead of merging into it.
+// A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by
+// the user replaces the default pose whole instead of merging into it.
 bool is_pose(const YAML::Node& map) {
   return map["position"] || map["translation"] || map["rotation"];
 }
