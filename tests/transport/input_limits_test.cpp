@@ -9,7 +9,8 @@
 #include <limits>
 
 #include "support/test_support.hpp"
-#include "wire.hpp"  // lib/client/transport's private wire conversion: the samples exactly as DDS delivers them
+// lib/client/transport's private wire conversion: the samples exactly as DDS delivers them.
+#include "wire.hpp"
 
 namespace cellmap::transport {
 namespace {
