@@ -15,7 +15,7 @@ namespace {
 
 using nlohmann::json;
 
-// The boxes in the boxes-file form of ARCHITECTURE.md, produced by the one serialiser of that contract.
+// The boxes in the form of the boxes JSON file (docs/boxes-json.md), produced by its one serialiser.
 json boxes_json(const std::vector<Box>& boxes) {
   return json::parse(to_json(BoxSet{0, "cell", boxes}))["boxes"];
 }

@@ -58,10 +58,10 @@ Segments grow_regions(const Neighbourhoods& nb, const RegionGrowingParams& param
         // Neighbours come nearest first: the first one beyond the gap ends the list (eq. 3).
         if (other < 0 || nb.sq_distance(i, j) > max_sq_gap) break;
         if (label[other] >= 0) continue;
-        if (nb.normals[i].dot(nb.normals[other]) < min_cos) continue;  // eq. 6
+        if (nb.normals[i].dot(nb.normals[other]) < min_cos) continue;  // eq. 5
         label[other] = region;
         ++size;
-        if (nb.curvature[other] <= max_curvature) queue.push_back(other);  // eq. 5
+        if (nb.curvature[other] <= max_curvature) queue.push_back(other);  // eq. 4
       }
     }
     region_size.push_back(size);

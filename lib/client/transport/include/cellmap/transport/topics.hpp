@@ -1,6 +1,6 @@
 #pragma once
-// cellmap's DDS topics and their QoS, exactly as ARCHITECTURE.md states them. Writers and readers both use
-// these, so a reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
+// cellmap's DDS topics and their QoS (the contract: docs/dds.md). Writers and readers both use these, so a
+// reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
 
 #include <cstdint>
 #include <map>
