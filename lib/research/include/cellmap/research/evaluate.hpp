@@ -1,5 +1,7 @@
 #pragma once
 // Scoring collision boxes against a simulated scene's true obstacles (the paper's sensor comparison).
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <cstddef>
 #include <vector>

@@ -1,6 +1,8 @@
 #pragma once
 // The paper's batch pipeline on one cloud: crop → neighbourhoods and features (eq. 1, 2) → outlier removal →
 // region growing → leftovers → convex merge → VCCS split → boxes.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <optional>
 #include <string>

@@ -1,5 +1,7 @@
 #pragma once
 // Region growing segmentation (paper Alg. 1) and the coverage of the points it leaves over.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/neighbourhoods.hpp"
