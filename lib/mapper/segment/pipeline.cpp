@@ -79,6 +79,18 @@ BoxSplitParams box_split_params(const SegmentConfig& config, const Cloud& cloud,
   return p;
 }
 
+const char* split_method_name(SplitMethod method) {
+  switch (method) {
+    case SplitMethod::kFreeSpace:
+      return "free_space";
+    case SplitMethod::kOff:
+      return "off";
+    case SplitMethod::kSupervoxels:
+      break;
+  }
+  return "supervoxels";
+}
+
 }  // namespace
 
 SegmentConfig segment_config_from_yaml(YamlMap root) {
@@ -132,7 +144,7 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
   }
   {
     YamlMap m = root.child("split");
-    const std::string method = m.get<std::string>("method", "free_space");
+    const std::string method = m.get<std::string>("method", split_method_name(c.split_method));
     if (method == "free_space") {
       c.split_method = SplitMethod::kFreeSpace;
     } else if (method == "supervoxels") {

@@ -42,10 +42,10 @@ struct SegmentConfig final {
   int leftover_min_points = 3;  ///< smaller leftover groups are dropped (counted)
   bool merge = true;            ///< convex merging on/off
   ConvexMergeParams merge_params;
-  SplitMethod split_method = SplitMethod::kFreeSpace;
+  SplitMethod split_method = SplitMethod::kSupervoxels;
   double split_min_gain = 0.25;  ///< free_space: see BoxSplitParams::min_gain
   SplitParams split;             ///< supervoxels
-  double join_max_growth = 0.1;  ///< see BoxSplitParams::max_growth; 0 = no joining
+  double join_max_growth = 0.0;  ///< see BoxSplitParams::max_growth; 0 = no joining
   BoxKind box_kind = BoxKind::kOriented;
   /// Metres: the points are centres of voxels of this edge (0 = plain points); boxes hold the whole voxels.
   double voxel = 0.0;
