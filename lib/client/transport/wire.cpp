@@ -1,6 +1,8 @@
 #include "wire.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/topics.hpp"
@@ -78,6 +80,15 @@ std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::s
 std::string cell_of(const char* cell, const char* topic) {
   if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
   return cell;
+}
+
+// A writer may send any 32-bit value; reading one outside the enumerators through the enum type is undefined
+// behaviour, so the value is read as the integer it is on the wire.
+std::int32_t kind_on_the_wire(const cellmap_msg_SceneEdit& msg) {
+  static_assert(sizeof msg.kind == sizeof(std::int32_t), "IDL enums are 32 bits on the wire");
+  std::int32_t kind;
+  std::memcpy(&kind, &msg.kind, sizeof kind);
+  return kind;
 }
 
 }  // namespace
@@ -194,7 +205,7 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   const std::string where = std::string(kSceneEditTopic) + " '" + (msg.name ? msg.name : "") + "'";
   SceneEdit edit;
   edit.cell = msg.cell ? msg.cell : "";
-  switch (msg.kind) {
+  switch (kind_on_the_wire(msg)) {
     case cellmap_msg_SCENE_EDIT_ADD_BOX:
       edit.kind = SceneEdit::Kind::kAddBox;
       break;
@@ -205,7 +216,7 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
       edit.kind = SceneEdit::Kind::kMove;
       break;
     default:
-      throw Error(where + ": kind: unknown value " + std::to_string(static_cast<int>(msg.kind)));
+      throw Error(where + ": kind: unknown value " + std::to_string(kind_on_the_wire(msg)));
   }
   edit.name = msg.name ? msg.name : "";
   if (edit.name.empty()) throw Error(where + ": name: must not be empty");
