@@ -78,28 +78,6 @@ Obstacle read_obstacle(YamlMap map) {
   return obstacle;
 }
 
-Robot read_robot(YamlMap map, const std::string& base_dir) {
-  if (map.has("gantry") == map.has("urdf")) map.fail("gantry", "exactly one of gantry, urdf is required");
-  if (map.has("gantry")) {
-    YamlMap gantry = map.child("gantry");
-    const Eigen::Vector3d lower = gantry.vector3("lower");
-    const Eigen::Vector3d upper = gantry.vector3("upper");
-    if (!(lower.array() <= upper.array()).all()) gantry.fail("upper", "must be >= lower on every axis");
-    const Eigen::Isometry3d X_CE_zero = gantry.pose("tool_at_zero");
-    gantry.expect_all_read();
-    map.expect_all_read();
-    return Robot::gantry(lower, upper, X_CE_zero);
-  }
-  YamlMap urdf = map.child("urdf");
-  std::filesystem::path file = urdf.require<std::string>("file");
-  if (file.is_relative()) file = std::filesystem::path(base_dir) / file;
-  const std::string tool_link = urdf.require<std::string>("tool_link");
-  const Eigen::Isometry3d X_C_root = urdf.pose("base");
-  urdf.expect_all_read();
-  map.expect_all_read();
-  return UrdfModel::load(file.string()).chain(tool_link, X_C_root);
-}
-
 Eigen::VectorXd joint_vector(YamlMap& map, const std::string& key, int dof) {
   const std::vector<double> v = map.numbers(key, static_cast<std::size_t>(dof));
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -241,7 +219,53 @@ void check_shape(const Shape& shape, const std::string& what) {
   if (!ok) throw Error(what + ": sizes must be positive and finite");
 }
 
+GantryParts::Part read_part(YamlMap& gantry, const std::string& key, const GantryParts::Part& fallback) {
+  if (!gantry.has(key)) return fallback;
+  YamlMap map = gantry.child(key);
+  GantryParts::Part part{map.vector3("center"), positive_vec3(map, "half_extents")};
+  map.expect_all_read();
+  return part;
+}
+
 }  // namespace
+
+Robot read_robot(YamlMap map, const std::string& base_dir) {
+  if (map.has("gantry") == map.has("urdf")) map.fail("gantry", "exactly one of gantry, urdf is required");
+  if (map.has("gantry")) {
+    YamlMap gantry = map.child("gantry");
+    const Eigen::Vector3d lower = gantry.vector3("lower");
+    const Eigen::Vector3d upper = gantry.vector3("upper");
+    if (!(lower.array() <= upper.array()).all()) gantry.fail("upper", "must be >= lower on every axis");
+    const Eigen::Isometry3d X_CE_zero = gantry.pose("tool_at_zero");
+    const GantryParts fitting = GantryParts::fitting(lower, upper, X_CE_zero);
+    GantryParts parts;
+    parts.bridge = read_part(gantry, "bridge", fitting.bridge);
+    parts.carriage = read_part(gantry, "carriage", fitting.carriage);
+    parts.ram = read_part(gantry, "ram", fitting.ram);
+    gantry.expect_all_read();
+    map.expect_all_read();
+    return Robot::gantry(lower, upper, X_CE_zero, parts);
+  }
+  YamlMap urdf = map.child("urdf");
+  std::filesystem::path file = urdf.require<std::string>("file");
+  if (file.is_relative()) file = std::filesystem::path(base_dir) / file;
+  const std::string tool_link = urdf.require<std::string>("tool_link");
+  const Eigen::Isometry3d X_C_root = urdf.pose("base");
+  std::vector<std::string> package_paths;
+  if (urdf.has("package_paths")) {
+    package_paths = urdf.require<std::vector<std::string>>("package_paths");
+    for (std::string& path : package_paths) {
+      if (std::filesystem::path(path).is_relative()) path = (std::filesystem::path(base_dir) / path).string();
+    }
+  }
+  urdf.expect_all_read();
+  map.expect_all_read();
+  try {
+    return UrdfModel::load(file.string()).robot(tool_link, X_C_root, package_paths);
+  } catch (const Error& e) {
+    map.fail("urdf", e.what());
+  }
+}
 
 double Obstacle::volume() const {
   if (const auto* box = std::get_if<BoxShape>(&shape)) return 8.0 * box->half_extents.prod();

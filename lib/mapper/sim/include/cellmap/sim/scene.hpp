@@ -13,24 +13,13 @@
 #include <vector>
 
 #include "cellmap/common/region.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
 
 namespace cellmap::sim {
 
-/// A box centred on its frame O, with half extents along O's x, y and z axes (metres, > 0).
-struct BoxShape final {
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Ones();
-};
-/// A solid cylinder centred on its frame O, its axis along O's z (metres, > 0).
-struct CylinderShape final {
-  double radius = 1.0;
-  double half_length = 1.0;
-};
-/// A solid sphere centred on its frame O (metres, > 0).
-struct SphereShape final {
-  double radius = 1.0;
-};
+/// An obstacle's solid: the robot's primitive shapes (cellmap/robot/geometry.hpp), in the obstacle's frame O.
 using Shape = std::variant<BoxShape, CylinderShape, SphereShape>;
 
 /// One named solid obstacle of the scene. X_CO is the pose of the shape's frame O in the cell frame.
@@ -121,6 +110,12 @@ struct Scene final {
   /// sensor inside the cell at every stop of its plan. @throws Error naming the obstacle, sensor or stop.
   void validate() const;
 };
+
+/// Reads the `robot` section of a scene (or daemon) file: `gantry: {lower, upper, tool_at_zero, [bridge,
+/// carriage, ram: {center, half_extents}]}` (parts at q = 0 in the cell frame; default GantryParts::fitting)
+/// or `urdf: {file, tool_link, [base], [package_paths]}` (relative paths against `base_dir`; the URDF's
+/// collision geometry and meshes are loaded). @throws Error naming the key.
+[[nodiscard]] Robot read_robot(YamlMap map, const std::string& base_dir);
 
 /// Reads a scene file (format: config/cell.yaml, documented there). A URDF path is relative to the file.
 /// @throws Error "<file>: <key path>: <reason>" for unknown keys, wrong types, non-positive sizes, a stop
