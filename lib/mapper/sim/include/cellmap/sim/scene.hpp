@@ -1,6 +1,6 @@
 #pragma once
-// The simulated cell: its bounds, the obstacles in it, the robot, the sensors on the robot and the sweep
-// plan.
+// The simulated cell: its bounds, the obstacles in it, the robot, the sensors (on the robot or fixed), the
+// sweep plan, and what moves while frames are taken (the robot's motion, walkers).
 // The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
 // Detection for Industrial Robotics Applications", AIRoV 2024.
 
@@ -16,6 +16,7 @@
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
+#include "cellmap/sim/motion.hpp"
 
 namespace cellmap::sim {
 
@@ -69,14 +70,19 @@ struct SweepPlan final {
   double period = 0.1;
 };
 
-/// One sensor mounted on the end-effector E with the hand-eye extrinsic X_ES.
+/// Where a sensor is mounted: on the robot's tool (posed through the robot) or fixed in the cell.
+enum class Mount { kTool, kCell };
+
+/// One sensor, on the end-effector E with the hand-eye extrinsic X_ES, or fixed in the cell at X_CS.
 struct SensorSpec final {
   std::string name;
   SensorModel model = SensorModel::kKinectV2;
-  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();
-  PinholeIntrinsics intrinsics;    ///< cameras only
-  LineScanner scanner;             ///< line scanners only
-  std::uint64_t seed = 1;          ///< noise seed; same seed → same frames
+  Mount mount = Mount::kTool;
+  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();  ///< on the tool
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< fixed in the cell
+  PinholeIntrinsics intrinsics;                            ///< cameras only
+  LineScanner scanner;                                     ///< line scanners only
+  std::uint64_t seed = 1;                                  ///< noise seed; same seed → same frames
   std::optional<SweepPlan> sweep;  ///< overrides the scene's plan (a line scanner needs dense stops)
 
   [[nodiscard]] bool is_camera() const { return model != SensorModel::kOs32c; }
@@ -95,6 +101,9 @@ struct Scene final {
   Robot robot;
   std::vector<SensorSpec> sensors;
   SweepPlan sweep;
+  std::optional<Motion>
+      motion;  ///< the robot moving all the time (Simulator::window); none: sweeps stop by stop
+  std::vector<Walker> walkers;  ///< people walking through while the robot moves
 
   /// The plan `sensor` follows: its own, or the scene's.
   [[nodiscard]] const SweepPlan& plan_for(const SensorSpec& sensor) const;
@@ -102,12 +111,15 @@ struct Scene final {
   [[nodiscard]] int find_obstacle(const std::string& name) const;
   /// Index of the sensor whose name, or else whose model name, is `name`; -1 if none.
   [[nodiscard]] int find_sensor(const std::string& name) const;
-  /// X_CS of sensor `index` at joint vector q: X_CE(q) · X_ES. @throws Error as Robot::tool_pose.
+  /// X_CS of sensor `index` at joint vector q: X_CE(q) · X_ES on the tool, X_CS when fixed.
+  /// @throws Error as Robot::tool_pose.
   [[nodiscard]] Eigen::Isometry3d sensor_pose(int index, const Eigen::VectorXd& q) const;
 
   /// Checks what parse_scene checks, for scenes built by hand or edited: bounds non-empty, obstacle names
   /// unique and non-empty, sizes positive, sensors valid, every stop within the robot's limits and every
-  /// sensor inside the cell at every stop of its plan. @throws Error naming the obstacle, sensor or stop.
+  /// sensor inside the cell at every stop of its plan, the motion and walkers valid, every picked obstacle a
+  /// box.
+  /// @throws Error naming the obstacle, sensor, stop, waypoint or walker.
   void validate() const;
 };
 
