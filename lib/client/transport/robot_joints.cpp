@@ -1,7 +1,6 @@
 #include "cellmap/transport/robot_joints.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <set>
 #include <utility>
 
@@ -30,10 +29,12 @@ bool RobotJointsWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
 }
 
 RobotJointsReader::RobotJointsReader(const dds::Participant& participant, std::string cell,
-                                     std::vector<std::string> joint_names, double max_clock_offset)
+                                     std::vector<std::string> joint_names, InputLimits limits,
+                                     OnRefused on_refused)
     : cell_(std::move(cell)),
       joint_names_(std::move(joint_names)),
-      max_clock_offset_(max_clock_offset),
+      limits_(std::move(limits)),
+      on_refused_(std::move(on_refused)),
       topic_(participant, &cellmap_msg_RobotJoints_desc, kRobotJointsTopic),
       reader_(participant, topic_, robot_joints_qos()),
       waitset_(participant) {
@@ -42,7 +43,6 @@ RobotJointsReader::RobotJointsReader(const dds::Participant& participant, std::s
   if (std::set<std::string>(joint_names_.begin(), joint_names_.end()).size() != joint_names_.size()) {
     throw Error(where + ": joint names repeat");
   }
-  if (!(max_clock_offset_ > 0)) throw Error(where + ": max_clock_offset must be > 0 seconds");
   waitset_.attach(reader_);
 }
 
@@ -57,13 +57,6 @@ RobotJointsReader::~RobotJointsReader() {
 RobotJoints RobotJointsReader::in_robot_order(RobotJoints joints) const {
   const std::string where =
       std::string(kRobotJointsTopic) + " '" + joints.cell + "' at " + std::to_string(joints.stamp_ns);
-  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                  std::chrono::system_clock::now().time_since_epoch())
-                                  .count();
-  const double offset = std::abs(static_cast<double>(joints.stamp_ns - now_ns)) * 1e-9;
-  if (offset > max_clock_offset_) {
-    throw Error(where + ": stamp is " + std::to_string(offset) + " s from this machine's clock");
-  }
   if (joints.positions.size() != joint_names_.size()) {
     throw Error(where + ": " + std::to_string(joints.positions.size()) + " positions, the robot has " +
                 std::to_string(joint_names_.size()) + " joints");
@@ -90,14 +83,19 @@ RobotJoints RobotJointsReader::in_robot_order(RobotJoints joints) const {
 std::vector<RobotJoints> RobotJointsReader::take(std::chrono::nanoseconds timeout) {
   if (timeout.count() > 0) waitset_.wait(timeout);
   std::vector<RobotJoints> samples;
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count();
   reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
     const auto& msg = *static_cast<const cellmap_msg_RobotJoints*>(sample);
     if (msg.cell != nullptr && cell_ != msg.cell) return;
     try {
-      samples.push_back(in_robot_order(wire::from_wire(msg)));
+      RobotJoints joints = wire::from_wire(msg);
+      check_limits(joints, limits_, now_ns);
+      samples.push_back(in_robot_order(std::move(joints)));
     } catch (const Error& e) {
       ++rejected_;
-      last_rejection_ = e.what();
+      if (on_refused_) on_refused_(e.what());
     }
   });
   return samples;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellmap/transport/dds.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
 
 namespace cellmap::transport {
@@ -37,35 +38,34 @@ class RobotJointsReader final {
  public:
   /// @param cell         only this cell's samples are returned; others are skipped (not counted as rejected)
   /// @param joint_names  the robot's joints in its order (Robot::joint_names())
-  /// @param max_clock_offset  seconds a stamp may lie before or after this machine's CLOCK_REALTIME; a sample
-  ///                     further away (a controller with an unset clock, a unit mix-up) is refused
-  /// @throws Error if joint_names is empty or holds a name twice, or max_clock_offset is not positive.
+  /// @param limits       samples outside them are refused (input_limits.hpp; stamps against CLOCK_REALTIME)
+  /// @param on_refused   called with the reason of each refused sample, from take()
+  /// @throws Error if joint_names is empty or holds a name twice.
   RobotJointsReader(const dds::Participant& participant, std::string cell,
-                    std::vector<std::string> joint_names, double max_clock_offset = 10.0);
+                    std::vector<std::string> joint_names, InputLimits limits = {}, OnRefused on_refused = {});
   ~RobotJointsReader();
   RobotJointsReader(const RobotJointsReader&) = delete;
   RobotJointsReader& operator=(const RobotJointsReader&) = delete;
 
   /// Waits up to `timeout` for data (zero: just looks) and returns the samples received, oldest first, with
-  /// names = the robot's joint names and positions in that order. Refused and counted: an empty cell,
-  /// non-finite numbers, a bad payload, a stamp off by more than max_clock_offset, names that are not exactly
-  /// the robot's joints (unknown, missing or repeated), or a count that is not the robot's.
+  /// names = the robot's joint names and positions in that order. Refused (skipped, counted in rejected() and
+  /// passed to on_refused): an empty cell, non-finite numbers, a bad payload, samples outside the limits,
+  /// names that are not exactly the robot's joints (unknown, missing or repeated), or a count that is not the
+  /// robot's.
   std::vector<RobotJoints> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
-  /// Why the last refused sample was refused ("" if none was): one line for the log.
-  [[nodiscard]] const std::string& last_rejection() const { return last_rejection_; }
 
  private:
   [[nodiscard]] RobotJoints in_robot_order(RobotJoints joints) const;
 
   std::string cell_;
   std::vector<std::string> joint_names_;
-  double max_clock_offset_;
+  InputLimits limits_;
+  OnRefused on_refused_;
   dds::Topic topic_;
   dds::Reader reader_;
   dds::WaitSet waitset_;
   std::uint64_t rejected_ = 0;
-  std::string last_rejection_;
 };
 
 }  // namespace cellmap::transport
