@@ -96,12 +96,13 @@ std::uint64_t repeat(const RobotPoseOptions& options, const std::function<void(s
   return sent;
 }
 
+// `what`: "poses" or "joint states", as the messages and the summary line name them.
 template <class Writer, class Message>
-void publish_on(const RobotPoseOptions& options, Message message, const char* what) {
+void publish_on(const RobotPoseOptions& options, Message message, const std::string& what) {
   const dds::Participant participant(options.domain, options.security.setting());
   const Writer writer(participant);
   if (!writer.wait_for_reader(seconds(options.wait))) {
-    throw Error("robot-pose: no cellmapd reading " + std::string(what) + " on domain " +
+    throw Error("robot-pose: no cellmapd reading robot " + what + " on domain " +
                 std::to_string(options.domain) + " within " + std::to_string(options.wait) + " s");
   }
   const std::uint64_t sent = repeat(options, [&](std::int64_t stamp_ns) {
@@ -109,7 +110,7 @@ void publish_on(const RobotPoseOptions& options, Message message, const char* wh
     writer.write(message);
   });
   if (!writer.wait_for_acks(seconds(options.wait))) {
-    throw Error("robot-pose: the daemon did not acknowledge the " + std::string(what));
+    throw Error("robot-pose: the daemon did not acknowledge the " + what);
   }
   std::cout << "sent " << sent << " " << what << std::endl;
 }
