@@ -232,16 +232,16 @@ sim::Scene thirty_object_cell() {
       const double size = 0.07 + 0.01 * (n % 5);     // half width 7..11 cm
       switch (n % 4) {
         case 0:
-          o.shape = cellmap::BoxShape{Eigen::Vector3d(size, 0.8 * size, height)};
+          o.shape = sim::BoxShape{Eigen::Vector3d(size, 0.8 * size, height)};
           break;
         case 1:
-          o.shape = cellmap::CylinderShape{size, height};
+          o.shape = sim::CylinderShape{size, height};
           break;
         case 2:
-          o.shape = cellmap::SphereShape{size};
+          o.shape = sim::SphereShape{size};
           break;
         default:
-          o.shape = cellmap::BoxShape{Eigen::Vector3d(size, size, height)};
+          o.shape = sim::BoxShape{Eigen::Vector3d(size, size, height)};
           break;
       }
       const double half_z = (n % 4 == 2) ? size : height;

@@ -17,9 +17,6 @@
 namespace {
 
 using namespace cellmap::sim;
-using cellmap::BoxShape;
-using cellmap::CylinderShape;
-using cellmap::SphereShape;
 
 Scene bench_scene() {
   Scene scene = default_scene();

@@ -30,8 +30,8 @@ class MeshBvh;
                                               const Eigen::Vector3d& d_O);
 
 /// The robot as rays see it: its collision shapes, each mesh with a bounding-volume hierarchy built once
-/// (cost: O(n log n) per mesh; the IRB 2400's 1 918 triangles take about a millisecond). Immutable; a
-/// SceneCaster built with it borrows it, so it must outlive those casters.
+/// (cost: O(n log n) per mesh). Immutable; a SceneCaster built with it borrows it, so it must outlive those
+/// casters.
 class RobotSolids final {
  public:
   explicit RobotSolids(Robot robot);

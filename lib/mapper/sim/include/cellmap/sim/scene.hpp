@@ -20,7 +20,12 @@
 
 namespace cellmap::sim {
 
-/// An obstacle's solid: the robot's primitive shapes (cellmap/robot/geometry.hpp), in the obstacle's frame O.
+// The primitive shapes are the robot's (cellmap/robot/geometry.hpp), also reachable as sim::BoxShape etc.
+using cellmap::BoxShape;
+using cellmap::CylinderShape;
+using cellmap::SphereShape;
+
+/// An obstacle's solid, in the obstacle's frame O.
 using Shape = std::variant<BoxShape, CylinderShape, SphereShape>;
 
 /// One named solid obstacle of the scene. X_CO is the pose of the shape's frame O in the cell frame.
