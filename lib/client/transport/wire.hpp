@@ -66,6 +66,22 @@ class RobotStateSample {
   cellmap_msg_RobotState msg_{};
 };
 
+class RobotJointsSample {
+ public:
+  explicit RobotJointsSample(const RobotJoints& joints);
+  [[nodiscard]] const cellmap_msg_RobotJoints* get() const { return &msg_; }
+
+ private:
+  RobotJoints joints_;
+  std::vector<char*> names_;
+  cellmap_msg_ToolPayload payload_{};
+  cellmap_msg_RobotJoints msg_{};
+};
+
+/// @throws Error naming the topic and field if the cell is empty, names are given but not one per position, a
+/// number is not finite, a payload half extent is negative or its rotation is not orthonormal.
+void validate(const RobotJoints& joints);
+
 /// @throws Error naming the topic and field if a number is not finite, a half extent is negative, a rotation
 /// is not a unit quaternion, the cell is empty or box ids repeat.
 [[nodiscard]] Environment from_wire(const cellmap_msg_Environment& msg);
@@ -74,5 +90,7 @@ class RobotStateSample {
 [[nodiscard]] SceneEdit from_wire(const cellmap_msg_SceneEdit& msg);
 /// @throws Error also for an empty cell, a non-finite number or a quaternion whose norm is not 1 ± 1e-3.
 [[nodiscard]] RobotState from_wire(const cellmap_msg_RobotState& msg);
+/// @throws Error as validate(), or for a payload quaternion whose norm is not 1 ± 1e-3.
+[[nodiscard]] RobotJoints from_wire(const cellmap_msg_RobotJoints& msg);
 
 }  // namespace cellmap::transport::wire

@@ -15,8 +15,6 @@ inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta
 inline constexpr const char* kStatusTopic = "cellmap/status";
 inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
 inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
-/// Reserved for the robot's joint states (no type yet): already in the DDS Security grants (robot writes,
-/// daemon reads), so credentials issued now stay valid when it arrives.
 inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
@@ -33,6 +31,8 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
 /// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
 [[nodiscard]] dds::Qos robot_state_qos();
+/// cellmap/robot_joints: as cellmap/robot_state (RELIABLE, VOLATILE, KEEP_LAST 256 per cell).
+[[nodiscard]] dds::Qos robot_joints_qos();
 
 /// What each DDS Security role may write and read (`cellmap security init` signs these into the permissions):
 ///   daemon   writes environment, delta, status;  reads robot state and joints, scene edits (simulator)
