@@ -10,7 +10,9 @@
 #include "cellmap/collision/box_distance.hpp"
 #include "cellmap/collision/box_tree.hpp"
 #include "cellmap/planning/path_check.hpp"
+#include "gjk.hpp"
 #include "ratio_report.hpp"
+#include "separating_axes.hpp"
 
 namespace {
 

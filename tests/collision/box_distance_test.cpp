@@ -6,6 +6,8 @@
 #include <random>
 #include <vector>
 
+#include "epa.hpp"
+
 namespace cellmap::collision {
 namespace {
 

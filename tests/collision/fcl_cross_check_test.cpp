@@ -14,6 +14,7 @@
 #include <random>
 
 #include "cellmap/collision/box_distance.hpp"
+#include "epa.hpp"
 
 namespace cellmap::collision {
 namespace {

@@ -1,6 +1,5 @@
 #pragma once
-// Box-box queries: separating-axis overlap, GJK distance with witness points, penetration depth (exact, from
-// the separating axes, and by EPA), and the signed distance that combines them.
+// Box-box queries: the separating-axis overlap test and the exact signed distance with witness points.
 //
 // All functions are pure and thread-safe; inputs must be finite with half extents >= 0 (an Obb that is not
 // is the caller's bug; the results are then unspecified but still free of exceptions). Outputs never hold
@@ -32,32 +31,6 @@ struct SignedDistance final {
 /// corners (the margin grows the boxes as boxes, not as rounded boxes); use signed_distance for the exact
 /// test. ~20 ns.
 [[nodiscard]] bool overlap(const Obb& a, const Obb& b, double margin = 0.0);
-
-/// Exact penetration along the 15 separating axes: the largest separation (distance > 0, a lower bound of the
-/// true distance) or, when no axis separates, minus the penetration depth (exact: the facets of the Minkowski
-/// difference of two boxes have exactly these normals). normal points from A to B. Points are not filled.
-[[nodiscard]] SignedDistance separating_axis_depth(const Obb& a, const Obb& b);
-
-/// Result of GJK: `distance` >= 0 and witness points; `intersecting` when the boxes touch or overlap (then
-/// distance is 0 and the points are a common point of both boxes, if touching, or unspecified if
-/// overlapping).
-struct GjkResult final {
-  double distance = 0.0;
-  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
-  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
-  bool intersecting = false;
-  int iterations = 0;
-};
-
-/// GJK minimum distance between two boxes (signed-volumes sub-algorithm after Montanari et al. 2017). Stops
-/// when the new support vertex is already in the simplex (exact and finite on polytopes), or when the gain
-/// falls below a relative (1e-14 of |v|^2) or absolute (1e-24 m^2 scaled by the scene size) threshold.
-[[nodiscard]] GjkResult gjk_distance(const Obb& a, const Obb& b);
-
-/// EPA (expanding polytope) penetration depth for overlapping boxes; for separated boxes it returns the GJK
-/// distance. A general polytope algorithm kept as a cross-check of separating_axis_depth (which
-/// signed_distance uses because it is exact and faster on boxes). Always finite.
-[[nodiscard]] SignedDistance epa_penetration(const Obb& a, const Obb& b);
 
 /// Signed distance between two boxes (see SignedDistance). Separated: the 15 separating axes give a lower
 /// bound; a pair of points of A and B certified closest (support features reaching the bound, or mutually

@@ -1,0 +1,24 @@
+#pragma once
+// Internal: the two halves of signed_distance, shared with EPA.
+
+#include <Eigen/Core>
+
+#include "cellmap/collision/box_distance.hpp"
+#include "gjk.hpp"
+#include "separating_axes.hpp"
+
+namespace cellmap::collision {
+
+/// Distance of separated boxes (axis.gap > 0) in A's frame: a certified closest pair when one applies, else
+/// GJK started along the axis.
+[[nodiscard]] GjkResult separated_distance(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
+                                           const RelativePose& rel, const SeparatingAxis& axis);
+
+/// Touching or overlapping boxes with penetration `depth` >= 0 along `axis_a` (unit, A's frame, A → B): the
+/// result in the cell frame with witness points. B moved out along the axis by depth + clearance touches
+/// nothing, and the closest points there (exactly `clearance` apart, along the axis) map back to A and the
+/// original B.
+[[nodiscard]] SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const RelativePose& rel,
+                                                   double depth, const Eigen::Vector3d& axis_a);
+
+}  // namespace cellmap::collision
