@@ -17,20 +17,14 @@ namespace cellmap::collision {
                                    const RelativePose& rel, const SeparatingAxis& axis, Eigen::Vector3d* pa,
                                    Eigen::Vector3d* pb);
 
-/// Projection certificate: starts at a vertex extreme along `axis` and alternates closest-point projections
-/// between the boxes (a few steps, from B's side then from A's); when a point maps back onto itself the two
-/// points are mutually closest, and mutually closest points of two convex sets are a closest pair (the
-/// direction between them lies in both normal cones). Covers vertex-vertex, vertex-edge and many edge-face
-/// contacts. Writes the pair (A's frame) and returns true when it converged.
-[[nodiscard]] bool certify_by_projections(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
-                                          const RelativePose& rel, const SeparatingAxis& axis,
-                                          Eigen::Vector3d* pa, Eigen::Vector3d* pb);
-
-/// Either certificate.
-[[nodiscard]] inline bool certify_closest(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
-                                          const RelativePose& rel, const SeparatingAxis& axis,
-                                          Eigen::Vector3d* pa, Eigen::Vector3d* pb) {
-  return certify_by_axis(ha, hb, rel, axis, pa, pb) || certify_by_projections(ha, hb, rel, axis, pa, pb);
-}
+/// Mutually closest points by alternating projections: from B's point closest to A's centre, project onto A,
+/// back onto B, and so on; when a point maps back onto itself (to 1e-13 of the scene size) the two points
+/// are mutually closest, and mutually closest points of two convex sets are a closest pair (the direction
+/// between them lies in both normal cones). Where the projections land on an edge of each box, the step goes
+/// straight to the closest points of the two edge lines, so crossing edges need no zig-zag. Writes the pair
+/// (A's frame) and returns true when it converged within a few steps (> 95 % of random separated pairs);
+/// overlapping boxes converge to a common point.
+[[nodiscard]] bool mutually_closest_points(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
+                                           const RelativePose& rel, Eigen::Vector3d* pa, Eigen::Vector3d* pb);
 
 }  // namespace cellmap::collision

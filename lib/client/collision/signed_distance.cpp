@@ -1,6 +1,7 @@
 #include "signed_distance.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "closest_features.hpp"
 
@@ -24,10 +25,18 @@ SignedDistance separated_result(const Obb& a, const GjkResult& g, const Vector3d
 
 }  // namespace
 
+bool clearly_separated(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel, GjkResult* result) {
+  if (!mutually_closest_points(ha, hb, rel, &result->point_a, &result->point_b)) return false;
+  const double distance2 = (result->point_b - result->point_a).squaredNorm();
+  if (!(distance2 > 1e-24 * (ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm()))) return false;
+  result->distance = std::sqrt(distance2);
+  return true;
+}
+
 GjkResult separated_distance(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel,
                              const SeparatingAxis& axis) {
   GjkResult result;
-  if (certify_closest(ha, hb, rel, axis, &result.point_a, &result.point_b)) {
+  if (certify_by_axis(ha, hb, rel, axis, &result.point_a, &result.point_b)) {
     result.distance = (result.point_b - result.point_a).norm();
     return result;
   }
@@ -40,11 +49,14 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const RelativeP
   const double shift = depth + clearance;
   RelativePose moved = rel;
   moved.t += shift * axis_a;
-  SeparatingAxis axis = best_separating_axis(a.half_extents, b.half_extents, moved);
-  if (!(axis.gap > 0.0)) {  // rounding; GJK decides below
-    axis = SeparatingAxis{clearance, axis_a, SeparatingAxis::kFaceA, 0, 0};
+  GjkResult g;
+  if (!clearly_separated(a.half_extents, b.half_extents, moved, &g)) {
+    SeparatingAxis axis = best_separating_axis(a.half_extents, b.half_extents, moved);
+    if (!(axis.gap > 0.0)) {  // rounding; GJK decides below
+      axis = SeparatingAxis{clearance, axis_a, SeparatingAxis::kFaceA, 0, 0};
+    }
+    g = separated_distance(a.half_extents, b.half_extents, moved, axis);
   }
-  const GjkResult g = separated_distance(a.half_extents, b.half_extents, moved, axis);
   Vector3d pa = g.point_a;
   Vector3d pb = g.point_b - shift * axis_a;
   if (g.intersecting) {  // cannot happen for a true separating direction; stay finite regardless
@@ -63,15 +75,9 @@ SignedDistance signed_distance(const Obb& a, const Obb& b) {
   const RelativePose rel = relative_pose(a, b);
   const Vector3d& ha = a.half_extents;
   const Vector3d& hb = b.half_extents;
-  // Fast path: a face axis already separates and a certificate holds (most separated pairs).
-  const SeparatingAxis faces = best_separating_axis(ha, hb, rel, true);
-  if (faces.gap > 0.0) {
-    GjkResult g;
-    if (certify_closest(ha, hb, rel, faces, &g.point_a, &g.point_b)) {
-      g.distance = (g.point_b - g.point_a).norm();
-      return separated_result(a, g, faces.axis);
-    }
-  }
+  GjkResult g;
+  if (clearly_separated(ha, hb, rel, &g)) return separated_result(a, g, Vector3d::UnitX());
+  // Slowly converging, touching or overlapping: the separating axes decide.
   const SeparatingAxis axis = best_separating_axis(ha, hb, rel);
   if (axis.gap > 0.0) {
     const GjkResult g = separated_distance(ha, hb, rel, axis);

@@ -9,10 +9,15 @@
 
 namespace cellmap::collision {
 
-/// Distance of separated boxes (axis.gap > 0) in A's frame: a certified closest pair when one applies, else
-/// GJK started along the axis.
+/// Distance of separated boxes (axis.gap > 0) in A's frame: the support-feature certificate when it applies,
+/// else GJK started along the axis.
 [[nodiscard]] GjkResult separated_distance(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
                                            const RelativePose& rel, const SeparatingAxis& axis);
+
+/// Distance of boxes in A's frame when mutually closest points are found at a distance well above rounding
+/// (false otherwise: touching, overlapping or slowly converging).
+[[nodiscard]] bool clearly_separated(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
+                                     const RelativePose& rel, GjkResult* result);
 
 /// Touching or overlapping boxes with penetration `depth` >= 0 along `axis_a` (unit, A's frame, A → B): the
 /// result in the cell frame with witness points. B moved out along the axis by depth + clearance touches
