@@ -4,31 +4,45 @@
 #include <cmath>
 
 #include "closest_features.hpp"
+#include "mutual_projections.hpp"
 
 namespace cellmap::collision {
 namespace {
 
 using Eigen::Vector3d;
 
-// A separated pair's result in the cell frame.
-SignedDistance separated_result(const Obb& a, const GjkResult& g, const Vector3d& axis) {
+// |ha|^2 + |hb|^2 + |t|^2: the scene size the tolerances scale with.
+double scale2_of(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel) {
+  return ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm();
+}
+
+// Separations below this (squared, relative to scale2) count as touching: the direction between the points
+// is then rounding, and the separating axes decide instead.
+constexpr double kClearlySeparated2 = 1e-24;
+
+// A separated pair (A's frame: p of A, q of B, gap g = q - p with |g|^2 = distance2 > 0) in the cell frame.
+SignedDistance separated_result(const Obb& a, const double* p, const double* q, const Vector3d& gap,
+                                double distance2) {
   SignedDistance out;
-  out.distance = g.distance;
-  out.point_a = a.rotation * g.point_a + a.center;
-  out.point_b = a.rotation * g.point_b + a.center;
-  // A positive separation exceeds the rounding floor, so the direction is well defined; a certified pair at
-  // zero distance cannot occur (the axis gap is positive), the fallback only guards against rounding.
-  const Vector3d gap = g.point_b - g.point_a;
-  out.normal = a.rotation * (gap.squaredNorm() > 0.0 ? Vector3d(gap.normalized()) : axis);
+  out.distance = std::sqrt(distance2);
+  out.point_a.noalias() = a.rotation * Vector3d(p[0], p[1], p[2]);
+  out.point_a += a.center;
+  out.point_b.noalias() = a.rotation * Vector3d(q[0], q[1], q[2]);
+  out.point_b += a.center;
+  out.normal.noalias() = a.rotation * (gap / out.distance);
   return out;
 }
 
 }  // namespace
 
 bool clearly_separated(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel, GjkResult* result) {
-  if (!mutually_closest_points(ha, hb, rel, &result->point_a, &result->point_b)) return false;
+  const double scale2 = scale2_of(ha, hb, rel);
+  double p[3], q[3];
+  if (!mutually_closest_points(ha, hb, rel, scale2, p, q)) return false;
+  result->point_a = Vector3d(p[0], p[1], p[2]);
+  result->point_b = Vector3d(q[0], q[1], q[2]);
   const double distance2 = (result->point_b - result->point_a).squaredNorm();
-  if (!(distance2 > 1e-24 * (ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm()))) return false;
+  if (!(distance2 > kClearlySeparated2 * scale2)) return false;
   result->distance = std::sqrt(distance2);
   return true;
 }
@@ -71,20 +85,31 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const RelativeP
   return out;
 }
 
-SignedDistance signed_distance(const Obb& a, const Obb& b) {
-  const RelativePose rel = relative_pose(a, b);
-  const Vector3d& ha = a.half_extents;
-  const Vector3d& hb = b.half_extents;
-  GjkResult g;
-  if (clearly_separated(ha, hb, rel, &g)) return separated_result(a, g, Vector3d::UnitX());
-  // Slowly converging, touching or overlapping: the separating axes decide.
-  const SeparatingAxis axis = best_separating_axis(ha, hb, rel);
+// The separating axes and GJK, for pairs the projections leave open (touching, overlapping, slow to converge).
+SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const RelativePose& rel) {
+  const SeparatingAxis axis = best_separating_axis(a.half_extents, b.half_extents, rel);
   if (axis.gap > 0.0) {
-    const GjkResult g = separated_distance(ha, hb, rel, axis);
-    if (!g.intersecting) return separated_result(a, g, axis.axis);
+    const GjkResult g = separated_distance(a.half_extents, b.half_extents, rel, axis);
+    const Vector3d gap = g.point_b - g.point_a;
+    const double distance2 = gap.squaredNorm();
+    if (!g.intersecting && distance2 > 0.0) {
+      return separated_result(a, g.point_a.data(), g.point_b.data(), gap, distance2);
+    }
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
   return penetration_witnesses(a, b, rel, std::max(-axis.gap, 0.0), axis.axis);
+}
+
+SignedDistance signed_distance(const Obb& a, const Obb& b) {
+  const RelativePose rel = relative_pose(a, b);
+  const double scale2 = scale2_of(a.half_extents, b.half_extents, rel);
+  double p[3], q[3];
+  if (mutually_closest_points(a.half_extents, b.half_extents, rel, scale2, p, q)) {
+    const Vector3d gap(q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+    const double distance2 = gap.squaredNorm();
+    if (distance2 > kClearlySeparated2 * scale2) return separated_result(a, p, q, gap, distance2);
+  }
+  return signed_distance_by_axes(a, b, rel);
 }
 
 }  // namespace cellmap::collision
