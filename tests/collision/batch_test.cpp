@@ -65,6 +65,36 @@ TEST(BatchTest, DenseVectorHasThePaperCountAndExactEntries) {
   EXPECT_EQ(c.result.distance, signed_distance(robot[2][1], environment[4]).distance);
 }
 
+TEST(BatchTest, DenseEntriesEqualSignedDistanceInEveryLane) {
+  // The dense batch runs its first projections on several environment boxes at once; every entry must still
+  // be exactly signed_distance's answer: separated, overlapping and touching pairs, environment sizes that do
+  // and do not fill the last block.
+  std::mt19937 rng(6);
+  for (const int n_env : {1, 4, 11}) {
+    std::vector<Obb> environment = random_boxes(n_env, 0.4, rng);
+    std::vector<std::vector<Obb>> robot{random_boxes(5, 0.4, rng), random_boxes(5, 0.4, rng)};
+    robot[1][0] = Obb(environment[0].center +
+                          environment[0].rotation * Vector3d(environment[0].half_extents.x() + 0.3, 0, 0),
+                      Vector3d(0.3, 0.1, 0.1), environment[0].rotation);  // touching a face
+    const ConstraintSet set = constraints(robot, environment);
+    ASSERT_EQ(set.entries.size(), set.n_constr());
+    int separated = 0, overlapping = 0;
+    for (const Constraint& c : set.entries) {
+      const SignedDistance expected =
+          signed_distance(robot[c.checkpoint][c.robot_box], environment[c.env_box]);
+      EXPECT_EQ(c.result.distance, expected.distance);
+      EXPECT_EQ(c.result.point_a, expected.point_a);
+      EXPECT_EQ(c.result.point_b, expected.point_b);
+      EXPECT_EQ(c.result.normal, expected.normal);
+      (c.result.distance > 0.0 ? separated : overlapping) += 1;
+    }
+    if (n_env == 11) {
+      EXPECT_GT(separated, 10);
+      EXPECT_GT(overlapping, 10);
+    }
+  }
+}
+
 TEST(BatchTest, BroadPhaseKeepsEveryPairCloserThanTheCutoff) {
   std::mt19937 rng(3);
   const std::vector<Obb> environment = random_boxes(200, 6.0, rng);

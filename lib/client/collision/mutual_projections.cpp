@@ -46,7 +46,8 @@ bool step_to_edge_end(double slope, double h, double* x_k) {
 
 }  // namespace
 
-bool jump_on_b(const double* ha, const double* hb, const double* R, const double* t, const double* p, double* y) {
+bool jump_on_b(const double* ha, const double* hb, const double* R, const double* t, const double* p,
+               double* y) {
   const int j = kEdgeDirection[free_coordinates(y, hb)];
   if (j < 0) return false;
   const int p_free = free_coordinates(p, ha);

@@ -26,7 +26,8 @@ inline void b_to_a(const double* R, const double* t, const double* y, double* q)
 // y = clamp_B(R^T (p - t)): B's point closest to A's point p, in B's coordinates.
 inline void closest_in_b(const double* R, const double* t, const double* hb, const double* p, double* y) {
   const double d[3] = {p[0] - t[0], p[1] - t[1], p[2] - t[2]};
-  for (int j = 0; j < 3; ++j) y[j] = clamp(R[3 * j] * d[0] + R[3 * j + 1] * d[1] + R[3 * j + 2] * d[2], hb[j]);
+  for (int j = 0; j < 3; ++j)
+    y[j] = clamp(R[3 * j] * d[0] + R[3 * j + 1] * d[1] + R[3 * j + 2] * d[2], hb[j]);
 }
 
 // p = clamp_A(q): A's point closest to q.
@@ -42,7 +43,8 @@ inline double distance2(const double* u, const double* v) {
 // The steps where plain projections would zig-zag (mutual_projections.cpp). After B's point y was projected
 // from A's point p: y on an edge of B facing A's edge goes to the closest points of the two edge lines; y on
 // an edge facing A's face goes to the edge's end nearest that face. Return false when nothing moved.
-bool jump_on_b(const double* ha, const double* hb, const double* R, const double* t, const double* p, double* y);
+bool jump_on_b(const double* ha, const double* hb, const double* R, const double* t, const double* p,
+               double* y);
 // After A's point p was projected from B's point y: p on an edge of A facing a face of B goes to the edge's
 // end nearest that face.
 bool jump_on_a(const double* ha, const double* hb, const double* R, const double* y, double* p);
@@ -53,8 +55,8 @@ bool jump_on_a(const double* ha, const double* hb, const double* R, const double
 /// jumping ahead where an edge faces an edge or a face (see jump_on_b, jump_on_a). When each point is the
 /// other's closest point (to 1e-13 of the scene size, `scale2` = |ha|^2 + |hb|^2 + |t|^2), they are a
 /// closest pair (mutually closest points of two convex sets are: the direction between them lies in both
-/// normal cones). Writes the pair (A's frame: p of A, q of B) and returns true when that happened within a few
-/// steps (~99 % of random separated pairs); overlapping boxes end on a common point.
+/// normal cones). Writes the pair (A's frame: p of A, q of B) and returns true when that happened within a
+/// few steps (~99 % of random separated pairs); overlapping boxes end on a common point.
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif

@@ -5,6 +5,7 @@
 
 #include "closest_features.hpp"
 #include "mutual_projections.hpp"
+#include "projection_lanes.hpp"
 
 namespace cellmap::collision {
 namespace {
@@ -19,19 +20,6 @@ double scale2_of(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel
 // Separations below this (squared, relative to scale2) count as touching: the direction between the points
 // is then rounding, and the separating axes decide instead.
 constexpr double kClearlySeparated2 = 1e-24;
-
-// A separated pair (A's frame: p of A, q of B, gap g = q - p with |g|^2 = distance2 > 0) in the cell frame.
-SignedDistance separated_result(const Obb& a, const double* p, const double* q, const Vector3d& gap,
-                                double distance2) {
-  SignedDistance out;
-  out.distance = std::sqrt(distance2);
-  out.point_a.noalias() = a.rotation * Vector3d(p[0], p[1], p[2]);
-  out.point_a += a.center;
-  out.point_b.noalias() = a.rotation * Vector3d(q[0], q[1], q[2]);
-  out.point_b += a.center;
-  out.normal.noalias() = a.rotation * (gap / out.distance);
-  return out;
-}
 
 }  // namespace
 
@@ -85,7 +73,10 @@ SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const RelativeP
   return out;
 }
 
-// The separating axes and GJK, for pairs the projections leave open (touching, overlapping, slow to converge).
+namespace {
+
+// The separating axes and GJK, for pairs the projections leave open (touching, overlapping, slow to
+// converge).
 SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const RelativePose& rel) {
   const SeparatingAxis axis = best_separating_axis(a.half_extents, b.half_extents, rel);
   if (axis.gap > 0.0) {
@@ -93,23 +84,38 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
     const Vector3d gap = g.point_b - g.point_a;
     const double distance2 = gap.squaredNorm();
     if (!g.intersecting && distance2 > 0.0) {
-      return separated_result(a, g.point_a.data(), g.point_b.data(), gap, distance2);
+      return separated_in_cell(a, g.point_a.data(), g.point_b.data(), gap.data(), distance2);
     }
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
   return penetration_witnesses(a, b, rel, std::max(-axis.gap, 0.0), axis.axis);
 }
 
-SignedDistance signed_distance(const Obb& a, const Obb& b) {
-  const RelativePose rel = relative_pose(a, b);
+// The full alternating projections (with jumps), then the separating axes and GJK.
+SignedDistance signed_distance_iterated(const Obb& a, const Obb& b, const RelativePose& rel) {
   const double scale2 = scale2_of(a.half_extents, b.half_extents, rel);
   double p[3], q[3];
   if (mutually_closest_points(a.half_extents, b.half_extents, rel, scale2, p, q)) {
-    const Vector3d gap(q[0] - p[0], q[1] - p[1], q[2] - p[2]);
-    const double distance2 = gap.squaredNorm();
-    if (distance2 > kClearlySeparated2 * scale2) return separated_result(a, p, q, gap, distance2);
+    const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    const double distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
+    if (distance2 > kClearlySeparated2 * scale2) return separated_in_cell(a, p, q, gap, distance2);
   }
   return signed_distance_by_axes(a, b, rel);
+}
+
+}  // namespace
+
+SignedDistance signed_distance(const Obb& a, const Obb& b) {
+  BoxLanes<1> lane;
+  lane.set(0, b);
+  ProjectionLanes<1> projection;
+  relative_poses(a, lane, &projection);
+  project_twice(a.half_extents, lane, &projection);
+  if (projection.certified[0]) return separated_lane(a, projection, 0);
+  RelativePose rel;
+  for (int k = 0; k < 9; ++k) rel.R.data()[k] = projection.R[k][0];
+  for (int k = 0; k < 3; ++k) rel.t[k] = projection.t[k][0];
+  return signed_distance_iterated(a, b, rel);
 }
 
 }  // namespace cellmap::collision

@@ -24,12 +24,12 @@ struct SignedDistance final {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
 };
 
-/// Separating-axis test on the 15 axes (3 + 3 face normals, 9 edge-edge cross products). Returns true unless
-/// some axis separates the boxes by at least `margin` (a safety margin δ >= 0). Parallel edges are handled by
-/// an epsilon on the absolute rotation terms (degenerate cross products then never separate). Conservative:
-/// with margin > 0 a pair whose true distance is slightly above margin can still report true near edges and
-/// corners (the margin grows the boxes as boxes, not as rounded boxes); use signed_distance for the exact
-/// test. ~20 ns.
+/// Separating-axis test: the line between the centres (bounding spheres, a cheap first reject), then the 15
+/// axes (3 + 3 face normals, 9 edge-edge cross products). Returns true unless some axis separates the boxes
+/// by at least `margin` (a safety margin δ >= 0). Parallel edges are handled by an epsilon on the absolute
+/// rotation terms (degenerate cross products then never separate). Conservative: with margin > 0 a pair whose
+/// true distance is slightly above margin can still report true near edges and corners (the margin grows the
+/// boxes as boxes, not as rounded boxes); use signed_distance for the exact test. ~10 ns.
 [[nodiscard]] bool overlap(const Obb& a, const Obb& b, double margin = 0.0);
 
 /// Signed distance between two boxes (see SignedDistance). Separated: alternating closest-point projections
