@@ -117,7 +117,8 @@ TEST(OpenNI2SourceTest, SilentDeviceTurnsDisconnectedAndIsReopened) {
   // Under ASan about one run in four crashes inside OpenNI2 itself (SEGV near null in libOpenNI2, on the
   // DummyDevice driver's frame thread, during the fast close/reopen cycles below), also with a 200 ms wait
   // after stopping the stream; the release pass runs it.
-  GTEST_SKIP() << "the DummyDevice driver's frame thread crashes inside OpenNI2 under ASan (release pass runs this)";
+  GTEST_SKIP()
+      << "the DummyDevice driver's frame thread crashes inside OpenNI2 under ASan (release pass runs this)";
 #endif
   // The Dummy device sends a frame every 33 ms; a 10 ms frame timeout makes each gap look like an unplugged
   // camera, so the real driver goes through disconnect → back-off → reopen → frames again.
