@@ -57,7 +57,6 @@ std::unique_ptr<test::ChildProcess> start(std::vector<std::string> argv) {
   return std::make_unique<test::ChildProcess>(argv);
 }
 
-// Every line the program printed until it ended, and its exit code.
 // Cyclone DDS prints some of its own warnings on stdout ("1796061733.000847 [193] dq.builtin: Remote secure
 // participant ... not allowed"); they are not the probe's lines.
 bool is_cyclone_log(const std::string& line) {
@@ -74,6 +73,7 @@ std::optional<std::string> read_probe_line(test::ChildProcess& process,
   return line;
 }
 
+// Every line the program printed until it ended, and its exit code.
 std::vector<std::string> finish(test::ChildProcess& process, int* exit_code) {
   std::vector<std::string> lines;
   while (std::optional<std::string> line = read_probe_line(process)) lines.push_back(*line);
