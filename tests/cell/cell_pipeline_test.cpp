@@ -46,19 +46,45 @@ sim::Scene coarse_cell() {
 
 // A simulated cell swept by its Kinect, and the pipeline fed with its sweeps.
 class Cell {
+  // Whether the occupied voxel `seed` is one of a 26-connected group of at least change.min_voxels.
+  [[nodiscard]] bool obstacle(const octomap::OcTreeKey& seed) const {
+    std::vector<octomap::OcTreeKey> group{seed};
+    for (std::size_t next = 0; next < group.size() && group.size() < min_group_; ++next) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            octomap::OcTreeKey key = group[next];
+            key[0] = static_cast<octomap::key_type>(key[0] + dx);
+            key[1] = static_cast<octomap::key_type>(key[1] + dy);
+            key[2] = static_cast<octomap::key_type>(key[2] + dz);
+            if (pipeline_.map().state(key) == VoxelState::occupied &&
+                std::find(group.begin(), group.end(), key) == group.end()) {
+              group.push_back(key);
+            }
+          }
+        }
+      }
+    }
+    return group.size() >= min_group_;
+  }
+
  public:
   explicit Cell(sim::Scene scene, bool noise = true, const CellPipelineConfig& config = defaults())
       : simulator_(std::move(scene), sim::SimOptions{noise, 2}),
         exact_(simulator_.scene(), sim::SimOptions{false, 2}),
         sensor_(simulator_.scene().find_sensor("kinect")),
-        pipeline_(config, {}, 1) {}
+        pipeline_(config, {}, 1),
+        min_group_(static_cast<std::size_t>(config.change.min_voxels)) {}
 
   // One sweep through the pipeline; counts the versions it makes.
   SweepReport sweep() {
     std::vector<Frame> frames;
     for (sim::SimFrame& f : simulator_.sweep(sensor_, index_++)) frames.push_back(std::move(f.frame));
     SweepReport report = pipeline_.process(merge_frames(frames));
-    if (report.change) ++versions_;
+    if (report.change) {
+      ++versions_;
+      outside_at_versions_ = std::max(outside_at_versions_, occupied_voxels_outside_boxes());
+    }
     return report;
   }
 
@@ -93,8 +119,10 @@ class Cell {
     return seen > 0 ? static_cast<double>(covered) / static_cast<double>(seen) : 0.0;
   }
 
-  // Occupied voxels of the map that no single box holds whole (all 8 corners, 1 µm tolerance): 0 after a
-  // full segmentation (the first version).
+  // Obstacle voxels of the map that no single box holds whole (all 8 corners, 1 µm tolerance): the safety
+  // property, 0 at every version. Obstacle voxels are the occupied voxels of 26-connected groups of at least
+  // change.min_voxels; a smaller group touching nothing else is noise, for the boxes as for change
+  // detection.
   [[nodiscard]] std::size_t occupied_voxels_outside_boxes() const {
     const OccupancyMap& map = pipeline_.map();
     const double half = 0.5 * map.config().resolution;
@@ -108,7 +136,7 @@ class Cell {
         }
         return true;
       };
-      outside += std::none_of(pipeline_.boxes().begin(), pipeline_.boxes().end(), holds) ? 1 : 0;
+      if (std::none_of(pipeline_.boxes().begin(), pipeline_.boxes().end(), holds) && obstacle(key)) ++outside;
     }
     return outside;
   }
@@ -123,6 +151,8 @@ class Cell {
 
   [[nodiscard]] const CellPipeline& pipeline() const { return pipeline_; }
   [[nodiscard]] int versions() const { return versions_; }
+  // The most occupied voxels outside every box at any version so far: the safety property, 0.
+  [[nodiscard]] std::size_t outside_at_versions() const { return outside_at_versions_; }
 
  private:
   sim::Simulator simulator_;
@@ -130,7 +160,9 @@ class Cell {
   int sensor_;
   std::uint64_t index_ = 0;
   CellPipeline pipeline_;
+  std::size_t min_group_;
   int versions_ = 0;
+  std::size_t outside_at_versions_ = 0;
 };
 
 const Box* box_holding(const std::vector<Box>& boxes, const Eigen::Vector3d& p_C) {
@@ -198,15 +230,16 @@ void expect_far_boxes_kept(const std::vector<Box>& before, const std::vector<Box
 }
 
 // The paper's two criteria on the default cell (full Kinect, noise on): few boxes (each multiplies a
-// planner's constraints) that block little free space, every occupied voxel still inside a box (measured:
-// 24 boxes, 24.0 % of the obstacle volume); an object put on the table arrives as one version with one box,
+// planner's constraints) that block little free space, every obstacle voxel still inside a box (measured:
+// 13 boxes, 18.6 % of the obstacle volume; 24 boxes and 24.0 % while isolated 1–2-voxel noise got boxes of
+// its own, 13 of them); an object put on the table arrives as one version with one box,
 // its removal as one version.
 TEST(CellPipelineTest, DefaultCellIsFewTightBoxesAndAnInjectedBoxIsOneVersion) {
   Cell cell(sim::default_scene());
   settle(cell);
   const sim::BoxScore first = cell.score();
   EXPECT_LE(first.boxes, 25u);
-  EXPECT_LE(first.blocked_free_space, 0.25);
+  EXPECT_LE(first.blocked_free_space, 0.20);
   EXPECT_EQ(cell.occupied_voxels_outside_boxes(), 0u);
 
   const int settled = cell.versions();
@@ -303,6 +336,34 @@ TEST(CellPipelineTest, SmallMoveKeepsTheIdAndEndsAsOneBox) {
   EXPECT_EQ(cell.pipeline().boxes().size(), before_move.size()) << "the strip's box should be gone";
   expect_far_boxes_kept(before_move, cell.pipeline().boxes(), at, 0.3);
   EXPECT_GE(cell.coverage(), kCoverage);
+}
+
+// Noise keeps adding obstacle voxels outside the changed areas after the first version (on the coarse cell:
+// 4–9 within 3 sweeps, surfaces filling in and flying pixels); change detection rightly ignores them, so with
+// the defaults a later version holds only what its change touched (measured: 7 obstacle voxels outside every
+// box at the removal below; on the pipeline before isolated noise was left out, 22–37 occupied ones). With
+// reconcile.cover_every_version each version takes them up: every obstacle voxel wholly inside a box at every
+// version, and still one version for the add and one for the removal.
+TEST(CellPipelineTest, EveryVersionHoldsEveryObstacleVoxelWhenAskedTo) {
+  CellPipelineConfig config = defaults();
+  config.cover_every_version = true;
+  Cell cell(coarse_cell(), true, config);
+  settle(cell);
+  const int settled = cell.versions();
+  const Eigen::Vector3d at(1.9, 0.7, 0.87), top = at + Eigen::Vector3d(0, 0, 0.11);
+  cell.edit(transport::SceneEdit::add_box("planted", at, {0.1, 0.08, 0.12}));
+  const Versions add = run(cell, 15);
+  EXPECT_EQ(cell.versions() - settled, 1);
+  ASSERT_NE(box_holding(cell.pipeline().boxes(), top), nullptr);
+  const std::uint64_t planted_id = box_holding(cell.pipeline().boxes(), top)->id;
+  EXPECT_NE(std::find(add.added.begin(), add.added.end(), planted_id), add.added.end());
+
+  cell.edit(transport::SceneEdit::remove("planted"));
+  const Versions remove = run(cell, 15);
+  EXPECT_EQ(cell.versions() - settled, 2);
+  EXPECT_NE(std::find(remove.removed.begin(), remove.removed.end(), planted_id), remove.removed.end());
+  EXPECT_EQ(box_holding(cell.pipeline().boxes(), top), nullptr);
+  EXPECT_EQ(cell.outside_at_versions(), 0u);
 }
 
 TEST(CellPipelineTest, MapStateRoundTripsWithItsViewpointAndRejectsGarbage) {

@@ -20,6 +20,8 @@
 
 namespace cellmap {
 
+class OccupiedVoxels;
+
 /// Everything the cell pipeline is configured with: four sections of a config file and the settling policy.
 struct CellPipelineConfig final {
   OccupancyConfig occupancy;   ///< `occupancy` section
@@ -31,8 +33,18 @@ struct CellPipelineConfig final {
   /// to collect two hits, flying pixels in unobserved space decay slowly), so the first version is one
   /// segmentation of the settled map instead of a trickle of small versions. 0 = the first sweep makes it.
   int settle_sweeps = 15;
+  /// Every version holds every obstacle voxel of the map whole (`reconcile.cover_every_version`; default
+  /// false). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
+  /// smaller group touching nothing else is noise (flying pixels) and never fitted. The first version holds
+  /// every obstacle voxel either way. Later, noise keeps adding voxels outside the changed areas (surfaces
+  /// filling in at grazing angles, flying pixels collecting hits where no ray clears them) that change
+  /// detection rightly ignores; with this on, each version also takes them up (boxes grown by at most
+  /// `join.max_growth` of their volume, else small boxes of their own), so a version may change boxes far
+  /// from its change and carry boxes for noise. Off, versions change only what the change touched.
+  bool cover_every_version = false;
 
-  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile` of `root`
+  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile`
+  /// (cover_every_version included) of `root`
   /// and marks them read; absent keys keep the defaults above.
   /// @throws Error naming the key ("change.settle_sweeps: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static CellPipelineConfig from_yaml(YamlMap& root);
@@ -109,7 +121,9 @@ class CellPipeline final {
   void add_boxes_within(Scope& scope) const;
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                           std::size_t& evidence) const;
+                                           const OccupiedVoxels& voxels, std::size_t& evidence) const;
+  // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
+  void cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void update_viewpoint(const Sweep& sweep);
   // Whether this sweep's changes (or the end of settling) call for re-segmentation.
