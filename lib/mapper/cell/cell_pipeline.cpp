@@ -215,6 +215,10 @@ Resegmentation CellPipeline::resegment_everything() const {
   return result;
 }
 
+std::size_t CellPipeline::voxels_outside_boxes(int min_group) const {
+  return voxels_outside(map_, OccupiedVoxels(map_), boxes_, min_group).size();
+}
+
 // Every obstacle voxel wholly inside a box at every version: also those that noise added outside the changed
 // area since that area was last fitted (a surface seen at grazing angles filling in, flying pixels collecting
 // their hits in space no ray clears) and those a box kept by reconcile within its tolerance leaves out.

@@ -34,14 +34,14 @@ struct CellPipelineConfig final {
   /// segmentation of the settled map instead of a trickle of small versions. 0 = the first sweep makes it.
   int settle_sweeps = 15;
   /// Every version holds every obstacle voxel of the map whole (`reconcile.cover_every_version`; default
-  /// false). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
-  /// smaller group touching nothing else is noise (flying pixels) and never fitted. The first version holds
-  /// every obstacle voxel either way. Later, noise keeps adding voxels outside the changed areas (surfaces
-  /// filling in at grazing angles, flying pixels collecting hits where no ray clears them) that change
-  /// detection rightly ignores; with this on, each version also takes them up (boxes grown by at most
-  /// `join.max_growth` of their volume, else small boxes of their own), so a version may change boxes far
-  /// from its change and carry boxes for noise. Off, versions change only what the change touched.
-  bool cover_every_version = false;
+  /// true). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
+  /// smaller group touching nothing else is noise and never fitted. The first version holds every obstacle
+  /// voxel either way. Later, a few voxels keep appearing outside the changed areas (surfaces seen at grazing
+  /// angles filling in; flying pixels, where the cameras' filter lets them through) that change detection
+  /// rightly ignores; each version also takes them up: boxes grown by at most `join.max_growth` of their
+  /// volume, else small boxes of their own, so a version may also grow boxes away from its change. Off,
+  /// versions change only what the change touched and may leave such voxels outside every box.
+  bool cover_every_version = true;
 
   /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile`
   /// (cover_every_version included) of `root`
@@ -105,6 +105,10 @@ class CellPipeline final {
   /// The id the next new box gets: above every id this pipeline handed out or was started with.
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
   [[nodiscard]] const OccupancyMap& map() const { return map_; }
+  /// Occupied voxels of 26-connected occupied groups of at least `min_group` voxels that no single box holds
+  /// whole: with min_group = change.min_voxels the obstacle voxels the boxes leave out (the safety property
+  /// wants 0), with 1 every occupied voxel they leave out (noise included). Costs a pass over the map.
+  [[nodiscard]] std::size_t voxels_outside_boxes(int min_group) const;
   /// The map and the viewpoint normals face, as one opaque string (what a restart passes back to the
   /// constructor; also how a measurement clones a pipeline). The box-id counter is not part of it: it is
   /// kept with the versions (VersionStore), so a lost map state cannot bring back an id.
