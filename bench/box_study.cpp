@@ -13,9 +13,8 @@
 // --sweeps then runs N more sweeps of the unchanged cell, printing every 10 the occupied voxels outside every
 // box (all, and those of groups of at least change.min_voxels) and the versions. --max-depth-jump sets the
 // Kinect's flying-pixel filter (0 = off). Coverage is scored against the exact sweep without that filter.
-// With
-// --out: first_version.json and default_cell_boxes.svg (the boxes over the true obstacles, seen from above
-// and from the front).
+// With --out: first_version.json and default_cell_boxes.svg (the boxes over the true obstacles, seen from
+// above and from the front).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -48,7 +47,6 @@ struct Options {
   int sweeps = 0;                        // then run this many sweeps of the unchanged cell
   std::optional<double> max_depth_jump;  // the Kinect's, instead of the scene's
 };
-
 
 Cloud sweep_cloud(const std::vector<sim::SimFrame>& frames) {
   std::vector<Frame> plain;

@@ -1,7 +1,6 @@
 #include "cellmap/frame/frame.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 #include <vector>
 
