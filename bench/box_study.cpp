@@ -2,18 +2,24 @@
 // true solids, and the trade-off between box count and blocked free space (scripts/box_study).
 //
 //   cellmap-box-study [--out DIR] [--exact] [--config FILE] [--boxes FILE] [--cloud FILE] [--inject]
+//                     [--sweeps N] [--max-depth-jump X]
 //
 // The default cell (config/cell.yaml) is swept by its Kinect (noise on unless --exact) into cellmapd's
 // pipeline with its built-in defaults (or --config laid over them) until the first version. Printed: boxes,
 // coverage of the seen surface, blocked free space, volume coverage and per-object volumetric IoU, over the
 // region above the table and over the whole cell. --boxes scores a boxes file (e.g. a version cellmapd saved)
 // instead; --cloud writes the settled map's occupied voxel centres (PCD, to study the segmentation alone);
-// --inject then puts the README's example box on the table and takes it away, printing every version. With
-// --out: first_version.json and default_cell_boxes.svg (the boxes over the true obstacles, seen from above
-// and from the front).
+// --inject then puts the README's example box on the table and takes it away, printing every version;
+// --sweeps then runs N more sweeps of the unchanged cell, printing every 10 the occupied voxels outside every
+// box (all, and those of groups of at least change.min_voxels) and the versions. --max-depth-jump sets the
+// Kinect's flying-pixel filter (0 = off). Coverage is scored against the exact sweep without that filter.
+// With --out: first_version.json and default_cell_boxes.svg (the boxes over the true obstacles, seen from
+// above and from the front).
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -37,7 +43,9 @@ struct Options {
       cloud;  // write the settled map's occupied voxel centres here (PCD, viewpoint = mean sensor origin)
   std::string config;  // cellmapd config laid over the built-in defaults
   bool exact = false;
-  bool inject = false;  // then trace the README's inject example through the pipeline
+  bool inject = false;                   // then trace the README's inject example through the pipeline
+  int sweeps = 0;                        // then run this many sweeps of the unchanged cell
+  std::optional<double> max_depth_jump;  // the Kinect's, instead of the scene's
 };
 
 Cloud sweep_cloud(const std::vector<sim::SimFrame>& frames) {
@@ -54,17 +62,21 @@ void print_score(const char* what, const sim::BoxScore& s) {
       s.median_iou());
 }
 
+// cellmapd's pipeline configuration: its built-in defaults, or `config` laid over them.
+CellPipelineConfig pipeline_config(const std::string& config) {
+  return config.empty()
+             ? daemon::DaemonConfig::parse(daemon::default_config_yaml(), "cellmapd defaults", ".").pipeline
+             : daemon::DaemonConfig::load(config).pipeline;
+}
+
 // cellmapd's pipeline fed with the default cell's Kinect sweeps.
 class Daemon {
  public:
   Daemon(const sim::Scene& scene, bool noise, const std::string& config)
       : simulator_(scene, sim::SimOptions{noise, 2}),
         sensor_(scene.find_sensor("kinect")),
-        pipeline_(config.empty()
-                      ? daemon::DaemonConfig::parse(daemon::default_config_yaml(), "cellmapd defaults", ".")
-                            .pipeline
-                      : daemon::DaemonConfig::load(config).pipeline,
-                  {}, 1) {}
+        config_(pipeline_config(config)),
+        pipeline_(config_, {}, 1) {}
 
   // One sweep; returns its report.
   SweepReport sweep() {
@@ -114,11 +126,28 @@ class Daemon {
     return centres;
   }
 
+  // Sweeps the unchanged cell `sweeps` times, printing every 10 sweeps what noise left outside every box.
+  void watch(int sweeps) {
+    std::printf("%d sweeps of the unchanged cell:\n", sweeps);
+    const int min_voxels = config_.change.min_voxels;
+    int versions = 0;
+    for (int n = 1; n <= sweeps; ++n) {
+      versions += sweep().change ? 1 : 0;
+      if (n % 10 != 0 && n != sweeps) continue;
+      std::printf(
+          "  sweep %d: %zu occupied voxels outside every box, %zu in groups of >= %d; %d versions, %zu "
+          "boxes\n",
+          n, pipeline_.voxels_outside_boxes(1), pipeline_.voxels_outside_boxes(min_voxels), min_voxels,
+          versions, pipeline_.boxes().size());
+    }
+  }
+
   [[nodiscard]] const std::vector<Box>& boxes() const { return pipeline_.boxes(); }
 
  private:
   sim::Simulator simulator_;
   int sensor_;
+  CellPipelineConfig config_;
   CellPipeline pipeline_;
   std::uint64_t index_ = 0;
   Sweep last_;
@@ -136,9 +165,10 @@ void trace_inject(Daemon& daemon) {
 }
 
 int run(const Options& options) {
-  const sim::Scene scene = sim::default_scene();
-  const sim::Simulator exact(scene, sim::SimOptions{false, 2});
+  sim::Scene scene = sim::default_scene();
   const int sensor = scene.find_sensor("kinect");
+  if (options.max_depth_jump) scene.sensors[sensor].intrinsics.max_depth_jump = *options.max_depth_jump;
+  const sim::Simulator exact(sim::without_depth_filter(scene), sim::SimOptions{false, 2});
   Daemon daemon(scene, !options.exact, options.config);
   std::vector<Box> boxes;
   if (options.boxes.empty()) {
@@ -168,6 +198,7 @@ int run(const Options& options) {
     write_file_atomically(dir / "default_cell_boxes.svg", bench::box_picture(scene, boxes));
   }
   if (options.inject && options.boxes.empty()) trace_inject(daemon);
+  if (options.sweeps > 0 && options.boxes.empty()) daemon.watch(options.sweeps);
   return 0;
 }
 
@@ -189,10 +220,14 @@ int main(int argc, char** argv) {
       options.inject = true;
     } else if (std::strcmp(argv[a], "--exact") == 0) {
       options.exact = true;
+    } else if (std::strcmp(argv[a], "--sweeps") == 0 && a + 1 < argc) {
+      options.sweeps = std::atoi(argv[++a]);
+    } else if (std::strcmp(argv[a], "--max-depth-jump") == 0 && a + 1 < argc) {
+      options.max_depth_jump = std::atof(argv[++a]);
     } else {
       std::fprintf(stderr,
                    "usage: cellmap-box-study [--out DIR] [--exact] [--config FILE] [--boxes FILE] [--cloud "
-                   "FILE] [--inject]\n");
+                   "FILE] [--inject] [--sweeps N] [--max-depth-jump X]\n");
       return 2;
     }
   }

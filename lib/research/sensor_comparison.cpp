@@ -74,7 +74,7 @@ void bar_panel(research::SvgPlot& svg, const std::vector<SensorComparisonRow>& r
 
 std::vector<SensorComparisonRow> compare_sensors(const Scene& scene, const SensorComparisonConfig& config) {
   const Simulator noisy(scene, SimOptions{true, 2});
-  const Simulator exact(scene, SimOptions{false, 2});
+  const Simulator exact(without_depth_filter(scene), SimOptions{false, 2});
   std::vector<SensorComparisonRow> rows;
   for (std::size_t i = 0; i < scene.sensors.size(); ++i) {
     const int index = static_cast<int>(i);

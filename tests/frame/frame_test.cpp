@@ -44,6 +44,42 @@ TEST(DepthToPointsTest, OrganizedKeepsTheGridWithNaN) {
   EXPECT_FLOAT_EQ(cloud.at(2, 0).z, 2.0f);
 }
 
+// A 9 × 3 image: a wall at 1.000 m (columns 0–3) before a wall at 2.000 m (columns 5–8), and between them
+// column 4 at 1.500 m, where a time-of-flight pixel mixing both walls lands; the near wall is tilted so its
+// neighbours differ by 1 % of their depth.
+DepthImage depth_edge() {
+  DepthImage image;
+  image.intrinsics.width = 9;
+  image.intrinsics.height = 3;
+  image.intrinsics.fx = image.intrinsics.fy = 10.0;
+  image.intrinsics.cx = 4.0;
+  image.intrinsics.cy = 1.0;
+  for (int v = 0; v < 3; ++v) {
+    for (const std::uint16_t z : {1000, 1010, 1020, 1030, 1500, 2000, 2000, 2000, 2000})
+      image.depth.push_back(z);
+  }
+  return image;
+}
+
+TEST(DepthToPointsTest, FlyingPixelFilterDropsWhatLiesBehindADepthEdgeAndKeepsSurfaces) {
+  DepthImage image = depth_edge();
+  EXPECT_EQ(depth_to_points(image).size(), 27u) << "off by default";
+  image.intrinsics.max_depth_jump = 0.02;
+  const Cloud organized = depth_to_points(image, true);
+  for (int v = 0; v < 3; ++v) {
+    for (int u = 0; u < 9; ++u) {
+      // Dropped: the flying column and the far wall's rim behind it (one pixel); the near wall's rim stays.
+      EXPECT_EQ(std::isnan(organized.at(u, v).z), u == 4 || u == 5) << u << "," << v;
+    }
+  }
+  EXPECT_EQ(depth_to_points(image).size(), 21u);
+  // A pixel without a return is no neighbour: a hole does not drop the pixels around it.
+  image.depth[9 + 1] = 0;
+  EXPECT_EQ(depth_to_points(image).size(), 20u);
+  image.intrinsics.max_depth_jump = -0.1;
+  EXPECT_THROW((void)depth_to_points(image), Error);
+}
+
 TEST(DepthToPointsTest, RejectsSizeMismatchAndBadIntrinsics) {
   DepthImage image = small_image();
   image.depth.pop_back();

@@ -50,6 +50,10 @@ TEST(DepthIoTest, IntrinsicsYamlIsStrict) {
   const PinholeIntrinsics k = read_intrinsics_yaml(dir / "k.yaml");
   EXPECT_EQ(k.width, 4);
   EXPECT_DOUBLE_EQ(k.depth_scale, 0.0001);
+  EXPECT_DOUBLE_EQ(k.max_depth_jump, kDefaultMaxDepthJump);  // a camera's flying-pixel filter is on
+  write_file_atomically(dir / "off.yaml",
+                        "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nmax_depth_jump: 0\n");
+  EXPECT_DOUBLE_EQ(read_intrinsics_yaml(dir / "off.yaml").max_depth_jump, 0.0);
   write_file_atomically(dir / "typo.yaml", "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nfocal: 3\n");
   EXPECT_THROW((void)read_intrinsics_yaml(dir / "typo.yaml"), Error);
   write_file_atomically(dir / "nofx.yaml", "width: 4\nheight: 3\nfy: 2\ncx: 1.5\ncy: 1\n");

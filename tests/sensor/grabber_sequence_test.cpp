@@ -186,6 +186,7 @@ TEST(GrabberSequenceTest, PngReplayOfTheRealDepthGivesTheSamePoints) {
   image.intrinsics = read_pcl_intrinsics_xml((kSequence / (stem + ".xml")).string());
   image.intrinsics.width = raw.width;
   image.intrinsics.height = raw.height;
+  image.intrinsics.max_depth_jump = kDefaultMaxDepthJump;  // what the replay source gives PCL's format
   image.depth = raw.depth;
   const Cloud from_tiff = depth_to_points(image);
   ASSERT_TRUE(from_png.depth.has_value());

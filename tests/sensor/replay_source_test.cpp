@@ -27,7 +27,9 @@ struct Recording {
   TempDir dir{"replay"};
   std::vector<ReplayEntry> entries;
   Recording() {
-    write_file_atomically(dir / "intrinsics.yaml", "width: 6\nheight: 4\nfx: 3\nfy: 3\ncx: 2.5\ncy: 1.5\n");
+    // The ramp's rows lie 0.3 m behind each other: the flying-pixel filter (on by default) is off here.
+    write_file_atomically(dir / "intrinsics.yaml",
+                          "width: 6\nheight: 4\nfx: 3\nfy: 3\ncx: 2.5\ncy: 1.5\nmax_depth_jump: 0\n");
     write_depth_png(dir / "f0.png", ramp(6, 4));
     write_depth_png(dir / "f1.png", ramp(6, 4));
     Cloud cloud;

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "cellmap/common/error.hpp"
+#include "coverage.hpp"
 
 namespace cellmap {
 namespace {
@@ -139,8 +140,11 @@ Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
     if (!contains_id(scope.boxes, box.id)) kept.push_back(box);
   }
   Resegmentation result;
-  const std::vector<Box> fitted = fit_boxes(scope.area, kept, result.evidence);
+  const OccupiedVoxels voxels(map_);
+  const std::vector<Box> fitted = fit_boxes(scope.area, kept, voxels, result.evidence);
   result.reconciled = reconcile(boxes_, scope.boxes, fitted, next_box_id_, config_.reconcile);
+  // Noise alone makes no version: what it added is taken up by the next version a change makes.
+  if (config_.cover_every_version && result.reconciled.changed()) cover_the_rest(voxels, result.reconciled);
   return result;
 }
 
@@ -177,12 +181,16 @@ void CellPipeline::add_boxes_within(Scope& scope) const {
 }
 
 std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                         std::size_t& evidence) const {
+                                         const OccupiedVoxels& voxels, std::size_t& evidence) const {
   Cloud cloud;
   for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
-    // Evidence a kept box already covers needs no new box (e.g. the table around a new object).
-    const bool covered =
-        std::any_of(kept.begin(), kept.end(), [&](const Box& box) { return box.contains(c); });
+    // A group of fewer than change.min_voxels voxels touching nothing else is noise (flying pixels that
+    // collected their hits where no ray clears them), as for change detection: not an obstacle.
+    if (!voxels.in_group_of(c, config_.change.min_voxels)) continue;
+    // Evidence a kept box already holds needs no new box (e.g. the table around a new object).
+    const bool covered = std::any_of(kept.begin(), kept.end(), [&](const Box& box) {
+      return holds_cube(box, c, map_.config().resolution);
+    });
     if (!covered) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
   }
   evidence = cloud.size();
@@ -200,9 +208,26 @@ Resegmentation CellPipeline::resegment_everything() const {
   std::vector<std::uint64_t> scope;
   for (const Box& box : boxes_) scope.push_back(box.id);
   Resegmentation result;
-  const std::vector<Box> fitted = fit_boxes({whole}, {}, result.evidence);
+  const OccupiedVoxels voxels(map_);
+  const std::vector<Box> fitted = fit_boxes({whole}, {}, voxels, result.evidence);
   result.reconciled = reconcile(boxes_, scope, fitted, next_box_id_, config_.reconcile);
+  cover_the_rest(voxels, result.reconciled);
   return result;
+}
+
+std::size_t CellPipeline::voxels_outside_boxes(int min_group) const {
+  return voxels_outside(map_, OccupiedVoxels(map_), boxes_, min_group).size();
+}
+
+// Every obstacle voxel wholly inside a box at every version: also those that noise added outside the changed
+// area since that area was last fitted (a surface seen at grazing angles filling in, flying pixels collecting
+// their hits in space no ray clears) and those a box kept by reconcile within its tolerance leaves out.
+void CellPipeline::cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const {
+  CoverOptions options;
+  options.voxel = map_.config().resolution;
+  options.max_growth = config_.segment.join_max_growth;
+  options.kind = config_.segment.box_kind;
+  cover(reconciled, voxels_outside(map_, voxels, reconciled.boxes, config_.change.min_voxels), options);
 }
 
 }  // namespace cellmap

@@ -24,7 +24,10 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   c.change = ChangeConfig::from_yaml(change);
   c.segment = segment_config_from_yaml(root.child("segment"));
-  c.reconcile = read_reconcile(root.child("reconcile"));
+  // cover_every_version is the pipeline's policy too, read the same way.
+  YamlMap reconcile = root.child("reconcile");
+  c.cover_every_version = reconcile.get<bool>("cover_every_version", c.cover_every_version);
+  c.reconcile = read_reconcile(reconcile);
   return c;
 }
 

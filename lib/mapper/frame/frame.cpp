@@ -1,6 +1,8 @@
 #include "cellmap/frame/frame.hpp"
 
+#include <algorithm>
 #include <limits>
+#include <vector>
 
 #include "cellmap/common/error.hpp"
 
@@ -12,7 +14,38 @@ void PinholeIntrinsics::validate() const {
   if (!(depth_scale > 0)) throw Error("intrinsics: depth_scale must be positive");
   if (!(min_range >= 0) || !(max_range > min_range))
     throw Error("intrinsics: need 0 <= min_range < max_range");
+  if (!(max_depth_jump >= 0)) throw Error("intrinsics: max_depth_jump must be >= 0");
 }
+
+namespace {
+
+// Depth in metres of each pixel with a return in [min_range, max_range], else 0.
+std::vector<double> valid_depths(const DepthImage& image) {
+  const PinholeIntrinsics& k = image.intrinsics;
+  std::vector<double> z(image.depth.size(), 0.0);
+  for (std::size_t p = 0; p < z.size(); ++p) {
+    const double d = image.depth[p] * k.depth_scale;
+    if (image.depth[p] != 0 && d >= k.min_range && d <= k.max_range) z[p] = d;
+  }
+  return z;
+}
+
+// Whether a valid 8-neighbour of pixel (u, v) is nearer by more than max_jump of the pixel's depth.
+// Written here rather than taken from PCL: its ShadowPoints filter needs normals of an organized cloud
+// first, and the test on raw neighbours is a few comparisons per pixel.
+bool behind_depth_edge(const std::vector<double>& z, int width, int height, int u, int v, double max_jump) {
+  const double zp = z[static_cast<std::size_t>(v) * width + u];
+  const double limit = max_jump * zp;
+  for (int nv = std::max(0, v - 1); nv <= std::min(height - 1, v + 1); ++nv) {
+    for (int nu = std::max(0, u - 1); nu <= std::min(width - 1, u + 1); ++nu) {
+      const double zq = z[static_cast<std::size_t>(nv) * width + nu];
+      if (zq > 0 && zp - zq > limit) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
 
 Cloud depth_to_points(const DepthImage& image, bool organized) {
   const PinholeIntrinsics& k = image.intrinsics;
@@ -27,11 +60,12 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const double inv_fx = 1.0 / k.fx;
   const double inv_fy = 1.0 / k.fy;
+  const std::vector<double> depths = valid_depths(image);
   for (int v = 0; v < k.height; ++v) {
     for (int u = 0; u < k.width; ++u) {
-      const std::uint16_t raw = image.depth[static_cast<std::size_t>(v) * k.width + u];
-      const double z = raw * k.depth_scale;
-      if (raw == 0 || z < k.min_range || z > k.max_range) {
+      const double z = depths[static_cast<std::size_t>(v) * k.width + u];
+      if (z == 0 ||
+          (k.max_depth_jump > 0 && behind_depth_edge(depths, k.width, k.height, u, v, k.max_depth_jump))) {
         if (organized) cloud.push_back(pcl::PointXYZ(nan, nan, nan));
         continue;
       }

@@ -185,6 +185,7 @@ void OpenNI2Source::connect(double now) {
     intrinsics_.depth_scale = chosen.format == "DEPTH_1_MM" ? 0.001 : 0.0001;
     intrinsics_.min_range = config_.min_range;
     intrinsics_.max_range = config_.max_range;
+    intrinsics_.max_depth_jump = config_.max_depth_jump;
     if (openni::PlaybackControl* playback = device->device.getPlaybackControl()) {
       playback->setRepeatEnabled(false);
       playback->setSpeed(config_.realtime_playback ? 1.0f : 0.0f);

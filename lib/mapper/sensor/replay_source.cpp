@@ -135,6 +135,7 @@ PinholeIntrinsics ReplaySource::intrinsics_for(const std::string& image_path, in
     intrinsics = read_pcl_intrinsics_xml(xml.string());
     intrinsics.width = width;
     intrinsics.height = height;
+    intrinsics.max_depth_jump = kDefaultMaxDepthJump;  // PCL's format has no such key
   } else if (std::filesystem::is_regular_file(yaml)) {
     intrinsics = read_intrinsics_yaml(yaml.string());
     if (intrinsics.width != width || intrinsics.height != height) {

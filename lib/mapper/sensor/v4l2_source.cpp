@@ -163,6 +163,7 @@ PinholeIntrinsics realsense_d435_intrinsics(int width, int height) {
   k.depth_scale = 0.001;
   k.min_range = 0.3;
   k.max_range = 10.0;
+  k.max_depth_jump = kStereoMaxDepthJump;
   return k;
 }
 

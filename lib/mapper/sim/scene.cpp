@@ -160,6 +160,7 @@ PinholeIntrinsics read_intrinsics(YamlMap map, SensorModel model) {
   k.min_range = map.number("min_range", k.min_range, 0.0, 1000.0);
   k.max_range = map.number("max_range", k.max_range, 0.0, 1000.0);
   if (!(k.max_range > k.min_range)) map.fail("max_range", "must be greater than min_range");
+  k.max_depth_jump = map.number("max_depth_jump", k.max_depth_jump, 0.0, 10.0);
   map.expect_all_read();
   return k;
 }
@@ -435,6 +436,11 @@ void LineScanner::validate() const {
   if (!(range_resolution > 0)) throw Error("scanner: range_resolution must be positive");
 }
 
+Scene without_depth_filter(Scene scene) {
+  for (SensorSpec& sensor : scene.sensors) sensor.intrinsics.max_depth_jump = 0;
+  return scene;
+}
+
 PinholeIntrinsics default_intrinsics(SensorModel model) {
   PinholeIntrinsics k;
   k.depth_scale = 0.001;
@@ -443,11 +449,13 @@ PinholeIntrinsics default_intrinsics(SensorModel model) {
       // 512×424 time-of-flight depth, 70.6° × 60° field of view, 0.5–4.5 m.
       k.width = 512, k.height = 424, k.fx = 365.0, k.fy = 365.0, k.cx = 255.5, k.cy = 211.5;
       k.min_range = 0.5, k.max_range = 4.5;
+      k.max_depth_jump = kDefaultMaxDepthJump;
       return k;
     case SensorModel::kRealsenseD435:
       // 640×480 stereo depth (87° × 58° native), 0.2–10 m.
       k.width = 640, k.height = 480, k.fx = 383.0, k.fy = 383.0, k.cx = 319.5, k.cy = 239.5;
       k.min_range = 0.2, k.max_range = 10.0;
+      k.max_depth_jump = kStereoMaxDepthJump;
       return k;
     case SensorModel::kOs32c:
       break;

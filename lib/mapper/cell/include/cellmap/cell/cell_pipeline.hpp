@@ -20,6 +20,8 @@
 
 namespace cellmap {
 
+class OccupiedVoxels;
+
 /// Everything the cell pipeline is configured with: four sections of a config file and the settling policy.
 struct CellPipelineConfig final {
   OccupancyConfig occupancy;   ///< `occupancy` section
@@ -31,8 +33,18 @@ struct CellPipelineConfig final {
   /// to collect two hits, flying pixels in unobserved space decay slowly), so the first version is one
   /// segmentation of the settled map instead of a trickle of small versions. 0 = the first sweep makes it.
   int settle_sweeps = 15;
+  /// Every version holds every obstacle voxel of the map whole (`reconcile.cover_every_version`; default
+  /// true). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
+  /// smaller group touching nothing else is noise and never fitted. The first version holds every obstacle
+  /// voxel either way. Later, a few voxels keep appearing outside the changed areas (surfaces seen at grazing
+  /// angles filling in; flying pixels, where the cameras' filter lets them through) that change detection
+  /// rightly ignores; each version also takes them up: boxes grown by at most `join.max_growth` of their
+  /// volume, else small boxes of their own, so a version may also grow boxes away from its change. Off,
+  /// versions change only what the change touched and may leave such voxels outside every box.
+  bool cover_every_version = true;
 
-  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile` of `root`
+  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile`
+  /// (cover_every_version included) of `root`
   /// and marks them read; absent keys keep the defaults above.
   /// @throws Error naming the key ("change.settle_sweeps: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static CellPipelineConfig from_yaml(YamlMap& root);
@@ -93,6 +105,10 @@ class CellPipeline final {
   /// The id the next new box gets: above every id this pipeline handed out or was started with.
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
   [[nodiscard]] const OccupancyMap& map() const { return map_; }
+  /// Occupied voxels of 26-connected occupied groups of at least `min_group` voxels that no single box holds
+  /// whole: with min_group = change.min_voxels the obstacle voxels the boxes leave out (the safety property
+  /// wants 0), with 1 every occupied voxel they leave out (noise included). Costs a pass over the map.
+  [[nodiscard]] std::size_t voxels_outside_boxes(int min_group) const;
   /// The map and the viewpoint normals face, as one opaque string (what a restart passes back to the
   /// constructor; also how a measurement clones a pipeline). The box-id counter is not part of it: it is
   /// kept with the versions (VersionStore), so a lost map state cannot bring back an id.
@@ -109,7 +125,9 @@ class CellPipeline final {
   void add_boxes_within(Scope& scope) const;
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                           std::size_t& evidence) const;
+                                           const OccupiedVoxels& voxels, std::size_t& evidence) const;
+  // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
+  void cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void update_viewpoint(const Sweep& sweep);
   // Whether this sweep's changes (or the end of settling) call for re-segmentation.

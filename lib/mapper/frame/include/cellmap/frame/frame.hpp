@@ -21,10 +21,26 @@ struct PinholeIntrinsics final {
   double depth_scale = 0.001;  ///< metres per raw depth unit (1 mm for Kinect-class and RealSense Z16)
   double min_range = 0.0;      ///< depths below this (metres along z) are treated as no return
   double max_range = 10.0;     ///< depths above this are treated as no return
+  /// Flying-pixel filter: a pixel lying behind a valid 8-neighbour by more than this share of its own depth
+  /// is treated as no return. At a depth edge a camera's pixel mixes the near and the far surface (time of
+  /// flight) or smears one into the other (stereo) and its depth lands in between, in free space behind the
+  /// near surface's rim; such points are not measurements of a surface (what PCL calls veil or shadow
+  /// points). The near rim stays (it is the object's outline); the price is the far surface's rim (one
+  /// pixel) and surfaces seen within about atan(pixel angle / max_depth_jump) of grazing (Kinect v2 at
+  /// 256 × 212, 0.31° pixels: 0.02 → 15°), which other views see. 0 = off (the default here; every
+  /// configured camera sets its own, see docs/config.md).
+  double max_depth_jump = 0.0;
 
-  /// @throws Error if a size or focal length is not positive, or the range is empty.
+  /// @throws Error if a size or focal length is not positive, the range is empty or max_depth_jump negative.
   void validate() const;
 };
+
+/// max_depth_jump of a configured camera unless its configuration says otherwise: time-of-flight and
+/// structured-light cameras (Kinect v2, PS1080)...
+inline constexpr double kDefaultMaxDepthJump = 0.02;
+/// ... and active stereo cameras (RealSense D4xx), whose depth noise grows with z² (neighbours differ by
+/// several centimetres at 3 m without any edge).
+inline constexpr double kStereoMaxDepthJump = 0.05;
 
 /// A raw 16-bit depth image, row-major, `depth.size() == width * height`; 0 means no return.
 struct DepthImage final {
@@ -32,7 +48,8 @@ struct DepthImage final {
   std::vector<std::uint16_t> depth;
 };
 
-/// Back-projects a depth image into the sensor frame: p_S = ((u - cx) z / fx, (v - cy) z / fy, z).
+/// Back-projects a depth image into the sensor frame: p_S = ((u - cx) z / fx, (v - cy) z / fy, z), leaving
+/// out pixels without a return, outside [min_range, max_range] or on a depth edge (max_depth_jump).
 /// With `organized`, the cloud keeps width × height with NaN for pixels without a valid return (matches PCL's
 /// grabbers); otherwise only valid points are returned. @throws Error if the image size disagrees with the
 /// intrinsics or the intrinsics are invalid.

@@ -30,7 +30,8 @@ namespace cellmap {
 [[nodiscard]] std::vector<std::uint16_t> decode_z16(const std::uint8_t* data, std::size_t size, int width,
                                                     int height, std::size_t bytes_per_line);
 
-/// The D435 intrinsics listed above for 848×480, 640×480 and 1280×720 (depth_scale 0.001, range 0.3–10 m).
+/// The D435 intrinsics listed above for 848×480, 640×480 and 1280×720 (depth_scale 0.001, range 0.3–10 m,
+/// max_depth_jump kStereoMaxDepthJump).
 /// @throws Error for other sizes (their intrinsics must come from the config).
 [[nodiscard]] PinholeIntrinsics realsense_d435_intrinsics(int width, int height);
 

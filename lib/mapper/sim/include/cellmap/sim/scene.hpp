@@ -128,6 +128,10 @@ struct Scene final {
   void validate() const;
 };
 
+/// `scene` with every camera's flying-pixel filter off (PinholeIntrinsics::max_depth_jump = 0): the exact
+/// sweep of that scene is the whole surface its cameras see, what a filtered sweep's boxes are scored against.
+[[nodiscard]] Scene without_depth_filter(Scene scene);
+
 /// Reads the `robot` section of a scene (or daemon) file: `gantry: {lower, upper, tool_at_zero, [bridge,
 /// carriage, ram: {center, half_extents}]}` (parts at q = 0 in the cell frame; default GantryParts::fitting)
 /// or `urdf: {file, tool_link, [base], [package_paths]}` (relative paths against `base_dir`; the URDF's

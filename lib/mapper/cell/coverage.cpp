@@ -1,0 +1,178 @@
+#include "coverage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace cellmap {
+namespace {
+
+constexpr double kTolerance = 1e-7;  // metres; the grown boxes hold their cubes to rounding
+
+// Half extents, along a box's own axes, of a cube of edge `edge`: edge / 2 · ‖axis‖₁.
+Eigen::Vector3d cube_half(const Eigen::Matrix3d& R, double edge) {
+  return 0.5 * edge * R.cwiseAbs().colwise().sum().transpose();
+}
+
+// The smallest box with `box`'s axes holding `box` and the cube around `centre_C`.
+Box grown_to_hold(const Box& box, const Eigen::Vector3d& centre_C, double edge) {
+  const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+  const Eigen::Vector3d p = R.transpose() * (centre_C - box.center);
+  const Eigen::Vector3d w = cube_half(R, edge);
+  const Eigen::Vector3d lower = (-box.half_extents).cwiseMin(p - w);
+  const Eigen::Vector3d upper = box.half_extents.cwiseMax(p + w);
+  Box grown = box;
+  grown.half_extents = 0.5 * (upper - lower);
+  grown.center = box.center + R * (0.5 * (upper + lower));
+  grown.points += 1;
+  return grown;
+}
+
+// Index of the box of `boxes` that takes the cube with the least growth, at most max_growth of its volume;
+// -1 if none may.
+int cheapest_growth(const std::vector<Box>& boxes, const Eigen::Vector3d& centre_C, const CoverOptions& o) {
+  int best = -1;
+  double best_added = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const double added = grown_to_hold(boxes[i], centre_C, o.voxel).volume() - boxes[i].volume();
+    if (added <= o.max_growth * boxes[i].volume() && added < best_added) {
+      best = static_cast<int>(i);
+      best_added = added;
+    }
+  }
+  return best;
+}
+
+// Groups of 26-connected voxels (centres on the voxel grid), in the order of their first voxel.
+std::vector<std::vector<Eigen::Vector3d>> connected_groups(const std::vector<Eigen::Vector3d>& centres_C,
+                                                           double voxel) {
+  const auto cell_of = [&](const Eigen::Vector3d& c) {
+    return Eigen::Vector3i((c / voxel).array().floor().cast<int>());
+  };
+  const auto hash = [](const Eigen::Vector3i& v) {
+    return (static_cast<std::size_t>(v.x()) * 73856093u) ^ (static_cast<std::size_t>(v.y()) * 19349663u) ^
+           (static_cast<std::size_t>(v.z()) * 83492791u);
+  };
+  std::unordered_map<Eigen::Vector3i, int, decltype(hash)> index(centres_C.size(), hash);
+  for (std::size_t i = 0; i < centres_C.size(); ++i)
+    index.emplace(cell_of(centres_C[i]), static_cast<int>(i));
+  std::vector<int> group(centres_C.size(), -1);
+  std::vector<std::vector<Eigen::Vector3d>> groups;
+  for (std::size_t seed = 0; seed < centres_C.size(); ++seed) {
+    if (group[seed] >= 0) continue;
+    const int g = static_cast<int>(groups.size());
+    groups.emplace_back();
+    std::vector<int> stack{static_cast<int>(seed)};
+    group[seed] = g;
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      groups[g].push_back(centres_C[i]);
+      const Eigen::Vector3i at = cell_of(centres_C[i]);
+      for (int n = 0; n < 27; ++n) {
+        const auto it = index.find(at + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1));
+        if (it == index.end() || group[it->second] >= 0) continue;
+        group[it->second] = g;
+        stack.push_back(it->second);
+      }
+    }
+  }
+  return groups;
+}
+
+// Records box `box` (already in reconciled.boxes) as changed: added stays added, else modified.
+void record_grown(Reconciled& reconciled, const Box& box) {
+  for (std::vector<Box>* list : {&reconciled.added, &reconciled.modified}) {
+    const auto it = std::find_if(list->begin(), list->end(), [&](const Box& b) { return b.id == box.id; });
+    if (it != list->end()) {
+      *it = box;
+      return;
+    }
+  }
+  reconciled.modified.push_back(box);
+}
+
+}  // namespace
+
+bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge) {
+  const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+  const Eigen::Vector3d p = R.transpose() * (centre_C - box.center);
+  return (p.cwiseAbs() + cube_half(R, edge) - box.half_extents).maxCoeff() <= kTolerance;
+}
+
+OccupiedVoxels::OccupiedVoxels(const OccupancyMap& map)
+    : map_(map), keys_(map.occupied_keys()), set_(keys_.begin(), keys_.end()) {}
+
+bool OccupiedVoxels::in_group_of(const octomap::OcTreeKey& seed, int size) const {
+  if (set_.count(seed) == 0) return false;
+  std::vector<octomap::OcTreeKey> found{seed};
+  for (std::size_t next = 0; next < found.size() && static_cast<int>(found.size()) < size; ++next) {
+    for (int n = 0; n < 27 && static_cast<int>(found.size()) < size; ++n) {
+      octomap::OcTreeKey key = found[next];
+      key[0] = static_cast<octomap::key_type>(key[0] + n % 3 - 1);
+      key[1] = static_cast<octomap::key_type>(key[1] + n / 3 % 3 - 1);
+      key[2] = static_cast<octomap::key_type>(key[2] + n / 9 - 1);
+      if (set_.count(key) > 0 && std::find(found.begin(), found.end(), key) == found.end()) {
+        found.push_back(key);
+      }
+    }
+  }
+  return static_cast<int>(found.size()) >= size;
+}
+
+bool OccupiedVoxels::in_group_of(const Eigen::Vector3d& centre_C, int size) const {
+  return in_group_of(map_.tree().coordToKey(octomap::point3d(static_cast<float>(centre_C.x()),
+                                                             static_cast<float>(centre_C.y()),
+                                                             static_cast<float>(centre_C.z()))),
+                     size);
+}
+
+std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map, const OccupiedVoxels& voxels,
+                                            const std::vector<Box>& boxes, int min_group) {
+  const double edge = map.config().resolution;
+  std::vector<Region> bounds;
+  for (const Box& box : boxes) bounds.push_back(bounds_of(box));
+  std::vector<Eigen::Vector3d> outside;
+  for (const octomap::OcTreeKey& key : voxels.keys()) {
+    const Eigen::Vector3d c = map.centre(key);
+    bool held = false;
+    for (std::size_t i = 0; i < boxes.size() && !held; ++i) {
+      held = bounds[i].contains(c) && holds_cube(boxes[i], c, edge);
+    }
+    if (!held && voxels.in_group_of(key, min_group)) outside.push_back(c);
+  }
+  return outside;
+}
+
+void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
+           const CoverOptions& options) {
+  std::vector<Box>& boxes = reconciled.boxes;
+  std::vector<Eigen::Vector3d> rest;
+  for (const Eigen::Vector3d& c : centres_C) {
+    const auto holds = [&](const Box& box) { return holds_cube(box, c, options.voxel); };
+    if (std::any_of(boxes.begin(), boxes.end(), holds)) continue;
+    const int best = cheapest_growth(boxes, c, options);
+    if (best < 0) {
+      rest.push_back(c);
+      continue;
+    }
+    boxes[best] = grown_to_hold(boxes[best], c, options.voxel);
+    record_grown(reconciled, boxes[best]);
+  }
+  for (const std::vector<Eigen::Vector3d>& group : connected_groups(rest, options.voxel)) {
+    Box box = fit_box(group, options.kind, options.voxel);
+    for (const Eigen::Vector3d& c : group) {
+      if (!holds_cube(box, c, options.voxel)) box = grown_to_hold(box, c, options.voxel);
+    }
+    box.id = reconciled.next_id++;
+    boxes.push_back(box);
+    reconciled.added.push_back(box);
+  }
+  const auto by_id = [](const Box& a, const Box& b) { return a.id < b.id; };
+  std::sort(boxes.begin(), boxes.end(), by_id);
+  std::sort(reconciled.added.begin(), reconciled.added.end(), by_id);
+  std::sort(reconciled.modified.begin(), reconciled.modified.end(), by_id);
+}
+
+}  // namespace cellmap

@@ -1,0 +1,57 @@
+#pragma once
+// The cell pipeline's safety pass (internal): every occupied voxel of the map wholly inside a box at every
+// version, including the voxels noise added outside the changed area since that area was last fitted.
+
+#include <Eigen/Core>
+
+#include <unordered_set>
+#include <vector>
+
+#include "cellmap/boxes/box.hpp"
+#include "cellmap/environment/reconcile.hpp"
+#include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/segment/fit.hpp"
+
+namespace cellmap {
+
+/// Whether `box` holds the whole axis-aligned cube of edge `edge` around `centre_C` (0.1 µm tolerance).
+[[nodiscard]] bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge);
+
+/// The occupied voxels of a map at one moment, hashed for neighbour queries.
+class OccupiedVoxels final {
+ public:
+  explicit OccupiedVoxels(const OccupancyMap& map);
+  /// Whether the voxel `key` is occupied and one of a 26-connected group of at least `size` occupied voxels.
+  [[nodiscard]] bool in_group_of(const octomap::OcTreeKey& key, int size) const;
+  /// As above, for the voxel whose centre is `centre_C`.
+  [[nodiscard]] bool in_group_of(const Eigen::Vector3d& centre_C, int size) const;
+  /// Every occupied voxel, sorted by key (z, y, x).
+  [[nodiscard]] const std::vector<octomap::OcTreeKey>& keys() const { return keys_; }
+
+ private:
+  const OccupancyMap& map_;
+  std::vector<octomap::OcTreeKey> keys_;
+  std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> set_;
+};
+
+/// Centres of the occupied voxels that no single box of `boxes` holds whole and that belong to a
+/// 26-connected group of at least `min_group` occupied voxels, sorted by key (z, y, x).
+[[nodiscard]] std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map,
+                                                          const OccupiedVoxels& voxels,
+                                                          const std::vector<Box>& boxes, int min_group);
+
+/// How the safety pass covers what is left out.
+struct CoverOptions final {
+  double voxel = 0.02;      ///< voxel edge, metres
+  double max_growth = 0.1;  ///< a box may grow by this share of its volume to take a voxel (the join rule)
+  BoxKind kind = BoxKind::kOriented;  ///< of the new boxes
+};
+
+/// Makes the boxes of `reconciled` hold every voxel of `centres_C` whole: each voxel, in order, goes to the
+/// box that grows least to take it if that growth is at most `max_growth` of the box's volume (the box is
+/// then modified, or stays added if it is new), the rest are segmented into new boxes with fresh ids from
+/// `reconciled.next_id`. Keeps `reconciled`'s lists sorted by id.
+void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
+           const CoverOptions& options);
+
+}  // namespace cellmap
