@@ -200,7 +200,6 @@ SelfFilterResult SelfFilter::filter(const Frame& frame, const RobotAt& robot) co
     add_posed(payload, robot.X_CL.back() * robot.payload->X_EB, frame.X_CS, posed);
   }
   result.skipped_shapes = posed.skipped;
-  result.scan.origin_C = frame.X_CS.translation();
   if (frame.depth) {
     filter_camera(frame, posed, result);
   } else {
