@@ -10,12 +10,16 @@
 // compensated, camera exposure time, clock offset) places the rendered robot where it was up to `latency`
 // seconds earlier or later, so a surface point moving at speed v (m/s, the fastest point of the robot in
 // view: usually the tool or the payload's far corner) is off by v · latency. The padding offset must cover
-// that plus the sensor's depth noise at the robot's distance and the geometry's calibration error:
-//   padding ≥ v · latency + 2 σ_depth(z) + calibration.
-// Examples for the latency term alone: 0.5 m/s × 20 ms = 1 cm; 1 m/s × 20 ms = 2 cm; 2 m/s × 20 ms = 4 cm;
-// 1 m/s × 50 ms = 5 cm. The default offset (4 cm) covers a robot at 1 m/s with 20 ms of stamp error and a
-// Kinect-class camera's noise (σ ≈ 1 cm at 2.5 m). `padding_scale` grows every shape about its centre on top
-// (for models that are systematically too small).
+// that, the sensor's depth noise at the robot's distance and the geometry's calibration error:
+//   padding ≥ v · latency + depth noise bound(z) + calibration.
+// The latency term: 0.5 m/s × 20 ms = 1 cm; 1 m/s × 20 ms = 2 cm; 2 m/s × 20 ms = 4 cm; 1 m/s × 50 ms = 5 cm.
+// The noise term (the simulator's hard bounds): Kinect v2 3 σ with σ = 1 mm + 0.5 mm/m² · z², 2 cm at 3.4 m;
+// RealSense D435 at 640 × 480 4.5 σ (waviness included) with σ = 4.2 mm/m² · z², 1.9 cm at 1 m, 4.2 cm at
+// 1.5 m, 7.5 cm at 2 m (stereo: keep the robot near it or pad more). The default offset, 4 cm, is 2 cm of motion (1 m/s × 20 ms) plus a Kinect v2's
+// noise at 3.4 m. A measurement that the noise puts in front of the padded surface stays a hit; so do depth
+// pixels that the sensor mixed with a nearer surface beside the robot (time-of-flight flying pixels, stereo
+// smear), which nothing tells apart from an object in front of the robot. `padding_scale` grows every shape
+// about its centre on top (for models that are systematically too small).
 
 #include <Eigen/Geometry>
 
@@ -71,7 +75,7 @@ struct SelfFilterResult final {
 };
 
 /// Cuts one robot out of sensor frames. Built once per robot and configuration: shapes are padded and
-/// primitives tessellated at construction (meshes: a few thousand triangles take about a millisecond).
+/// primitives tessellated at construction.
 /// Immutable afterwards; filter() is const and may run on several threads at once (each call allocates its
 /// own depth buffer).
 class SelfFilter final {
