@@ -25,6 +25,7 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   c.change = ChangeConfig::from_yaml(change);
   c.segment = segment_config_from_yaml(root.child("segment"));
   c.reconcile = read_reconcile(root.child("reconcile"));
+  c.self_filter = SelfFilterConfig::from_yaml(root.child("self_filter"));
   return c;
 }
 
