@@ -215,15 +215,16 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
 
 // Two cameras, one of them unplugged: the cell is degraded and names it, the other keeps mapping.
 TEST_F(CameraE2eTest, OneOfTwoCamerasUnpluggedDegradesTheCellAndTheOtherKeepsTheMapCurrent) {
-  const std::string yaml = std::string(
-                               "cell: two-cameras\nsweep_period: 0.5\nstatus_period: 0.2\n"
-                               "change: {settle_sweeps: 2}\nsources:\n"
-                               "  - {kind: openni2, sensor: post, mount: cell, pose: {position: [1, 2, 1.5]}, "
-                               "openni2: ") +
-                           kDummy +
-                           "}\n"
-                           "  - {kind: v4l2, sensor: wrist, v4l2: {device: /dev/cellmap-unplugged, "
-                           "reconnect: {initial_backoff: 0.2, max_backoff: 0.5}}}\n";
+  const std::string yaml =
+      std::string(
+          "cell: two-cameras\nsweep_period: 0.5\nstatus_period: 0.2\n"
+          "change: {settle_sweeps: 2}\nsources:\n"
+          "  - {kind: openni2, sensor: post, mount: cell, pose: {position: [1, 2, 1.5]}, "
+          "openni2: ") +
+      kDummy +
+      "}\n"
+      "  - {kind: v4l2, sensor: wrist, v4l2: {device: /dev/cellmap-unplugged, "
+      "reconnect: {initial_backoff: 0.2, max_backoff: 0.5}}}\n";
   const dds::Participant participant(kUnpluggedDomain);
   transport::StatusReader reader(participant);
   transport::EnvironmentSubscriber planner(participant, "two-cameras");

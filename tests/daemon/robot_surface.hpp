@@ -67,10 +67,11 @@ inline constexpr int kArmWorkingLinks = 2;
 
 /// Ids of the boxes holding a point of `surface`.
 inline std::vector<std::uint64_t> boxes_holding_any(const std::vector<Box>& boxes,
-                                                   const std::vector<Eigen::Vector3d>& surface) {
+                                                    const std::vector<Eigen::Vector3d>& surface) {
   std::vector<std::uint64_t> ids;
   for (const Box& box : boxes) {
-    if (std::any_of(surface.begin(), surface.end(), [&](const Eigen::Vector3d& p) { return box.contains(p); }))
+    if (std::any_of(surface.begin(), surface.end(),
+                    [&](const Eigen::Vector3d& p) { return box.contains(p); }))
       ids.push_back(box.id);
   }
   return ids;

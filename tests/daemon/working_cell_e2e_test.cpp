@@ -54,7 +54,9 @@ class WorkingCellE2eTest : public ::testing::Test {
     test::use_loopback();
     const std::filesystem::path config = dir_.path() / "cellmapd.yaml";
     // The box kind of config/arm-cell.yaml.
-    std::ofstream(config) << "cell: arm\nsweep_period: 0\nstatus_period: 0.5\nsegment: {boxes: {kind: aabb}}\n" << yaml;
+    std::ofstream(config)
+        << "cell: arm\nsweep_period: 0\nstatus_period: 0.5\nsegment: {boxes: {kind: aabb}}\n"
+        << yaml;
     const dds::Participant participant(static_cast<std::uint32_t>(domain));
     VersionLog log;
     transport::EnvironmentSubscriber planner(participant, "arm", std::ref(log));
@@ -104,17 +106,18 @@ TEST_F(WorkingCellE2eTest, ArmInViewOfTheFixedCameraMakesOneVersionAndNoBoxOnThe
   EXPECT_GT(versions.front().boxes().size(), 5u);
   for (const Environment& env : versions) {
     EXPECT_TRUE(boxes_on_the_robot(env, scene).empty())
-        << "version " << env.version() << ": a box on the robot (" << boxes_on_the_robot(env, scene)[0] << ")";
+        << "version " << env.version() << ": a box on the robot (" << boxes_on_the_robot(env, scene)[0]
+        << ")";
   }
-  std::cout << "arm cell, fixed camera, self filter on: " << sweeps << " sweeps, " << versions.back().version()
-            << " version(s), " << versions.back().boxes().size() << " boxes\n";
+  std::cout << "arm cell, fixed camera, self filter on: " << sweeps << " sweeps, "
+            << versions.back().version() << " version(s), " << versions.back().boxes().size() << " boxes\n";
 }
 
 TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxesOnItself) {
   const sim::Scene scene = sim::load_scene(kArmScene);
-  const std::vector<Environment> versions =
-      run_daemon("sources: [{kind: sim, scene: " + kArmScene + ", sensor: post}]\nself_filter: {enabled: false}\n",
-                 kUnfilteredDomain, 20);
+  const std::vector<Environment> versions = run_daemon(
+      "sources: [{kind: sim, scene: " + kArmScene + ", sensor: post}]\nself_filter: {enabled: false}\n",
+      kUnfilteredDomain, 20);
   ASSERT_FALSE(versions.empty());
   EXPECT_GT(versions.back().version(), 1u) << "the unfiltered arm made no version after the first";
   const std::size_t on_robot = boxes_on_the_robot(versions.back(), scene).size();
@@ -127,10 +130,11 @@ TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxes
 double surface_in_boxes(const Environment& env, const sim::Scene& scene) {
   std::size_t inside = 0, total = 0;
   for (const char* name : {"pallet", "carton", "drum", "stack_1", "stack_2"}) {
-    for (const Eigen::Vector3d& p : scene.obstacles[static_cast<std::size_t>(scene.find_obstacle(name))]
-                                        .sample_surface(0.01)) {
+    for (const Eigen::Vector3d& p :
+         scene.obstacles[static_cast<std::size_t>(scene.find_obstacle(name))].sample_surface(0.01)) {
       ++total;
-      inside += std::any_of(env.boxes().begin(), env.boxes().end(), [&](const Box& b) { return b.contains(p); });
+      inside +=
+          std::any_of(env.boxes().begin(), env.boxes().end(), [&](const Box& b) { return b.contains(p); });
     }
   }
   return static_cast<double>(inside) / static_cast<double>(total);
@@ -145,7 +149,8 @@ TEST_F(WorkingCellE2eTest, TwoSensorsFusedCoverMoreOfTheObstaclesThanEitherAlone
     return "{kind: sim, scene: " + kArmScene + ", sensor: " + sensor + "}";
   };
   const auto coverage = [&](const std::string& sources, int domain) {
-    const std::vector<Environment> versions = run_daemon(settle + "sources: [" + sources + "]\n", domain, sweeps);
+    const std::vector<Environment> versions =
+        run_daemon(settle + "sources: [" + sources + "]\n", domain, sweeps);
     return versions.empty() ? 0.0 : surface_in_boxes(versions.back(), scene);
   };
   const double post = coverage(source("post"), kPostDomain);
