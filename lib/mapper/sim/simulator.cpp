@@ -77,8 +77,9 @@ CellState Simulator::state_at(double t) const {
 SimWindow Simulator::window(double t0, double t1, const std::vector<int>& sensors) const {
   if (!(t0 >= 0) || !(t1 >= t0)) throw Error("simulator: window needs 0 <= t0 <= t1");
   std::vector<int> rendered = sensors;
-  for (int sensor = 0; rendered.empty() && sensor < static_cast<int>(scene_.sensors.size()); ++sensor)
-    rendered.push_back(sensor);
+  if (sensors.empty()) {
+    for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor) rendered.push_back(sensor);
+  }
   SimWindow out;
   for (const int sensor : rendered) {
     if (sensor < 0 || sensor >= static_cast<int>(scene_.sensors.size()))
