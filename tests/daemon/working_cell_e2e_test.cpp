@@ -117,12 +117,12 @@ TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxes
   const sim::Scene scene = sim::load_scene(kArmScene);
   const std::vector<Environment> versions = run_daemon(
       "sources: [{kind: sim, scene: " + kArmScene + ", sensor: post}]\nself_filter: {enabled: false}\n",
-      kUnfilteredDomain, 20);
+      kUnfilteredDomain, 30);
   ASSERT_FALSE(versions.empty());
   EXPECT_GT(versions.back().version(), 1u) << "the unfiltered arm made no version after the first";
   const std::size_t on_robot = boxes_on_the_robot(versions.back(), scene).size();
   EXPECT_GT(on_robot, 0u);
-  std::cout << "arm cell, fixed camera, self filter off: 20 sweeps, " << versions.back().version()
+  std::cout << "arm cell, fixed camera, self filter off: 30 sweeps, " << versions.back().version()
             << " versions, boxes on the robot in the last: " << on_robot << "\n";
 }
 
