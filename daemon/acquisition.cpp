@@ -2,11 +2,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <mutex>
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "camera_input.hpp"
+#include "cellmap/cell/frame_grouper.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/scene_edits.hpp"
 #include "simulated_cell.hpp"
@@ -38,16 +42,20 @@ class SimAcquisition final : public Acquisition {
  public:
   SimAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
       : cell_name_(config.cell),
-        cell_(config.source),
+        cell_(config.sources, config.robot),
         edits_(participant, inside(cell_), refuse(output.refusals)),
         output_(output),
-        sweep_period_(config.sweep_period) {}
+        sweep_period_(config.sweep_period) {
+    for (const SourceConfig& source : config.sources) sensors_.push_back(source.sensor);
+  }
 
   void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) override {
     double stamp = 0.0;
     for (std::uint64_t sweeps = 0; !stop;) {
       const auto start = Clock::now();
-      if (deliver(stamp)) stamp += sweep_period_;
+      // Sweeps as fast as processed still cover one pass of the plan each in the motion's time.
+      const double duration = sweep_period_ > 0 ? sweep_period_.load() : cell_.pass_duration();
+      if (deliver(stamp, duration)) stamp += duration;
       if (max_sweeps > 0 && ++sweeps >= max_sweeps) return;
       const auto next = start + seconds(sweep_period_.load());
       while (!stop && Clock::now() < next) std::this_thread::sleep_for(milliseconds(10));
@@ -55,22 +63,25 @@ class SimAcquisition final : public Acquisition {
   }
 
   [[nodiscard]] std::string describe() const override {
-    return "sim (sensor '" + cell_.sensor_name() + "', " + std::to_string(cell_.scene().obstacles.size()) +
-           " obstacles)";
+    return "sim (sensor '" + cell_.sensor_names() + "', " + std::to_string(cell_.scene().obstacles.size()) +
+           " obstacles" + (cell_.scene().motion ? ", the robot moving" : "") + ")";
   }
-
+  [[nodiscard]] std::optional<Robot> robot() const override { return cell_.robot(); }
+  [[nodiscard]] std::uint64_t dropped_frames() const override { return dropped_; }
   void set_sweep_period(double seconds) override { sweep_period_ = seconds; }
 
  private:
   // Applies the edits that arrived, renders the next sweep and hands it over; false if that failed.
-  bool deliver(double stamp) {
+  bool deliver(double stamp, double duration) {
     try {
       apply_edits();
-      output_.mailbox.put(cell_.next_sweep(stamp));
-      output_.health.set_sensor(SourceState::kConnected);
+      output_.mailbox.put(cell_.next_sweep(stamp, duration));
+      dropped_ = cell_.dropped_frames();
+      for (const std::string& sensor : sensors_) output_.health.set_sensor(sensor, SourceState::kConnected);
       return true;
     } catch (const Error& e) {
-      output_.health.set_sensor(SourceState::kError, e.what());
+      for (const std::string& sensor : sensors_)
+        output_.health.set_sensor(sensor, SourceState::kError, e.what());
       spdlog::error("sweep source: {}", e.what());
       return false;
     }
@@ -91,58 +102,39 @@ class SimAcquisition final : public Acquisition {
   SimulatedCell cell_;
   transport::SceneEditReader edits_;
   AcquisitionOutput output_;
+  std::vector<std::string> sensors_;
   std::atomic<double> sweep_period_;
+  std::atomic<std::uint64_t> dropped_{0};
 };
 
-// One camera: sweeps come as its frames arrive and get their poses; the camera's own back-off paces retries.
-class CameraAcquisition final : public Acquisition {
+// A replay played as fast as processed must lose no sweep.
+bool lossless(const SourceConfig& source) {
+  const auto* replay = std::get_if<ReplayConfig>(&source.camera.source);
+  return replay != nullptr && replay->playback == ReplayConfig::Playback::kFastest;
+}
+
+// One camera's thread: its frames posed and grouped (with the other cameras') into sweeps; the camera's own
+// back-off paces retries.
+class CameraLoop final {
  public:
-  CameraAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
-      : camera_(config.source, participant, config.cell, refuse(output.refusals)),
-        output_(output),
-        pose_tolerance_(config.source.camera.pose_tolerance) {
-    const auto* replay = std::get_if<ReplayConfig>(&config.source.camera.source);
-    lossless_ = replay != nullptr && replay->playback == ReplayConfig::Playback::kFastest;
-    kind_ = to_string(config.source.kind);
-  }
+  CameraLoop(const SourceConfig& config, const RobotInput* robot, AcquisitionOutput output)
+      : camera_(config, robot), kind_(to_string(config.kind)), output_(output) {}
 
-  void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) override {
-    open();
-    std::uint64_t delivered = 0;
-    while (!stop) {
-      for (Sweep& sweep : step()) {
-        // A replay played as fast as processed must lose no sweep: wait for the processing thread.
-        while (lossless_ && !stop && !output_.mailbox.wait_taken(milliseconds(100))) {
-        }
-        output_.mailbox.put(std::move(sweep));
-        if (max_sweeps > 0 && ++delivered >= max_sweeps) return;
-      }
-      // --sweeps N on a recording shorter than N sweeps ends with the recording (its last sweep was flushed).
-      if (max_sweeps > 0 && camera_.status().state == SourceState::kEnded) return;
-      dropped_ = camera_.dropped_frames();
-      report_state();
-      report_drops();
-    }
-  }
-
-  [[nodiscard]] std::string describe() const override { return kind_ + " (camera '" + camera_.name() + "')"; }
-  [[nodiscard]] std::uint64_t dropped_frames() const override { return dropped_; }
-
- private:
   void open() {
     const SourceStatus opened = camera_.open();
     reported_ = opened;
     if (opened.state == SourceState::kConnected) {
       spdlog::info("camera '{}': streaming", camera_.name());
-      if (camera_.poses_received() > 0)
-        spdlog::info("camera '{}': {} recorded robot poses", camera_.name(), camera_.poses_received());
+      if (camera_.recorded_poses() > 0)
+        spdlog::info("camera '{}': {} recorded robot poses", camera_.name(), camera_.recorded_poses());
     } else {
       spdlog::warn("camera '{}': {}", camera_.name(), sensor_text(opened.state, opened.reason));
     }
-    output_.health.set_sensor(opened.state, opened.reason);
+    output_.health.set_sensor(camera_.name(), opened.state, opened.reason);
   }
 
-  std::vector<Sweep> step() {
+  // One turn: the frames posed in it, or none after an error (logged).
+  std::vector<SweepFrame> step() {
     try {
       return camera_.step(milliseconds(100));
     } catch (const Error& e) {
@@ -152,47 +144,157 @@ class CameraAcquisition final : public Acquisition {
     }
   }
 
-  // Logs and reports a change of the camera's state.
-  void report_state() {
+  // Logs and reports a change of the camera's state; true while it streams.
+  bool report_state() {
     const SourceStatus now = camera_.status();
-    if (now.state == reported_.state && now.reason == reported_.reason) return;
-    if (now.state == SourceState::kConnected) {
-      spdlog::info("camera '{}': streaming", camera_.name());
-    } else {
-      spdlog::warn("camera '{}': {}; keeping version {}", camera_.name(), sensor_text(now.state, now.reason),
-                   output_.published_version.load());
+    if (now.state != reported_.state || now.reason != reported_.reason) {
+      if (now.state == SourceState::kConnected) {
+        spdlog::info("camera '{}': streaming", camera_.name());
+      } else {
+        spdlog::warn("camera '{}': {}; keeping version {}", camera_.name(),
+                     sensor_text(now.state, now.reason), output_.published_version.load());
+      }
+      output_.health.set_sensor(camera_.name(), now.state, now.reason);
+      reported_ = now;
     }
-    output_.health.set_sensor(now.state, now.reason);
-    reported_ = now;
+    streaming_ = now.state == SourceState::kConnected;
+    return streaming_;
   }
+  [[nodiscard]] bool streaming() const { return streaming_; }
 
   // Frames dropped for want of a pose, logged at most once a second.
-  void report_drops() {
+  void report_drops(const RobotInput* robot, double pose_tolerance) {
     if (camera_.dropped_frames() <= drops_logged_ || Clock::now() < next_drop_log_) return;
     spdlog::warn(
-        "camera '{}': {} frames dropped without a robot pose within {} s ({} poses received, {} malformed)",
-        camera_.name(), camera_.dropped_frames(), pose_tolerance_, camera_.poses_received(),
-        camera_.poses_rejected());
+        "camera '{}': {} frames dropped without a robot pose within {} s ({} {} received, {} refused)",
+        camera_.name(), camera_.dropped_frames(), pose_tolerance, robot ? robot->received() : 0,
+        robot ? robot->what() : "recorded poses", robot ? robot->rejected() : 0);
     drops_logged_ = camera_.dropped_frames();
     next_drop_log_ = Clock::now() + std::chrono::seconds(1);
   }
 
+  [[nodiscard]] const CameraInput& camera() const { return camera_; }
+  [[nodiscard]] std::string describe() const { return kind_ + " (camera '" + camera_.name() + "')"; }
+
+ private:
   CameraInput camera_;
-  AcquisitionOutput output_;
-  double pose_tolerance_;
   std::string kind_;
-  bool lossless_ = false;  // a replay played as fast as processed: no sweep is replaced in the mailbox
+  AcquisitionOutput output_;
   SourceStatus reported_;
-  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<bool> streaming_{true};
   std::uint64_t drops_logged_ = 0;
   Clock::time_point next_drop_log_ = Clock::now();
+};
+
+// The cell's cameras, each on a thread of its own, their posed frames grouped into one stream of sweeps; a
+// thread takes the robot's samples (live cameras).
+class CameraAcquisition final : public Acquisition {
+ public:
+  CameraAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
+      : output_(output),
+        grouper_(config.sources.front().grouping),
+        pose_tolerance_(config.sources.front().camera.pose_tolerance),
+        robot_model_(config.robot) {
+    const bool live = std::any_of(config.sources.begin(), config.sources.end(),
+                                  [](const SourceConfig& s) { return !is_replay(s); });
+    if (live)
+      robot_.emplace(config.robot, pose_tolerance_, participant, config.cell, refuse(output.refusals));
+    lossless_ = std::all_of(config.sources.begin(), config.sources.end(), lossless);
+    for (const SourceConfig& source : config.sources)
+      loops_.push_back(std::make_unique<CameraLoop>(source, robot_ ? &*robot_ : nullptr, output));
+  }
+
+  void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) override {
+    std::atomic<bool> done{false};
+    std::thread robot([&] {
+      while (robot_ && !stop && !done) robot_->pump(milliseconds(100));
+    });
+    std::vector<std::thread> cameras;
+    std::atomic<std::size_t> ended{0};
+    for (auto& loop : loops_) {
+      cameras.emplace_back([&, camera = loop.get()] { run_camera(*camera, stop, done, ended, max_sweeps); });
+    }
+    for (std::thread& camera : cameras) camera.join();
+    done = true;
+    robot.join();
+  }
+
+  [[nodiscard]] std::string describe() const override {
+    std::string text;
+    for (const auto& loop : loops_) text += (text.empty() ? "" : ", ") + loop->describe();
+    return text;
+  }
+  [[nodiscard]] std::optional<Robot> robot() const override { return robot_model_; }
+  [[nodiscard]] std::uint64_t dropped_frames() const override {
+    std::uint64_t dropped = 0;
+    for (const auto& loop : loops_) dropped += loop->camera().dropped_frames();
+    return dropped;
+  }
+
+ private:
+  static bool is_replay(const SourceConfig& s) {
+    return std::holds_alternative<ReplayConfig>(s.camera.source);
+  }
+
+  // A camera's thread. With max_sweeps, every thread ends once that many sweeps went out or every camera's
+  // recording ended (its last sweep flushed).
+  void run_camera(CameraLoop& loop, const std::atomic<bool>& stop, std::atomic<bool>& done,
+                  std::atomic<std::size_t>& ended, std::uint64_t max_sweeps) {
+    loop.open();
+    bool counted_end = false;
+    while (!stop && !done) {
+      std::vector<SweepFrame> frames = loop.step();
+      loop.report_state();
+      loop.report_drops(robot_ ? &*robot_ : nullptr, pose_tolerance_);
+      // The open sweep is closed by the next frame of any camera; when none streams, nothing will close it.
+      const bool none_streaming =
+          std::none_of(loops_.begin(), loops_.end(), [](const auto& l) { return l->streaming(); });
+      if (group(std::move(frames), none_streaming, stop, max_sweeps)) done = true;
+      if (max_sweeps > 0 && !counted_end && loop.camera().status().state == SourceState::kEnded) {
+        counted_end = true;
+        if (++ended == loops_.size()) done = true;
+      }
+    }
+  }
+
+  // Groups the frames and delivers the sweeps they closed (and the open one when a camera stopped
+  // streaming); true once max_sweeps went out.
+  bool group(std::vector<SweepFrame> frames, bool flush, const std::atomic<bool>& stop,
+             std::uint64_t max_sweeps) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<FrameSweep> sweeps;
+    for (SweepFrame& frame : frames) {
+      for (FrameSweep& sweep : grouper_.add(std::move(frame))) sweeps.push_back(std::move(sweep));
+    }
+    if (flush) {
+      if (std::optional<FrameSweep> open = grouper_.flush()) sweeps.push_back(std::move(*open));
+    }
+    for (FrameSweep& sweep : sweeps) {
+      // A replay played as fast as processed must lose no sweep: wait for the processing thread.
+      while (lossless_ && !stop && !output_.mailbox.wait_taken(milliseconds(100))) {
+      }
+      output_.mailbox.put(std::move(sweep));
+      if (max_sweeps > 0 && ++delivered_ >= max_sweeps) return true;
+    }
+    return false;
+  }
+
+  AcquisitionOutput output_;
+  std::mutex mutex_;  // guards grouper_ and delivered_
+  FrameGrouper grouper_;
+  std::uint64_t delivered_ = 0;
+  double pose_tolerance_;
+  std::optional<Robot> robot_model_;
+  std::optional<RobotInput> robot_;  // live cameras only
+  bool lossless_ = false;  // replays played as fast as processed: no sweep is replaced in the mailbox
+  std::vector<std::unique_ptr<CameraLoop>> loops_;
 };
 
 }  // namespace
 
 std::unique_ptr<Acquisition> make_acquisition(const DaemonConfig& config, const dds::Participant& participant,
                                               AcquisitionOutput output) {
-  if (config.source.is_camera()) return std::make_unique<CameraAcquisition>(config, participant, output);
+  if (!config.simulated()) return std::make_unique<CameraAcquisition>(config, participant, output);
   return std::make_unique<SimAcquisition>(config, participant, output);
 }
 

@@ -1,13 +1,14 @@
 #pragma once
-// cellmapd's acquisition thread: sweeps from the configured source (the simulated cell, or one camera's posed
+// cellmapd's acquisition: sweeps from the configured sensors (the simulated cell's, or the cameras' posed
 // frames grouped into sweeps) into the processing thread's latest-wins mailbox.
 
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
-#include "cellmap/sweep/sweep.hpp"
+#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/transport/dds.hpp"
 #include "daemon_config.hpp"
 #include "health.hpp"
@@ -18,7 +19,7 @@ namespace cellmap::daemon {
 
 /// Where the acquisition thread delivers and reports; shared with the processing thread (all thread-safe).
 struct AcquisitionOutput {
-  LatestMailbox<Sweep>& mailbox;
+  LatestMailbox<FrameSweep>& mailbox;
   Health& health;
   /// The DDS inputs the source refused (scene edits, robot poses): outside the limits or not applicable.
   InputRefusals& refusals;
@@ -26,7 +27,7 @@ struct AcquisitionOutput {
   const std::atomic<std::uint64_t>& published_version;
 };
 
-/// One sweep source, driven by the acquisition thread.
+/// The cell's sensors, driven by the acquisition thread (which may start a thread per camera).
 class Acquisition {
  public:
   virtual ~Acquisition() = default;
@@ -36,9 +37,13 @@ class Acquisition {
   /// ride out (a sweep that failed, a camera that went away) are logged and reported, and it goes on.
   /// @throws std::exception on a fault it cannot ride out: the caller logs it and the daemon degrades.
   virtual void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) = 0;
-  /// For the start log line: "sim (sensor 'kinect', 17 obstacles)", "replay (camera 'wrist')".
+  /// For the start log line: "sim (sensor 'kinect', 17 obstacles)", "replay (camera 'wrist')",
+  /// "openni2 (camera 'post'), v4l2 (camera 'wrist')".
   [[nodiscard]] virtual std::string describe() const = 0;
-  /// Frames the source dropped before they made a sweep (a camera's frames without a robot pose).
+  /// The robot model the frames come with (the self filter's): the configured one, or the simulated
+  /// scene's; nullopt: frames come without the robot.
+  [[nodiscard]] virtual std::optional<Robot> robot() const = 0;
+  /// Frames dropped before they made a sweep (without a robot pose or joint sample at their stamp).
   /// Thread-safe.
   [[nodiscard]] virtual std::uint64_t dropped_frames() const { return 0; }
   /// SIGHUP: seconds between sweep starts from the next sweep on; ignored by cameras (their sweep grouping
@@ -46,9 +51,10 @@ class Acquisition {
   virtual void set_sweep_period(double /*seconds*/) {}
 };
 
-/// The source `config.source` names: the simulated cell, editable over cellmap/sim/scene_edits (edits for
-/// `config.cell` or for every cell), or a camera whose tool poses come from its recording or, live, from
-/// cellmap/robot_state. `participant` must outlive the result.
+/// The sensors `config.sources` name: the simulated cell, editable over cellmap/sim/scene_edits (edits for
+/// `config.cell` or for every cell), or cameras whose tool poses come from their recording or, live, from
+/// cellmap/robot_joints through the robot model (`robot` section) or else cellmap/robot_state.
+/// `participant` must outlive the result.
 /// @throws Error if the source cannot be set up (scene or camera settings invalid, DDS readers refused).
 [[nodiscard]] std::unique_ptr<Acquisition> make_acquisition(const DaemonConfig& config,
                                                             const dds::Participant& participant,

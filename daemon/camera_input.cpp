@@ -1,5 +1,6 @@
 #include "camera_input.hpp"
 
+#include <limits>
 #include <thread>
 
 #include "cellmap/common/error.hpp"
@@ -9,62 +10,130 @@
 namespace cellmap::daemon {
 namespace {
 
-// Live: 16 s of a 250 Hz controller, far more than a frame waits. A replay loads all its poses at once.
-std::size_t pose_capacity(const SourceConfig& config) {
-  return std::holds_alternative<ReplayConfig>(config.camera.source) ? 1'000'000 : 4096;
+// 16 s of a 250 Hz controller, far more than a frame waits.
+constexpr std::size_t kLiveSamples = 4096;
+
+transport::InputLimits skew_limits() {
+  transport::InputLimits limits;
+  limits.max_stamp_skew = kMaxPoseSkew;
+  return limits;
 }
 
 }  // namespace
 
-CameraInput::CameraInput(const SourceConfig& config, const dds::Participant& participant,
-                         const std::string& cell, transport::OnRefused on_refused)
-    : source_(make_depth_source(config.camera)),
-      poses_(config.camera.pose_tolerance, pose_capacity(config)),
-      assembler_(config.grouping, config.camera.X_ES),
-      on_refused_(std::move(on_refused)) {
-  transport::InputLimits limits;
-  limits.max_stamp_skew = kMaxPoseSkew;
-  if (!std::holds_alternative<ReplayConfig>(config.camera.source))
-    robot_.emplace(participant, cell, limits, on_refused_);
+RobotInput::RobotInput(const std::optional<Robot>& robot, double tolerance,
+                       const dds::Participant& participant, const std::string& cell,
+                       transport::OnRefused on_refused)
+    : on_refused_(std::move(on_refused)) {
+  if (robot) {
+    joints_.emplace(*robot, tolerance, kLiveSamples);
+    joint_reader_.emplace(participant, cell, robot->joint_names(), skew_limits(), on_refused_);
+  } else {
+    poses_.emplace(tolerance, kLiveSamples);
+    pose_reader_.emplace(participant, cell, skew_limits(), on_refused_);
+  }
+}
+
+void RobotInput::pump(std::chrono::milliseconds timeout) {
+  const auto refuse = [this](const char* topic, const Error& e) {
+    ++refused_;
+    if (on_refused_) on_refused_(std::string(topic) + ": " + e.what());
+  };
+  if (joint_reader_) {
+    for (const transport::RobotJoints& sample : joint_reader_->take(timeout)) {
+      try {
+        joints_->push(sample.state());
+        ++received_;
+      } catch (const Error& e) {
+        refuse(transport::kRobotJointsTopic, e);
+      }
+    }
+    return;
+  }
+  for (const transport::RobotState& state : pose_reader_->take(timeout)) {
+    try {
+      poses_->push(static_cast<double>(state.stamp_ns) * 1e-9, state.X_CE);
+      ++received_;
+    } catch (const Error& e) {
+      refuse(transport::kRobotStateTopic, e);
+    }
+  }
+}
+
+std::uint64_t RobotInput::rejected() const {
+  return refused_ + (joint_reader_ ? joint_reader_->rejected() : pose_reader_->rejected());
+}
+
+CameraInput::CameraInput(const SourceConfig& config, const RobotInput* robot)
+    : config_(config), source_(make_depth_source(config.camera)), robot_(robot) {
+  config_.grouping.validate();
+  if (std::holds_alternative<ReplayConfig>(config.camera.source)) {
+    recorded_.emplace(config.camera.pose_tolerance, 1'000'000);
+    robot_ = nullptr;
+  }
 }
 
 SourceStatus CameraInput::open() {
   const SourceStatus status = source_->open();
   if (const auto* replay = dynamic_cast<const ReplaySource*>(source_.get())) {
-    for (const StampedPose& pose : replay->poses()) poses_.push(pose);
-    poses_received_ += replay->size();
+    for (const StampedPose& pose : replay->poses()) recorded_->push(pose);
   }
   return status;
 }
 
-std::vector<Sweep> CameraInput::step(std::chrono::milliseconds timeout) {
-  if (robot_) {
-    for (const transport::RobotState& state : robot_->take()) {
-      try {
-        poses_.push(static_cast<double>(state.stamp_ns) * 1e-9, state.X_CE);
-        ++poses_received_;
-      } catch (const Error& e) {
-        ++poses_refused_;
-        if (on_refused_) on_refused_(std::string(transport::kRobotStateTopic) + ": " + e.what());
-      }
-    }
-  }
+std::vector<SweepFrame> CameraInput::step(std::chrono::milliseconds timeout) {
   const auto start = std::chrono::steady_clock::now();
   std::optional<Frame> frame = source_->next(timeout);
-  const double now = steady_seconds();
-  if (frame) assembler_.add(std::move(*frame), now);
-  std::vector<Sweep> sweeps = assembler_.poll(poses_, now);
-  const SourceState state = source_->status().state;
-  if (state != SourceState::kConnected) {
-    for (Sweep& sweep : assembler_.flush(poses_)) sweeps.push_back(std::move(sweep));
-    // Ended or failed sources return at once: wait out the timeout so the loop never spins.
-    if (!frame) std::this_thread::sleep_until(start + timeout);
+  if (frame) {
+    // Only the points and the intrinsics (for the self filter) travel on; a 640x480 image is 600 kB.
+    if (frame->depth) frame->depth->depth = {};
+    waiting_.push_back(Waiting{std::move(*frame), steady_seconds()});
   }
-  return sweeps;
+  std::vector<SweepFrame> posed;
+  const bool streaming = source_->status().state == SourceState::kConnected;
+  pose_waiting(
+      streaming ? steady_seconds() - config_.grouping.pose_wait : std::numeric_limits<double>::infinity(),
+      posed);
+  // Ended or failed sources return at once: wait out the timeout so the loop never spins.
+  if (!streaming && !frame) std::this_thread::sleep_until(start + timeout);
+  return posed;
 }
 
-std::uint64_t CameraInput::poses_rejected() const {
-  return poses_refused_ + (robot_ ? robot_->rejected() : 0);
+PoseLookup CameraInput::locate(SweepFrame& f) const {
+  const double stamp = f.frame.stamp;
+  std::optional<Eigen::Isometry3d> X_CE;
+  if (robot_ && robot_->joints()) {
+    const JointBuffer::Result r = robot_->joints()->at(stamp);
+    if (r.status != PoseLookup::kFound) return r.status;
+    f.robot = RobotAt{r.X_CL, r.state.payload};
+    X_CE = r.X_CE();
+  } else if (config_.mount == sim::Mount::kTool) {
+    const PoseBuffer* poses = recorded_ ? &*recorded_ : robot_->poses();
+    const PoseBuffer::Result r = poses->at(stamp);
+    if (r.status != PoseLookup::kFound) return r.status;
+    X_CE = r.X_CE;
+  }
+  f.frame.X_CS = config_.mount == sim::Mount::kCell ? config_.X_CS : *X_CE * config_.camera.X_ES;
+  return PoseLookup::kFound;
+}
+
+void CameraInput::pose_waiting(double give_up_before, std::vector<SweepFrame>& posed) {
+  while (!waiting_.empty()) {
+    Waiting& head = waiting_.front();
+    SweepFrame f{std::move(head.frame), std::nullopt};
+    const PoseLookup found = locate(f);
+    if (found == PoseLookup::kPending && head.arrived > give_up_before) {
+      // Frames behind the head are newer: they wait too.
+      head.frame = std::move(f.frame);
+      return;
+    }
+    if (found == PoseLookup::kFound) {
+      posed.push_back(std::move(f));
+    } else {
+      ++dropped_;
+    }
+    waiting_.pop_front();
+  }
 }
 
 }  // namespace cellmap::daemon

@@ -35,6 +35,12 @@ void log_dds_security(const dds::Participant& participant, int domain) {
   }
 }
 
+std::vector<std::string> sensor_names(const DaemonConfig& config) {
+  std::vector<std::string> names;
+  for (const SourceConfig& source : config.sources) names.push_back(source.sensor);
+  return names;
+}
+
 }  // namespace
 
 Daemon::Daemon(DaemonConfig config, RunOptions options)
@@ -46,14 +52,32 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
       keeper_(store_, [this](const Environment& env,
                              const EnvironmentDelta& delta) { publisher_.publish(env, delta); }),
-      health_(config_.cell, config_.source.sensor),
+      health_(config_.cell, sensor_names(config_)),
       refusals_([](const std::string& line) { spdlog::warn("{}", line); }) {
   log_dds_security(participant_, config_.domain);
   keeper_.resume(pipeline_);
   published_version_ = keeper_.published().version();
   acquisition_ = make_acquisition(config_, participant_, {mailbox_, health_, refusals_, published_version_});
+  use_self_filter();
   spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
                store_.directory().string(), acquisition_->describe(), keeper_.published().version());
+}
+
+void Daemon::use_self_filter() {
+  const std::optional<Robot> robot = acquisition_->robot();
+  const SelfFilterConfig& filter = config_.pipeline.self_filter;
+  if (!filter.enabled) {
+    spdlog::info("self filter off (self_filter.enabled): the robot in view is mapped as an obstacle");
+  } else if (!robot) {
+    spdlog::warn(
+        "self filter off: no robot model (a `robot` section) to cut out of the frames; cameras on the tool "
+        "are posed from cellmap/robot_state");
+  } else {
+    pipeline_.filter_robot(*robot);
+    spdlog::info("self filter on: {} links, {} shapes ({} triangles), padding scale {} + {} m",
+                 robot->link_names().size(), robot->shapes().size(),
+                 pipeline_.self_filter()->triangle_count(), filter.padding_scale, filter.padding);
+  }
 }
 
 void Daemon::run(const Signals& signals) {
@@ -63,7 +87,7 @@ void Daemon::run(const Signals& signals) {
     const std::optional<int> signal = signals.wait_for(milliseconds(200));
     if (!signal) continue;
     if (*signal == SIGHUP) {
-      const std::optional<double> period = reload_config(options_.config_file, !config_.source.is_camera());
+      const std::optional<double> period = reload_config(options_.config_file, config_.simulated());
       if (period) acquisition_->set_sweep_period(*period);
     } else {
       spdlog::info("signal {}: stopping", *signal);
@@ -85,7 +109,8 @@ void Daemon::acquire() {
   } catch (const std::exception& e) {
     // Degrade, don't die: the last environment stays published and the status says why.
     spdlog::error("sweep source stopped: {}; keeping version {}", e.what(), published_version_.load());
-    health_.set_sensor(SourceState::kError, e.what());
+    for (const SourceConfig& source : config_.sources)
+      health_.set_sensor(source.sensor, SourceState::kError, e.what());
   }
 }
 
@@ -95,7 +120,7 @@ void Daemon::process() {
   for (;;) {
     // Read before take(): a sweep put just before acquisition ended is then still taken.
     const bool acquisition_was_done = acquisition_done_;
-    std::optional<Sweep> sweep = mailbox_.take(milliseconds(100));
+    std::optional<FrameSweep> sweep = mailbox_.take(milliseconds(100));
     if (sweep) {
       handle(*sweep, ++processed);
       if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
@@ -116,15 +141,18 @@ void Daemon::process() {
   }
 }
 
-void Daemon::handle(const Sweep& sweep, std::uint64_t number) {
+void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
   try {
     const SweepReport report = pipeline_.process(sweep);
     health_.sweep_processed(number, system_now_ns());
     spdlog::info(
-        "sweep {}: {} points, {} hit / {} free voxels, {} flipped, {} change regions, {} boxes; "
-        "fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; {} sweeps dropped",
-        number, report.points, report.hit_voxels, report.free_voxels, report.flipped, report.regions,
-        report.boxes, report.t_fuse, report.t_change, report.t_segment, mailbox_.dropped());
+        "sweep {}: {} frames, {} points, {} on the robot, {} hit / {} free voxels, {} flipped, {} change "
+        "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; {} "
+        "sweeps "
+        "dropped",
+        number, report.frames, report.points, report.robot_points, report.hit_voxels, report.free_voxels,
+        report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_change,
+        report.t_segment, mailbox_.dropped());
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
     spdlog::error("sweep {}: {}; keeping version {}", number, e.what(), keeper_.published().version());

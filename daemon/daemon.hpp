@@ -42,7 +42,9 @@ class Daemon final {
  private:
   void acquire();
   void process();
-  void handle(const Sweep& sweep, std::uint64_t number);
+  void handle(const FrameSweep& sweep, std::uint64_t number);
+  // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled).
+  void use_self_filter();
   void publish_status();
 
   DaemonConfig config_;
@@ -52,7 +54,7 @@ class Daemon final {
   transport::EnvironmentPublisher publisher_;
   CellPipeline pipeline_;
   VersionKeeper keeper_;
-  LatestMailbox<Sweep> mailbox_;
+  LatestMailbox<FrameSweep> mailbox_;
   Health health_;
   InputRefusals refusals_;
   std::atomic<std::uint64_t> published_version_{0};  // for the acquisition thread's log lines

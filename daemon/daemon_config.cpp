@@ -5,6 +5,7 @@
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/config/yaml_map.hpp"
+#include "cellmap/sim/scene.hpp"
 
 namespace cellmap::daemon {
 namespace {
@@ -51,7 +52,21 @@ YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay) {
   return merged;
 }
 
-// The `source` section. Every camera kind's settings are read (so a misspelt key is found whichever kind is
+// A camera's mount: `mount` + `pose` (the one mount schema), or the older `X_ES` for a camera on the tool.
+void read_camera_mount(YamlMap& section, SourceConfig& c) {
+  if (section.has("X_ES")) {
+    if (section.has("mount") || section.has("pose"))
+      section.fail("X_ES", "is the older spelling of mount: tool with pose; give one of them");
+    c.camera.X_ES = section.pose("X_ES");
+    return;
+  }
+  const sim::SensorMount mount = sim::read_mount(section);
+  c.mount = mount.mount;
+  c.camera.X_ES = mount.X_ES;
+  c.X_CS = mount.X_CS;
+}
+
+// One source entry. Every camera kind's settings are read (so a misspelt key is found whichever kind is
 // chosen); the chosen kind's become the camera.
 SourceConfig read_source(YamlMap section, double sweep_period, const std::filesystem::path& base_dir) {
   SourceConfig c;
@@ -65,7 +80,13 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   c.noise = section.get<bool>("noise", c.noise);
 
   c.camera.name = c.sensor;
-  c.camera.X_ES = section.pose("X_ES");
+  if (c.is_camera()) {
+    read_camera_mount(section, c);
+  } else {
+    for (const char* key : {"mount", "pose", "X_ES"}) {
+      if (section.has(key)) section.fail(key, "a simulated sensor is mounted by its scene");
+    }
+  }
   c.camera.pose_tolerance = section.number("pose_tolerance", c.camera.pose_tolerance, 1e-6, 10.0);
   c.grouping.period = sweep_period;
   c.grouping.max_frames = static_cast<std::size_t>(section.integer("sweep_frames", 0, 0, 100000));
@@ -82,6 +103,48 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   }
   section.expect_all_read();
   return c;
+}
+
+// The sources as a whole: unique names, all simulated (one scene, one noise setting) or all cameras.
+void check_sources(const std::vector<SourceConfig>& sources, YamlMap& root, const std::string& key) {
+  std::set<std::string> names;
+  for (const SourceConfig& s : sources) {
+    if (!names.insert(s.sensor).second) root.fail(key, "sensor '" + s.sensor + "' is named twice");
+    if (s.is_camera() != sources.front().is_camera())
+      root.fail(key, "simulated sensors and cameras cannot be mixed in one cell");
+    if (!s.is_camera() && (s.scene != sources.front().scene || s.noise != sources.front().noise))
+      root.fail(key, "every sim source must name the same scene and noise");
+  }
+}
+
+// `sources` (each entry laid over the built-in `source` section) or the single `source` section.
+std::vector<SourceConfig> read_sources(YamlMap& root, const YamlMap& user, const YamlMap& defaults,
+                                       double sweep_period, const std::filesystem::path& base_dir) {
+  std::vector<SourceConfig> sources;
+  const YAML::Node list = root.node("sources");
+  if (!list) {
+    sources.push_back(read_source(root.child("source"), sweep_period, base_dir));
+    return sources;
+  }
+  if (user.has("source"))
+    root.fail("source", "give either source (one sensor) or sources (a list), not both");
+  (void)root.node("source");  // the built-in section: the entries' defaults
+  if (!list.IsSequence() || list.size() == 0) root.fail("sources", "must be a non-empty list of sensors");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string path = "sources[" + std::to_string(i) + "]";
+    if (!list[i].IsMap()) root.fail(path, "must be a map (kind, sensor, mount, ...)");
+    const YAML::Node entry = overlay_on(defaults.node()["source"], list[i]);
+    sources.push_back(read_source(YamlMap(entry, path, root.source()), sweep_period, base_dir));
+  }
+  check_sources(sources, root, "sources");
+  return sources;
+}
+
+// The `robot` section: none when absent or empty.
+std::optional<Robot> read_daemon_robot(YamlMap& root, const std::filesystem::path& base_dir) {
+  const YAML::Node node = root.node("robot");
+  if (!node || node.IsNull() || (node.IsMap() && node.size() == 0)) return std::nullopt;
+  return sim::read_robot(YamlMap(node, "robot", root.source()), base_dir.string());
 }
 
 }  // namespace
@@ -122,7 +185,8 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   if (levels.count(c.log_level) == 0)
     root.fail("log_level", "must be one of trace, debug, info, warn, error");
 
-  c.source = read_source(root.child("source"), c.sweep_period, base_dir);
+  c.sources = read_sources(root, user, defaults, c.sweep_period, base_dir);
+  c.robot = read_daemon_robot(root, base_dir);
   c.pipeline = CellPipelineConfig::from_yaml(root);
   c.security = read_security(root.child("security"), base_dir);
   root.expect_all_read();

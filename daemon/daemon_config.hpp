@@ -6,38 +6,48 @@
 #include <optional>
 #include <string>
 
+#include <vector>
+
 #include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/robot/robot.hpp"
 #include "cellmap/security/credentials.hpp"
 #include "cellmap/sensor/sensor_config.hpp"
+#include "cellmap/sim/scene.hpp"
 #include "cellmap/sweep/sweep_assembler.hpp"
 
 namespace cellmap::daemon {
 
-/// Where sweeps come from (`source.kind`): the simulated cell (the default: no hardware needed) or one depth
-/// camera on the robot (a replay directory, an OpenNI2 or a V4L2 device).
+/// What one sensor of the cell is (`kind` of an entry of `sources`): a sensor of the simulated cell (the
+/// default: no hardware needed) or a depth camera (a replay directory, an OpenNI2 or a V4L2 device).
 enum class SourceKind { kSim, kReplay, kOpenNI2, kV4l2 };
 /// The config's spelling: sim | replay | openni2 | v4l2.
 [[nodiscard]] const char* to_string(SourceKind kind);
 
+/// One entry of `sources` (or the single `source` section, read as a list of one). Each entry is laid over
+/// the built-in `source` section, so it names only what it changes.
 struct SourceConfig final {
-  SourceKind kind = SourceKind::kSim;  ///< `source.kind`
-  /// `source.scene` (sim): scene YAML (relative paths are relative to the config file); empty = the embedded
-  /// default cell (config/cell.yaml).
+  SourceKind kind = SourceKind::kSim;  ///< `kind`
+  /// `scene` (sim): scene YAML (relative paths are relative to the config file); empty = the embedded
+  /// default cell (config/cell.yaml). Every sim entry names the same scene.
   std::filesystem::path scene;
-  /// `source.sensor`: sim: the scene's sensor that sweeps; cameras: the name frames, logs and the status
-  /// topic give the camera.
+  /// `sensor`: sim: the scene's sensor; cameras: the name frames, logs and the status topic give the camera.
+  /// Unique among the sources.
   std::string sensor = "kinect";
-  bool noise = true;  ///< `source.noise` (sim): false = exact depths (tests)
-  /// Cameras: `source.X_ES`, `source.pose_tolerance` and the settings of the chosen kind (`source.openni2`,
-  /// `source.v4l2` or `source.replay`; a relative replay directory is relative to the config file).
+  bool noise = true;  ///< `noise` (sim, the same for every sim entry): false = exact depths (tests)
+  /// Cameras: `mount: tool | cell` with `pose` (sim::read_mount; `X_ES` is read as the old spelling of a
+  /// tool mount's pose): on the tool at camera.X_ES (posed through the robot), or fixed at X_CS. A simulated
+  /// sensor is mounted by its scene.
+  sim::Mount mount = sim::Mount::kTool;
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+  /// Cameras: `pose_tolerance` and the settings of the chosen kind (`openni2`, `v4l2` or `replay`; a relative
+  /// replay directory is relative to the config file); camera.X_ES is the tool mount's pose.
   SensorConfig camera;
-  /// Cameras: period = `sweep_period` (the frame time one sweep spans), max_frames = `source.sweep_frames`,
-  /// pose_wait = `source.pose_wait`.
+  /// Cameras: period = `sweep_period` (the frame time one sweep spans), max_frames = `sweep_frames`,
+  /// pose_wait = `pose_wait`.
   SweepGrouping grouping;
 
   [[nodiscard]] bool is_camera() const { return kind != SourceKind::kSim; }
 };
-
 /// The text of config/cellmapd.yaml, embedded at build time: the built-in defaults.
 [[nodiscard]] const char* default_config_yaml();
 
@@ -55,9 +65,19 @@ struct DaemonConfig final {
   /// `security` section (`directory`, `role`; --security, --role override): DDS Security with the credentials
   /// `cellmap security init` wrote (a relative directory is relative to the config file); nullopt = off.
   std::optional<security::Setting> security;
-  SourceConfig source;
+  /// `sources` (a list) or `source` (one sensor, the older form; not both): every sensor of the cell, all
+  /// simulated (one scene) or all cameras. Never empty.
+  std::vector<SourceConfig> sources;
+  /// `robot` section (`gantry: {...}` or `urdf: {...}`, sim::read_robot; relative paths against the config
+  /// file): the robot whose joints cellmap/robot_joints reports, posing tool-mounted cameras and the self
+  /// filter. nullopt (no section): a simulated cell uses its scene's robot; cameras on the tool are posed
+  /// from cellmap/robot_state (tool poses only).
+  std::optional<Robot> robot;
   /// The sections `occupancy`, `change`, `segment` and `reconcile`: what makes the map and the boxes.
   CellPipelineConfig pipeline;
+
+  /// True if the sources are the simulated cell's sensors.
+  [[nodiscard]] bool simulated() const { return !sources.front().is_camera(); }
 
   /// Reads a config file laid over the built-in defaults (default_config_yaml(), key by key), so every key is
   /// optional.

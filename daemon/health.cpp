@@ -1,5 +1,7 @@
 #include "health.hpp"
 
+#include "cellmap/common/error.hpp"
+
 namespace cellmap::daemon {
 
 const char* to_string(DaemonState state) {
@@ -24,13 +26,19 @@ std::string sensor_text(SourceState state, const std::string& reason) {
   return text;
 }
 
-Health::Health(std::string cell, std::string sensor_name)
-    : cell_(std::move(cell)), sensor_name_(std::move(sensor_name)) {}
+Health::Health(std::string cell, std::vector<std::string> sensor_names) : cell_(std::move(cell)) {
+  for (std::string& name : sensor_names) sensors_.push_back({std::move(name), SourceState::kClosed, {}});
+}
 
-void Health::set_sensor(SourceState state, std::string reason) {
+void Health::set_sensor(const std::string& name, SourceState state, std::string reason) {
   std::lock_guard<std::mutex> lock(mutex_);
-  sensor_state_ = state;
-  sensor_reason_ = std::move(reason);
+  for (Sensor& sensor : sensors_) {
+    if (sensor.name != name) continue;
+    sensor.state = state;
+    sensor.reason = std::move(reason);
+    return;
+  }
+  throw Error("health: no sensor '" + name + "'");
 }
 
 void Health::sweep_processed(std::uint64_t number, std::int64_t now_ns) {
@@ -63,10 +71,10 @@ std::pair<DaemonState, std::string> Health::state() const {
 std::pair<DaemonState, std::string> Health::state_locked() const {
   if (stopped_) return {DaemonState::kStopped, ""};
   if (!version_fault_.empty()) return {DaemonState::kDegraded, version_fault_};
-  const bool sensor_ok = sensor_state_ == SourceState::kClosed || sensor_state_ == SourceState::kConnected;
-  if (!sensor_ok) {
+  for (const Sensor& sensor : sensors_) {
+    if (sensor.state == SourceState::kClosed || sensor.state == SourceState::kConnected) continue;
     return {DaemonState::kDegraded,
-            "sensor '" + sensor_name_ + "': " + sensor_text(sensor_state_, sensor_reason_)};
+            "sensor '" + sensor.name + "': " + sensor_text(sensor.state, sensor.reason)};
   }
   if (!sweep_fault_.empty()) return {DaemonState::kDegraded, sweep_fault_};
   return {sweeps_ == 0 ? DaemonState::kStarting : DaemonState::kRunning, ""};
@@ -79,7 +87,8 @@ transport::CellStatus Health::status() const {
   const auto [state, reason] = state_locked();
   status.state = to_string(state);
   status.reason = reason;
-  status.sensors = {{sensor_name_, sensor_text(sensor_state_, sensor_reason_)}};
+  for (const Sensor& sensor : sensors_)
+    status.sensors.push_back({sensor.name, sensor_text(sensor.state, sensor.reason)});
   status.last_sweep_ns = last_sweep_ns_;
   status.sweeps = sweeps_;
   return status;

@@ -1,9 +1,11 @@
 #pragma once
-// cellmapd's health as cellmap/status reports it: the daemon's state and why, the sensor's state, the sweeps.
+// cellmapd's health as cellmap/status reports it: the daemon's state and why, each sensor's state, the
+// sweeps.
 
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "cellmap/sensor/depth_source.hpp"
 #include "cellmap/transport/messages.hpp"
@@ -28,13 +30,16 @@ enum class DaemonState {
 /// What both worker threads report, and the status message made from it. Thread-safe.
 ///
 /// The state is degraded, with the first of these as the reason, while a version could not be saved or
-/// published (set_version_fault), while the sensor is not streaming (nothing new reaches the map), or after
-/// a sweep failed until one succeeds; starting until the first sweep; else running; stopped after stop().
+/// published (set_version_fault), while a sensor is not streaming (nothing new of its view reaches the map;
+/// the first such sensor in the configured order is named), or after a sweep failed until one succeeds;
+/// starting until the first sweep; else running; stopped after stop().
 class Health final {
  public:
-  Health(std::string cell, std::string sensor_name);
+  /// @param sensor_names  the cell's sensors in the configured order (at least one)
+  Health(std::string cell, std::vector<std::string> sensor_names);
 
-  void set_sensor(SourceState state, std::string reason = {});
+  /// Sets the state of sensor `name` (one of the names given). @throws Error for an unknown name.
+  void set_sensor(const std::string& name, SourceState state, std::string reason = {});
   /// Sweep `number` (1 for the first) went through the pipeline at `now_ns` (ns since the Unix epoch).
   void sweep_processed(std::uint64_t number, std::int64_t now_ns);
   void sweep_failed(std::string reason);
@@ -50,11 +55,15 @@ class Health final {
  private:
   [[nodiscard]] std::pair<DaemonState, std::string> state_locked() const;
 
+  struct Sensor {
+    std::string name;
+    SourceState state = SourceState::kClosed;
+    std::string reason;
+  };
+
   const std::string cell_;
-  const std::string sensor_name_;
   mutable std::mutex mutex_;
-  SourceState sensor_state_ = SourceState::kClosed;
-  std::string sensor_reason_;
+  std::vector<Sensor> sensors_;
   std::string sweep_fault_;
   std::string version_fault_;
   std::int64_t last_sweep_ns_ = 0;

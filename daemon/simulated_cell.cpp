@@ -10,27 +10,86 @@ sim::Scene load(const SourceConfig& config) {
   return config.scene.empty() ? sim::default_scene() : sim::load_scene(config.scene.string());
 }
 
-}  // namespace
-
-SimulatedCell::SimulatedCell(const SourceConfig& config)
-    : simulator_(load(config), sim::SimOptions{config.noise, 2}) {
-  sensor_ = simulator_.scene().find_sensor(config.sensor);
-  if (sensor_ < 0) {
-    throw Error((config.scene.empty() ? std::string("default scene") : config.scene.string()) +
-                ": no sensor '" + config.sensor + "' (source.sensor)");
-  }
-  sensor_name_ = config.sensor;
+std::string scene_name(const SourceConfig& config) {
+  return config.scene.empty() ? std::string("default scene") : config.scene.string();
 }
 
-Sweep SimulatedCell::next_sweep(double start_stamp) {
-  std::vector<Frame> frames;
-  for (sim::SimFrame& f : simulator_.sweep(sensor_, sweep_index_++, start_stamp))
-    frames.push_back(std::move(f.frame));
-  return merge_frames(frames);
+// The daemon's model must drive the scene's robot joint by joint.
+Robot model_for(const sim::Scene& scene, const std::optional<Robot>& robot, const std::string& name) {
+  if (!robot) return scene.robot;
+  if (robot->joint_names() != scene.robot.joint_names())
+    throw Error("robot: its joints are not those of the robot in " + name);
+  return *robot;
+}
+
+// Joint samples of a 250 Hz controller over a minute, far more than one sweep window needs.
+constexpr std::size_t kSimSamples = 16384;
+
+}  // namespace
+
+SimulatedCell::SimulatedCell(const std::vector<SourceConfig>& sources, const std::optional<Robot>& robot)
+    : simulator_(load(sources.front()), sim::SimOptions{sources.front().noise, 2}),
+      joints_(model_for(simulator_.scene(), robot, scene_name(sources.front())),
+              sources.front().camera.pose_tolerance, kSimSamples) {
+  for (const SourceConfig& source : sources) {
+    const int sensor = simulator_.scene().find_sensor(source.sensor);
+    if (sensor < 0) throw Error(scene_name(source) + ": no sensor '" + source.sensor + "' (source.sensor)");
+    sensors_.push_back(sensor);
+  }
+}
+
+FrameSweep SimulatedCell::next_sweep(double start, double duration) {
+  ++sweep_index_;
+  return simulator_.scene().motion ? moving_sweep(start, duration) : stop_sweep(start);
+}
+
+FrameSweep SimulatedCell::moving_sweep(double start, double duration) {
+  sim::SimWindow window = simulator_.window(start, start + duration, sensors_);
+  for (const JointState& sample : window.joints) joints_.push(sample);
+  FrameSweep sweep;
+  for (sim::SimFrame& f : window.frames) {
+    const JointBuffer::Result robot = joints_.at(f.frame.stamp);
+    if (robot.status != PoseLookup::kFound) {
+      ++dropped_;
+      continue;
+    }
+    const sim::SensorSpec& spec =
+        simulator_.scene().sensors[static_cast<std::size_t>(simulator_.scene().find_sensor(f.frame.sensor))];
+    if (spec.mount == sim::Mount::kTool) f.frame.X_CS = robot.X_CE() * spec.X_ES;
+    sweep.stamp = f.frame.stamp;
+    sweep.frames.push_back({std::move(f.frame), RobotAt{robot.X_CL, robot.state.payload}});
+  }
+  return sweep;
+}
+
+FrameSweep SimulatedCell::stop_sweep(double start) {
+  FrameSweep sweep;
+  for (const int sensor : sensors_) {
+    for (sim::SimFrame& f : simulator_.sweep(sensor, sweep_index_ - 1, start)) {
+      RobotAt robot{joints_.robot().link_poses(f.q), std::nullopt};
+      sweep.stamp = std::max(sweep.stamp, f.frame.stamp);
+      sweep.frames.push_back({std::move(f.frame), std::move(robot)});
+    }
+  }
+  return sweep;
 }
 
 std::string SimulatedCell::apply(const transport::SceneEdit& edit) {
   return simulator_.apply(edit);
+}
+
+std::string SimulatedCell::sensor_names() const {
+  std::string names;
+  for (const int sensor : sensors_) {
+    if (!names.empty()) names += ", ";
+    names += simulator_.scene().sensors[static_cast<std::size_t>(sensor)].name;
+  }
+  return names;
+}
+
+double SimulatedCell::pass_duration() const {
+  const sim::SweepPlan& plan = simulator_.scene().sweep;
+  return plan.period * static_cast<double>(std::max<std::size_t>(plan.stops.size(), 1));
 }
 
 }  // namespace cellmap::daemon

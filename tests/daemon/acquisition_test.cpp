@@ -19,11 +19,11 @@ constexpr int kSimDomain = 187;
 
 // Points of `sweep` inside the axis-aligned box at `centre` with `half_extents` grown by 5 mm, leaving out
 // the 5 cm above the table it stands on.
-std::size_t points_above_table(const Sweep& sweep, const Eigen::Vector3d& centre,
+std::size_t points_above_table(const FrameSweep& sweep, const Eigen::Vector3d& centre,
                                const Eigen::Vector3d& half_extents) {
   std::size_t inside = 0;
-  for (const Scan& scan : sweep.scans) {
-    for (const pcl::PointXYZ& p : scan.points_C) {
+  for (const SweepFrame& frame : sweep.frames) {
+    for (const pcl::PointXYZ& p : to_scan(frame.frame).points_C) {
       const Eigen::Vector3d d = p.getVector3fMap().cast<double>() - centre;
       const bool above_table = d.z() > 0.05 - half_extents.z();
       if (above_table && (d.cwiseAbs().array() <= half_extents.array() + 0.005).all()) ++inside;
@@ -48,8 +48,8 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   DaemonConfig config =
       DaemonConfig::parse("cell: bench-7\nsweep_period: 0\nsource: {noise: false}\n", "test.yaml", ".");
   const dds::Participant participant(kSimDomain);
-  LatestMailbox<Sweep> mailbox;
-  Health health(config.cell, config.source.sensor);
+  LatestMailbox<FrameSweep> mailbox;
+  Health health(config.cell, {config.sources[0].sensor});
   std::vector<std::string> refusal_lines;
   InputRefusals refusals([&](const std::string& line) { refusal_lines.push_back(line); });
   const std::atomic<std::uint64_t> version{0};
@@ -68,7 +68,7 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
 
   const std::atomic<bool> stop{false};
   acquisition->run(stop, 2);  // returns after two sweeps
-  const std::optional<Sweep> sweep = mailbox.take(0ms);
+  const std::optional<FrameSweep> sweep = mailbox.take(0ms);
   ASSERT_TRUE(sweep.has_value());
   EXPECT_EQ(mailbox.dropped(), 1u);  // the first was replaced: nobody took it
   EXPECT_GT(points_above_table(*sweep, mine, half), 100u) << "the edit for this cell was not applied";

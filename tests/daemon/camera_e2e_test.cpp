@@ -14,6 +14,7 @@
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
+#include "cellmap/transport/robot_joints.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "cellmap/transport/status_reader.hpp"
 #include "daemon/service_e2e.hpp"
@@ -27,6 +28,12 @@ using namespace std::chrono_literals;
 constexpr int kReplayDomain = 182;
 constexpr int kNoDeviceDomain = 183;
 constexpr int kRobotPoseDomain = 184;
+constexpr int kUnpluggedDomain = 162;
+constexpr int kJointsDomain = 163;
+
+// Debian's OpenNI2 Dummy device at 320x240 (see below).
+const char* kDummy =
+    "{uri: Dummy, width: 320, height: 240, intrinsics: {fx: 285, fy: 285, cx: 159.5, cy: 119.5}}";
 
 // The tool 1.5 m above the floor at (1, 2), the camera looking along the cell's +x: camera x (right) = cell
 // -y, camera y (down) = cell -z, camera z (forward) = cell +x.
@@ -200,6 +207,84 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
   ASSERT_TRUE(posed.has_value()) << "no sweep was fused with poses from cellmap/robot_state";
   EXPECT_EQ(posed->state, "running");
   EXPECT_EQ(posed->sensors[0].state, "streaming");
+
+  daemon->signal(SIGTERM);
+  const int status = daemon->wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
+}
+
+// Two cameras, one of them unplugged: the cell is degraded and names it, the other keeps mapping.
+TEST_F(CameraE2eTest, OneOfTwoCamerasUnpluggedDegradesTheCellAndTheOtherKeepsTheMapCurrent) {
+  const std::string yaml =
+      std::string(
+          "cell: two-cameras\nsweep_period: 0.5\nstatus_period: 0.2\n"
+          "change: {settle_sweeps: 2}\nsources:\n"
+          "  - {kind: openni2, sensor: post, mount: cell, pose: {position: [1, 2, 1.5]}, "
+          "openni2: ") +
+      kDummy +
+      "}\n"
+      "  - {kind: v4l2, sensor: wrist, v4l2: {device: /dev/cellmap-unplugged, "
+      "reconnect: {initial_backoff: 0.2, max_backoff: 0.5}}}\n";
+  const dds::Participant participant(kUnpluggedDomain);
+  transport::StatusReader reader(participant);
+  transport::EnvironmentSubscriber planner(participant, "two-cameras");
+  auto daemon = start_daemon(yaml, kUnpluggedDomain);
+
+  const auto degraded = test::wait_for_status(reader, "two-cameras", [](const transport::CellStatus& s) {
+    return s.state == "degraded" && s.sweeps >= 4;
+  });
+  ASSERT_TRUE(degraded.has_value()) << "no degraded status with sweeps from the camera still streaming";
+  EXPECT_EQ(degraded->reason.rfind("sensor 'wrist': disconnected", 0), 0u) << degraded->reason;
+  ASSERT_EQ(degraded->sensors.size(), 2u);
+  EXPECT_EQ(degraded->sensors[0].name, "post");
+  EXPECT_EQ(degraded->sensors[0].state, "streaming");
+  EXPECT_EQ(degraded->sensors[1].name, "wrist");
+  EXPECT_EQ(degraded->sensors[1].state.rfind("disconnected", 0), 0u) << degraded->sensors[1].state;
+  EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the streaming camera's map was not published";
+
+  daemon->signal(SIGTERM);
+  const int status = daemon->wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
+}
+
+// A camera on the gantry's tool posed from cellmap/robot_joints through the daemon's robot model.
+TEST_F(CameraE2eTest, FramesArePosedFromJointSamplesThroughTheRobotModel) {
+  const std::string yaml = std::string(
+                               "cell: joints-cell\nsweep_period: 0.5\nstatus_period: 0.2\n"
+                               "robot: {gantry: {lower: [0, 0, 0], upper: [3, 2, 1]}}\n"
+                               "source: {kind: openni2, sensor: wrist, openni2: ") +
+                           kDummy + "}\n";
+  const dds::Participant participant(kJointsDomain);
+  transport::StatusReader reader(participant);
+  auto daemon = start_daemon(yaml, kJointsDomain);
+  const auto unposed = test::wait_for_status(
+      reader, "joints-cell", [](const transport::CellStatus& s) { return s.dropped_frames >= 10; });
+  ASSERT_TRUE(unposed.has_value()) << "frames without joint samples were not counted as dropped";
+  EXPECT_EQ(unposed->sweeps, 0u) << "a frame without joint samples was fused";
+
+  // The controller at 100 Hz, the gantry at rest mid-cell, stamped on the frames' clock.
+  transport::RobotJointsWriter writer(participant);
+  std::atomic<bool> stop{false};
+  std::thread controller([&] {
+    transport::RobotJoints joints;
+    joints.cell = "joints-cell";
+    joints.names = {"x", "y", "z"};
+    joints.positions = {1.5, 1.0, 0.8};
+    while (!stop) {
+      joints.stamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+      writer.write(joints);
+      std::this_thread::sleep_for(10ms);
+    }
+  });
+  const auto posed = test::wait_for_status(reader, "joints-cell",
+                                           [](const transport::CellStatus& s) { return s.sweeps >= 3; });
+  stop = true;
+  controller.join();
+  ASSERT_TRUE(posed.has_value()) << "no sweep was fused with poses from cellmap/robot_joints";
+  EXPECT_EQ(posed->state, "running");
+  EXPECT_EQ(posed->refused_inputs, 0u);
 
   daemon->signal(SIGTERM);
   const int status = daemon->wait();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/sensor/v4l2_source.hpp"
 
 namespace cellmap::daemon {
 namespace {
@@ -19,8 +20,8 @@ std::string error_of(const std::string& yaml) {
 TEST(DaemonConfigTest, BuiltInDefaultsAreTheShippedFile) {
   const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
   EXPECT_EQ(c.cell, "cell-1");
-  EXPECT_EQ(c.source.kind, SourceKind::kSim);
-  EXPECT_TRUE(c.source.scene.empty());
+  EXPECT_EQ(c.sources[0].kind, SourceKind::kSim);
+  EXPECT_TRUE(c.sources[0].scene.empty());
   EXPECT_DOUBLE_EQ(c.pipeline.occupancy.resolution, 0.02);
   EXPECT_EQ(c.pipeline.change.persist_sweeps, 3);
   // The voxel-tuned segmentation of config/cellmapd.yaml, not the batch defaults of config/segment.yaml.
@@ -33,8 +34,8 @@ TEST(DaemonConfigTest, FileOverlaysDefaultsKeyByKey) {
       "cell: press-3\nsource: {scene: scenes/small.yaml}\nsegment: {region_growing: {gap: 0.05}}\n",
       "my.yaml", "/etc/cellmap");
   EXPECT_EQ(c.cell, "press-3");
-  EXPECT_EQ(c.source.scene, std::filesystem::path("/etc/cellmap/scenes/small.yaml"));
-  EXPECT_EQ(c.source.sensor, "kinect");  // untouched sibling key keeps its default
+  EXPECT_EQ(c.sources[0].scene, std::filesystem::path("/etc/cellmap/scenes/small.yaml"));
+  EXPECT_EQ(c.sources[0].sensor, "kinect");  // untouched sibling key keeps its default
   EXPECT_DOUBLE_EQ(c.pipeline.segment.region_growing.gap, 0.05);
   EXPECT_EQ(c.pipeline.segment.k, 26);
 }
@@ -53,7 +54,7 @@ TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {
 
 TEST(DaemonConfigTest, SimIsTheDefaultAndCameraSettingsAreStillChecked) {
   const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
-  EXPECT_FALSE(c.source.is_camera());
+  EXPECT_FALSE(c.sources[0].is_camera());
   // A misspelt key in a section the chosen kind does not use is still an error.
   EXPECT_EQ(error_of("source: {v4l2: {devise: /dev/video2}}\n"), "my.yaml: source.v4l2.devise: unknown key");
   EXPECT_EQ(error_of("source: {openni2: {format: RGB_888}}\n"),
@@ -73,15 +74,16 @@ source:
   replay: {directory: recordings/field, playback: fastest}
 )",
                                              "my.yaml", "/etc/cellmap");
-  EXPECT_TRUE(c.source.is_camera());
-  EXPECT_EQ(c.source.camera.name, "wrist");
-  EXPECT_DOUBLE_EQ(c.source.camera.pose_tolerance, 0.02);
-  EXPECT_TRUE(c.source.camera.X_ES.translation().isApprox(Eigen::Vector3d(0, 0.05, 0.1)));
-  EXPECT_TRUE((c.source.camera.X_ES.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
-  EXPECT_DOUBLE_EQ(c.source.grouping.period, 2.0);
-  EXPECT_EQ(c.source.grouping.max_frames, 3u);
-  EXPECT_DOUBLE_EQ(c.source.grouping.pose_wait, 1.5);
-  const auto& replay = std::get<ReplayConfig>(c.source.camera.source);
+  EXPECT_TRUE(c.sources[0].is_camera());
+  EXPECT_EQ(c.sources[0].camera.name, "wrist");
+  EXPECT_DOUBLE_EQ(c.sources[0].camera.pose_tolerance, 0.02);
+  EXPECT_TRUE(c.sources[0].camera.X_ES.translation().isApprox(Eigen::Vector3d(0, 0.05, 0.1)));
+  EXPECT_TRUE(
+      (c.sources[0].camera.X_ES.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_DOUBLE_EQ(c.sources[0].grouping.period, 2.0);
+  EXPECT_EQ(c.sources[0].grouping.max_frames, 3u);
+  EXPECT_DOUBLE_EQ(c.sources[0].grouping.pose_wait, 1.5);
+  const auto& replay = std::get<ReplayConfig>(c.sources[0].camera.source);
   EXPECT_EQ(replay.directory, "/etc/cellmap/recordings/field");
   EXPECT_EQ(replay.playback, ReplayConfig::Playback::kFastest);
   EXPECT_EQ(replay.name, "wrist");
@@ -92,14 +94,14 @@ source:
 TEST(DaemonConfigTest, LiveCamerasTakeTheirSectionsWithDocumentedDefaults) {
   const DaemonConfig openni2 =
       DaemonConfig::parse("source: {kind: openni2, openni2: {uri: /data/a.oni}}\n", "my.yaml", ".");
-  const auto& o = std::get<OpenNI2Config>(openni2.source.camera.source);
+  const auto& o = std::get<OpenNI2Config>(openni2.sources[0].camera.source);
   EXPECT_EQ(o.uri, "/data/a.oni");
   EXPECT_EQ(o.mode.to_string(), "640x480@30 DEPTH_1_MM");
   EXPECT_DOUBLE_EQ(o.reconnect.frame_timeout, 2.0);
   EXPECT_DOUBLE_EQ(o.reconnect.max_backoff, 10.0);
 
   const DaemonConfig v4l2 = DaemonConfig::parse("source: {kind: v4l2}\n", "my.yaml", ".");
-  const auto& v = std::get<V4l2Config>(v4l2.source.camera.source);
+  const auto& v = std::get<V4l2Config>(v4l2.sources[0].camera.source);
   EXPECT_EQ(v.device, "/dev/video0");
   EXPECT_EQ(v.mode.to_string(), "848x480@30 Z16");
   ASSERT_TRUE(v.intrinsics.has_value());
@@ -121,6 +123,67 @@ TEST(DaemonConfigTest, SecurityIsOffByDefaultAndItsDirectoryIsRelativeToTheFile)
   EXPECT_EQ(error_of("security: {directory: k, role: admin}\n"),
             "my.yaml: security.role: must be one of daemon, planner, robot, tool");
   EXPECT_EQ(error_of("security: {dir: k}\n"), "my.yaml: security.dir: unknown key");
+}
+
+TEST(DaemonConfigTest, SourcesListCamerasOnTheToolAndFixedEachOverTheSourceDefaults) {
+  const DaemonConfig c = DaemonConfig::parse(R"(
+sweep_period: 0.25
+sources:
+  - {kind: openni2, sensor: post, mount: cell, pose: {position: [3.3, 2.3, 2.3]}}
+  - {kind: v4l2, sensor: wrist, mount: tool, pose: {position: [0.08, 0, 0.02]}, pose_tolerance: 0.02}
+  - {kind: v4l2, sensor: side, X_ES: {position: [0, 0.1, 0]}, v4l2: {device: /dev/video4}}
+)",
+                                             "my.yaml", "/etc/cellmap");
+  ASSERT_EQ(c.sources.size(), 3u);
+  EXPECT_FALSE(c.simulated());
+  EXPECT_EQ(c.sources[0].sensor, "post");
+  EXPECT_EQ(c.sources[0].mount, sim::Mount::kCell);
+  EXPECT_TRUE(c.sources[0].X_CS.translation().isApprox(Eigen::Vector3d(3.3, 2.3, 2.3)));
+  EXPECT_EQ(c.sources[1].mount, sim::Mount::kTool);
+  EXPECT_TRUE(c.sources[1].camera.X_ES.translation().isApprox(Eigen::Vector3d(0.08, 0, 0.02)));
+  EXPECT_DOUBLE_EQ(c.sources[1].camera.pose_tolerance, 0.02);
+  EXPECT_DOUBLE_EQ(c.sources[0].camera.pose_tolerance, 0.05);  // the built-in default
+  EXPECT_DOUBLE_EQ(c.sources[2].grouping.period, 0.25);
+  EXPECT_EQ(c.sources[2].mount, sim::Mount::kTool);  // X_ES: the older spelling of a tool mount
+  EXPECT_TRUE(c.sources[2].camera.X_ES.translation().isApprox(Eigen::Vector3d(0, 0.1, 0)));
+  EXPECT_EQ(std::get<V4l2Config>(c.sources[2].camera.source).device, "/dev/video4");
+  EXPECT_FALSE(c.robot.has_value());
+}
+
+TEST(DaemonConfigTest, SourcesErrorsNameTheEntryAndKey) {
+  EXPECT_EQ(error_of("source: {noise: false}\nsources: [{sensor: a}]\n"),
+            "my.yaml: source: give either source (one sensor) or sources (a list), not both");
+  EXPECT_EQ(error_of("sources: []\n"), "my.yaml: sources: must be a non-empty list of sensors");
+  EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a, v4l2: {devise: x}}]\n"),
+            "my.yaml: sources[0].v4l2.devise: unknown key");
+  EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a}, {kind: openni2, sensor: a}]\n"),
+            "my.yaml: sources: sensor 'a' is named twice");
+  EXPECT_EQ(error_of("sources: [{sensor: post}, {kind: v4l2, sensor: wrist}]\n"),
+            "my.yaml: sources: simulated sensors and cameras cannot be mixed in one cell");
+  EXPECT_EQ(error_of("sources: [{sensor: post, mount: cell, pose: {}}]\n"),
+            "my.yaml: sources[0].mount: a simulated sensor is mounted by its scene");
+  EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a, mount: shelf}]\n"),
+            "my.yaml: sources[0].mount: must be tool, cell or a pose, got 'shelf'");
+  EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a, mount: tool, pose: {}, X_ES: {}}]\n"),
+            "my.yaml: sources[0].X_ES: is the older spelling of mount: tool with pose; give one of them");
+}
+
+TEST(DaemonConfigTest, RobotSectionIsTheGantryOrAUrdf) {
+  const DaemonConfig gantry = DaemonConfig::parse("robot: {gantry: {lower: [0, 0, 0], upper: [3, 2, 1]}}\n",
+                                                  "my.yaml", "/etc/cellmap");
+  ASSERT_TRUE(gantry.robot.has_value());
+  EXPECT_EQ(gantry.robot->dof(), 3);
+  EXPECT_FALSE(gantry.robot->shapes().empty());  // the bridge, carriage and ram
+  const DaemonConfig arm = DaemonConfig::parse(
+      "robot: {urdf: {file: robots/cellmap_arm/urdf/cellmap_arm.urdf, tool_link: tool0}}\n", "my.yaml",
+      CELLMAP_SOURCE_DIR "/config");
+  ASSERT_TRUE(arm.robot.has_value());
+  EXPECT_EQ(arm.robot->dof(), 6);
+  EXPECT_GT(arm.robot->triangle_count(), 100u);
+  EXPECT_EQ(error_of("robot: {scara: {}}\n"),
+            "my.yaml: robot.gantry: exactly one of gantry, urdf is required");
+  EXPECT_EQ(error_of("self_filter: {padding: 2}\n").rfind("my.yaml: self_filter.padding:", 0), 0u)
+      << error_of("self_filter: {padding: 2}\n");
 }
 
 }  // namespace

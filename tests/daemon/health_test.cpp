@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include "cellmap/common/error.hpp"
+
 namespace cellmap::daemon {
 namespace {
 
 TEST(HealthTest, StartingUntilTheFirstSweepThenRunning) {
-  Health health("press-3", "wrist");
+  Health health("press-3", {"wrist"});
   EXPECT_EQ(health.state(), std::make_pair(DaemonState::kStarting, std::string()));
   transport::CellStatus status = health.status();
   EXPECT_EQ(status.cell, "press-3");
@@ -17,7 +19,7 @@ TEST(HealthTest, StartingUntilTheFirstSweepThenRunning) {
   EXPECT_EQ(status.sensors[0].state, "starting");
   EXPECT_EQ(status.sweeps, 0u);
 
-  health.set_sensor(SourceState::kConnected);
+  health.set_sensor("wrist", SourceState::kConnected);
   health.sweep_processed(1, 1234);
   status = health.status();
   EXPECT_EQ(status.state, "running");
@@ -28,8 +30,8 @@ TEST(HealthTest, StartingUntilTheFirstSweepThenRunning) {
 }
 
 TEST(HealthTest, DegradedWithTheReasonThatMattersMost) {
-  Health health("press-3", "wrist");
-  health.set_sensor(SourceState::kConnected);
+  Health health("press-3", {"wrist"});
+  health.set_sensor("wrist", SourceState::kConnected);
   health.sweep_processed(1, 1);
 
   health.sweep_failed("sweep 2: too many points");
@@ -37,7 +39,7 @@ TEST(HealthTest, DegradedWithTheReasonThatMattersMost) {
   health.sweep_processed(3, 3);  // a sweep that went through ends it
   EXPECT_EQ(health.state().first, DaemonState::kRunning);
 
-  health.set_sensor(SourceState::kDisconnected, "openni2: no devices found");
+  health.set_sensor("wrist", SourceState::kDisconnected, "openni2: no devices found");
   EXPECT_EQ(health.state(),
             std::make_pair(DaemonState::kDegraded,
                            std::string("sensor 'wrist': disconnected: openni2: no devices found")));
@@ -48,11 +50,31 @@ TEST(HealthTest, DegradedWithTheReasonThatMattersMost) {
   EXPECT_EQ(health.status().state, "degraded");
   EXPECT_EQ(health.status().reason, "version 7 not saved: state/x: write failed: No space left on device");
   health.set_version_fault("");
-  health.set_sensor(SourceState::kConnected);
+  health.set_sensor("wrist", SourceState::kConnected);
   EXPECT_EQ(health.status().state, "running");
 
   health.stop();
   EXPECT_EQ(health.status().state, "stopped");
+}
+
+TEST(HealthTest, OneSensorDownDegradesTheCellAndEverySensorIsReported) {
+  Health health("arm-cell", {"post", "wrist"});
+  health.set_sensor("post", SourceState::kConnected);
+  health.set_sensor("wrist", SourceState::kConnected);
+  health.sweep_processed(1, 1);
+  EXPECT_EQ(health.state().first, DaemonState::kRunning);
+
+  health.set_sensor("wrist", SourceState::kDisconnected, "v4l2: /dev/video2: No such device");
+  EXPECT_EQ(health.state(),
+            std::make_pair(DaemonState::kDegraded,
+                           std::string("sensor 'wrist': disconnected: v4l2: /dev/video2: No such device")));
+  const transport::CellStatus status = health.status();
+  ASSERT_EQ(status.sensors.size(), 2u);
+  EXPECT_EQ(status.sensors[0].name, "post");
+  EXPECT_EQ(status.sensors[0].state, "streaming");
+  EXPECT_EQ(status.sensors[1].name, "wrist");
+  EXPECT_EQ(status.sensors[1].state, "disconnected: v4l2: /dev/video2: No such device");
+  EXPECT_THROW(health.set_sensor("kinect", SourceState::kConnected), Error);
 }
 
 TEST(HealthTest, NamesMatchTheStatusContract) {

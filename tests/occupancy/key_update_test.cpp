@@ -81,6 +81,84 @@ TEST(KeyUpdateTest, EqualsOctomapsDiscreteUpdateForOneScan) {
   }
 }
 
+// A scan whose points right of x = 0.2 m (cell frame) become clear-only rays ending 0.3 m short of the point,
+// as the self filter turns measurements of the robot into rays that stop at its near surface; a few clear
+// ends share a voxel with a kept point.
+Scan with_clear_rays(Scan scan) {
+  Cloud kept;
+  for (const pcl::PointXYZ& p : scan.points_C) {
+    if (p.x <= 0.2f) {
+      kept.push_back(p);
+      continue;
+    }
+    const Eigen::Vector3d p_C(p.x, p.y, p.z);
+    const Eigen::Vector3d end_C = p_C - 0.3 * (p_C - scan.origin_C).normalized();
+    scan.clear_C.push_back(pcl::PointXYZ(float(end_C.x()), float(end_C.y()), float(end_C.z())));
+  }
+  for (std::size_t i = 0; i < kept.size(); i += 97) scan.clear_C.push_back(kept[i]);
+  scan.points_C = kept;
+  return scan;
+}
+
+// OctoMap's own keys for one scan with clear-only rays: computeDiscreteUpdate for the points, and for every
+// distinct clear-ray end voxel that holds no point computeRayKeys from the origin to its centre (cut at
+// max_range as OctoMap cuts a point's ray); occupied wins.
+std::pair<octomap::KeySet, octomap::KeySet> octomap_update_with_clear_rays(const Scan& scan,
+                                                                           octomap::OcTree& tree,
+                                                                           double max_range) {
+  octomap::KeySet free, occupied;
+  tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), free, occupied, max_range);
+  octomap::KeySet point_voxels;
+  for (const auto& p : scan.points_C) point_voxels.insert(tree.coordToKey(p.x, p.y, p.z));
+  octomap::KeySet clear_voxels;
+  for (const auto& p : scan.clear_C) clear_voxels.insert(tree.coordToKey(p.x, p.y, p.z));
+  const octomap::point3d origin = origin_of(scan);
+  for (const octomap::OcTreeKey& k : clear_voxels) {
+    if (point_voxels.count(k) != 0) continue;
+    octomap::point3d end = tree.keyToCoord(k);
+    if ((end - origin).norm() > max_range) end = origin + (end - origin).normalized() * float(max_range);
+    octomap::KeyRay ray;
+    if (tree.computeRayKeys(origin, end, ray)) free.insert(ray.begin(), ray.end());
+  }
+  for (const octomap::OcTreeKey& k : occupied) free.erase(k);
+  return {free, occupied};
+}
+
+TEST(KeyUpdateTest, ClearOnlyRaysEqualOctomapsRayKeys) {
+  octomap::OcTree tree(0.04);
+  for (const double max_range : {5.0, 2.5}) {
+    Sweep sweep;
+    sweep.scans.push_back(with_clear_rays(one_scan(tilted_pose()).scans[0]));
+    ASSERT_GT(sweep.scans[0].clear_C.size(), 1000u);
+    const auto [free, occupied] = octomap_update_with_clear_rays(sweep.scans[0], tree, max_range);
+    const KeyUpdate ours = compute_key_update(sweep, tree, max_range, 2);
+    EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
+    EXPECT_EQ(ours.free_keys(), sorted(free));
+    // The clear-only rays cleared voxels the points alone did not, and marked none occupied.
+    const Sweep points_only = one_scan(tilted_pose());
+    Sweep kept_only = sweep;
+    kept_only.scans[0].clear_C.clear();
+    EXPECT_GT(ours.free_count, compute_key_update(kept_only, tree, max_range, 2).free_count);
+    EXPECT_LE(ours.occupied_count, compute_key_update(points_only, tree, max_range, 2).occupied_count);
+  }
+}
+
+// A clear-only ray ends in a voxel that is neither hit nor cleared, and a ray whose end is in the origin's
+// voxel clears nothing.
+TEST(KeyUpdateTest, ClearOnlyRayStopsBeforeItsEndVoxel) {
+  octomap::OcTree tree(0.1);
+  Sweep sweep;
+  sweep.scans.emplace_back();
+  sweep.scans[0].clear_C.push_back(pcl::PointXYZ(1.05f, 0.05f, 0.05f));
+  sweep.scans[0].clear_C.push_back(pcl::PointXYZ(0.02f, 0.03f, 0.04f));
+  const KeyUpdate update = compute_key_update(sweep, tree, 5.0, 2);
+  EXPECT_EQ(update.occupied_count, 0u);
+  EXPECT_EQ(update.free_count, 10u);  // x in [0, 1.0): the origin voxel and the 9 after it
+  const Keys free = update.free_keys();
+  EXPECT_EQ(std::count(free.begin(), free.end(), tree.coordToKey(1.05, 0.05, 0.05)), 0);
+  EXPECT_EQ(std::count(free.begin(), free.end(), tree.coordToKey(0.95, 0.05, 0.05)), 1);
+}
+
 TEST(KeyUpdateTest, ResultDoesNotDependOnThreads) {
   octomap::OcTree tree(0.05);
   const Sweep sweep = one_scan(tilted_pose());

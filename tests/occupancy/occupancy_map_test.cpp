@@ -61,6 +61,74 @@ TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
   EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
 }
 
+// Clear-only rays through the map: the same tree as OctoMap's updateNode fed with computeRayKeys free keys.
+TEST(OccupancyMapTest, ClearOnlyRaysMatchOctomapsUpdateNode) {
+  OccupancyConfig config;
+  config.resolution = 0.05;
+  OccupancyMap map(config);
+  octomap::OcTree reference(config.resolution);
+  apply_sensor_model(config, reference);
+  std::vector<octomap::OcTreeKey> box_b;  // box B's voxels occupied after the first sweep
+  for (int sweep = 0; sweep < 3; ++sweep) {
+    if (sweep == 1) {
+      for (const octomap::OcTreeKey& k : map.occupied_keys()) {
+        const Eigen::Vector3d c = map.centre(k);
+        if (c.x() > 0.3 && c.x() < 0.7 && c.z() > 2.35 && c.z() < 2.85 && c.y() > 0.65 && c.y() < 0.99) {
+          box_b.push_back(k);
+        }
+      }
+    }
+    Scan scan = testing::render_scan(testing::box_room(), camera_at({0.011 * sweep, -0.2, 0.02}, -0.25),
+                                     testing::kinect_intrinsics(96, 72));
+    if (sweep > 0) {  // later sweeps: points on box B become clear-only rays ending 0.2 m before them
+      Cloud kept;
+      for (const auto& p : scan.points_C) {
+        const Eigen::Vector3d p_C(p.x, p.y, p.z);
+        if (p.x > 0.3f && p.x < 0.7f && p.z > 2.35f && p.z < 2.85f && p.y > 0.65f && p.y < 0.99f) {
+          const Eigen::Vector3d end_C = p_C - 0.2 * (p_C - scan.origin_C).normalized();
+          scan.clear_C.push_back(pcl::PointXYZ(float(end_C.x()), float(end_C.y()), float(end_C.z())));
+        } else {
+          kept.push_back(p);
+        }
+      }
+      scan.points_C = kept;
+    }
+    ASSERT_EQ(scan.clear_C.empty(), sweep == 0);
+    Sweep one;
+    one.scans.push_back(scan);
+    map.integrate(one);
+    // The reference: each distinct voxel once per sweep, occupied winning (OctoMap's discrete update).
+    const octomap::point3d origin(float(scan.origin_C.x()), float(scan.origin_C.y()),
+                                  float(scan.origin_C.z()));
+    octomap::KeySet free, occupied, hit_voxels, clear_voxels;
+    reference.computeDiscreteUpdate(to_octomap(scan), origin, free, occupied, config.max_range);
+    for (const auto& p : scan.points_C) hit_voxels.insert(reference.coordToKey(p.x, p.y, p.z));
+    for (const auto& p : scan.clear_C) clear_voxels.insert(reference.coordToKey(p.x, p.y, p.z));
+    for (const octomap::OcTreeKey& k : clear_voxels) {
+      octomap::KeyRay ray;
+      if (hit_voxels.count(k) == 0 && reference.computeRayKeys(origin, reference.keyToCoord(k), ray)) {
+        free.insert(ray.begin(), ray.end());
+      }
+    }
+    for (const octomap::OcTreeKey& k : free) {
+      if (occupied.count(k) == 0) reference.updateNode(k, false, true);
+    }
+    for (const octomap::OcTreeKey& k : occupied) reference.updateNode(k, true, true);
+    reference.updateInnerOccupancy();
+  }
+  const TreeAgreement agreement = compare_trees(map.tree(), reference);
+  EXPECT_GT(agreement.voxels, 3000u);
+  EXPECT_EQ(agreement.same, agreement.voxels);
+  EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
+  // Box B: hit once, then its points became clear-only rays that stop before it: its voxels stay occupied
+  // (nothing cleared them), while the space in front of it got the clear-only rays' free-space evidence.
+  ASSERT_GT(box_b.size(), 20u);
+  std::size_t still_occupied = 0;
+  for (const octomap::OcTreeKey& k : box_b) still_occupied += map.state(k) == VoxelState::occupied ? 1 : 0;
+  EXPECT_EQ(still_occupied, box_b.size());
+  EXPECT_EQ(map.state(Eigen::Vector3d(0.5, 0.6, 2.3)), VoxelState::free);
+}
+
 TEST(OccupancyMapTest, ReportsFlipsAndStates) {
   OccupancyMap map;
   const std::vector<AlignedBox> scene = {{{-1, -1, 2.0}, {1, 1, 2.1}}};  // a wall 2 m ahead

@@ -80,9 +80,36 @@ std::string CellPipeline::map_state() const {
   return out.str();
 }
 
+void CellPipeline::filter_robot(const Robot& robot) {
+  filter_ = std::make_unique<SelfFilter>(robot, config_.self_filter);
+}
+
+SweepReport CellPipeline::process(const FrameSweep& frames) {
+  Sweep sweep;
+  sweep.stamp = frames.stamp;
+  std::size_t robot_points = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (const SweepFrame& f : frames.frames) {
+    if (!filter_ || !f.robot || !config_.self_filter.enabled) {
+      sweep.scans.push_back(to_scan(f.frame));
+      continue;
+    }
+    SelfFilterResult filtered = filter_->filter(f.frame, *f.robot);
+    robot_points += filtered.removed;
+    sweep.scans.push_back(std::move(filtered.scan));
+  }
+  const double t_filter = seconds_since(start);
+  SweepReport report = process(sweep);
+  report.frames = frames.frames.size();
+  report.robot_points = robot_points;
+  report.t_filter = t_filter;
+  return report;
+}
+
 SweepReport CellPipeline::process(const Sweep& sweep) {
   SweepReport report;
   report.points = sweep.point_count();
+  report.frames = sweep.scans.size();
   update_viewpoint(sweep);
 
   auto start = std::chrono::steady_clock::now();

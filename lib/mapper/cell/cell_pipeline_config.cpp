@@ -28,6 +28,7 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   YamlMap reconcile = root.child("reconcile");
   c.cover_every_version = reconcile.get<bool>("cover_every_version", c.cover_every_version);
   c.reconcile = read_reconcile(reconcile);
+  c.self_filter = SelfFilterConfig::from_yaml(root.child("self_filter"));
   return c;
 }
 

@@ -313,26 +313,63 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
 
 constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
-// The distinct packed keys of `keys` (kNoKey entries skipped), in first-seen order (a bit set over their box,
-// or sorting when the box is huge).
-std::vector<Key> distinct(const std::vector<std::uint64_t>& keys, const KeyBox& box) {
-  std::vector<Key> out;
+// The distinct voxels of one scan: those holding a point, and the ends of its clear-only rays that hold none.
+struct DistinctKeys {
+  std::vector<Key> points;
+  std::vector<Key> clear;
+};
+
+// The distinct packed keys of `keys` (kNoKey entries skipped), in first-seen order; the first `point_count`
+// entries are the points', the rest clear-only ray ends (a bit set over their box, or sorting when the box is
+// huge).
+DistinctKeys distinct(const std::vector<std::uint64_t>& keys, std::size_t point_count, const KeyBox& box) {
+  DistinctKeys out;
   if (box.volume() > kMaxDenseVoxels) {
-    std::vector<std::uint64_t> packed;
-    packed.reserve(keys.size());
-    for (const std::uint64_t p : keys) {
-      if (p != kNoKey) packed.push_back(p);
+    std::vector<std::uint64_t> packed[2];
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (keys[i] != kNoKey) packed[i < point_count ? 0 : 1].push_back(keys[i]);
     }
-    for (const std::uint64_t p : sorted_unique(std::move(packed))) out.push_back(unpack(p));
+    const std::vector<std::uint64_t> points = sorted_unique(std::move(packed[0]));
+    for (const std::uint64_t p : points) out.points.push_back(unpack(p));
+    for (const std::uint64_t p : sorted_unique(std::move(packed[1]))) {
+      if (!std::binary_search(points.begin(), points.end(), p)) out.clear.push_back(unpack(p));
+    }
     return out;
   }
   BitSet seen(box.volume());
-  for (const std::uint64_t p : keys) {
-    if (p == kNoKey) continue;
-    const Key k = unpack(p);
-    if (!seen.test_and_set(box.index(k))) out.push_back(k);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i] == kNoKey) continue;
+    const Key k = unpack(keys[i]);
+    if (!seen.test_and_set(box.index(k))) (i < point_count ? out.points : out.clear).push_back(k);
   }
   return out;
+}
+
+enum class RayEnd { kVoxel, kCut, kOutside };
+
+// The ray from `origin` to the centre of voxel `end` (kVoxel); one that ends farther than `max_range` is cut
+// there (kCut: its end voxel is then neither hit nor cleared), or dropped if the cut end lies outside the map
+// (kOutside).
+RayEnd ray_to(const octomap::OcTree& grid, const Origin& origin, const Key& end, double max_range, Ray& ray) {
+  const octomap::point3d centre = grid.keyToCoord(end);
+  float offset[3];
+  float norm_sq = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    offset[i] = centre(i) - origin.p[i];
+    norm_sq += offset[i] * offset[i];
+  }
+  const double distance = std::sqrt(static_cast<double>(norm_sq));
+  if (distance <= max_range) {
+    for (int i = 0; i < 3; ++i) ray.end[i] = centre(i);
+    ray.end_key = end;
+    return RayEnd::kVoxel;
+  }
+  // Same rounding as OctoMap: normalize in single precision, then scale.
+  for (int i = 0; i < 3; ++i) {
+    ray.end[i] = origin.p[i] + (offset[i] / static_cast<float>(distance)) * static_cast<float>(max_range);
+  }
+  return grid.coordToKeyChecked(ray.end[0], ray.end[1], ray.end[2], ray.end_key) ? RayEnd::kCut
+                                                                                 : RayEnd::kOutside;
 }
 
 // Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
@@ -402,18 +439,21 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     origins.push_back(origin);
     box.extend(origin.key);
 
-    // Points to keys on all threads; a point that is not finite or outside the map gets kNoKey.
+    // Points, then clear-only ray ends, to keys on all threads; one that is not finite or outside the map
+    // gets kNoKey.
     const auto& points = scan.points_C.points;
-    std::vector<std::uint64_t> point_keys(points.size());
+    const auto& clear_ends = scan.clear_C.points;
+    std::vector<std::uint64_t> keys(points.size() + clear_ends.size());
     std::vector<KeyBox> thread_boxes(static_cast<std::size_t>(threads));
-    run_parallel(threads, points.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+    run_parallel(threads, keys.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
       for (std::size_t i = begin; i < end; ++i) {
+        const pcl::PointXYZ& p = i < points.size() ? points[i] : clear_ends[i - points.size()];
         Key k;
-        if (to_key(points[i].x, points[i].y, points[i].z, k)) {
-          point_keys[i] = pack(k);
+        if (to_key(p.x, p.y, p.z, k)) {
+          keys[i] = pack(k);
           thread_boxes[t].extend(k);
         } else {
-          point_keys[i] = kNoKey;
+          keys[i] = kNoKey;
         }
       }
     });
@@ -423,32 +463,18 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     }
     if (scan_box.empty()) continue;
 
-    for (const Key& k : distinct(point_keys, scan_box)) {
-      Ray ray{};
-      const octomap::point3d centre = grid.keyToCoord(k);
-      float offset[3];
-      float norm_sq = 0.0f;
-      for (int i = 0; i < 3; ++i) {
-        offset[i] = centre(i) - origin.p[i];
-        norm_sq += offset[i] * offset[i];
+    const DistinctKeys ends = distinct(keys, points.size(), scan_box);
+    for (const std::vector<Key>* list : {&ends.points, &ends.clear}) {
+      const bool hit = list == &ends.points;
+      for (const Key& k : *list) {
+        Ray ray{};
+        const RayEnd end = ray_to(grid, origin, k, max_range, ray);
+        if (end == RayEnd::kOutside) continue;
+        if (hit && end == RayEnd::kVoxel) hits.push_back(k);
+        ray.origin = static_cast<std::uint32_t>(s);
+        box.extend(ray.end_key);
+        rays.push_back(ray);
       }
-      const double distance = std::sqrt(static_cast<double>(norm_sq));
-      if (distance <= max_range) {
-        for (int i = 0; i < 3; ++i) ray.end[i] = centre(i);
-        ray.end_key = k;
-        hits.push_back(k);
-      } else {
-        // Clear free space up to max range only (the truncated end voxel itself is not cleared).
-        // Same rounding as OctoMap: normalize in single precision, then scale.
-        for (int i = 0; i < 3; ++i) {
-          ray.end[i] =
-              origin.p[i] + (offset[i] / static_cast<float>(distance)) * static_cast<float>(max_range);
-        }
-        if (!grid.coordToKeyChecked(ray.end[0], ray.end[1], ray.end[2], ray.end_key)) continue;
-      }
-      ray.origin = static_cast<std::uint32_t>(s);
-      box.extend(ray.end_key);
-      rays.push_back(ray);
     }
   }
   KeyUpdate update;

@@ -99,8 +99,9 @@ struct OpenNI2Source::Device {
       stream.stop();
       // Some drivers' frame threads poll a stop flag and are never joined (Debian's DummyDevice checks it
       // every 33 ms); freeing the stream at once let such a thread run on freed memory and crash here. 50 ms
-      // on close or reconnect is cheap.
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      // was not enough on a loaded machine under ASan (the thread was not scheduled in time); 200 ms on close
+      // or reconnect is still cheap.
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
     stream.destroy();
     device.close();

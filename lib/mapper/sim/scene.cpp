@@ -177,21 +177,26 @@ LineScanner read_scanner(YamlMap map) {
   return s;
 }
 
-// `mount: {position, rotation}` (X_ES on the tool), or `mount: tool | cell` with `pose:` (X_ES or X_CS).
-void read_mount(YamlMap& map, SensorSpec& s) {
+}  // namespace
+
+SensorMount read_mount(YamlMap& map) {
+  SensorMount m;
   const YAML::Node mount = map.node("mount");
   if (mount && mount.IsScalar()) {
     const std::string where = mount.as<std::string>();
     if (where != "tool" && where != "cell")
       map.fail("mount", "must be tool, cell or a pose, got '" + where + "'");
-    s.mount = where == "tool" ? Mount::kTool : Mount::kCell;
+    m.mount = where == "tool" ? Mount::kTool : Mount::kCell;
     if (!map.has("pose")) map.fail("pose", "is required with mount: " + where);
-    (s.mount == Mount::kTool ? s.X_ES : s.X_CS) = map.pose("pose");
-    return;
+    (m.mount == Mount::kTool ? m.X_ES : m.X_CS) = map.pose("pose");
+    return m;
   }
   if (map.has("pose")) map.fail("pose", "only with mount: tool or mount: cell");
-  s.X_ES = map.pose("mount");
+  m.X_ES = map.pose("mount");
+  return m;
 }
+
+namespace {
 
 SensorSpec read_sensor(YamlMap map, int dof) {
   SensorSpec s;
@@ -202,7 +207,10 @@ SensorSpec read_sensor(YamlMap map, int dof) {
   } catch (const Error& e) {
     map.fail("model", e.what());
   }
-  read_mount(map, s);
+  const SensorMount mount = read_mount(map);
+  s.mount = mount.mount;
+  s.X_ES = mount.X_ES;
+  s.X_CS = mount.X_CS;
   if (s.is_camera()) {
     s.intrinsics = read_intrinsics(map.child("intrinsics"), s.model);
     if (map.has("scanner")) map.fail("scanner", "only for a line scanner (model os32c)");

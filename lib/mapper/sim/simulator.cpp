@@ -74,10 +74,16 @@ CellState Simulator::state_at(double t) const {
   return state;
 }
 
-SimWindow Simulator::window(double t0, double t1) const {
+SimWindow Simulator::window(double t0, double t1, const std::vector<int>& sensors) const {
   if (!(t0 >= 0) || !(t1 >= t0)) throw Error("simulator: window needs 0 <= t0 <= t1");
+  std::vector<int> rendered = sensors;
+  if (sensors.empty()) {
+    for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor) rendered.push_back(sensor);
+  }
   SimWindow out;
-  for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor) {
+  for (const int sensor : rendered) {
+    if (sensor < 0 || sensor >= static_cast<int>(scene_.sensors.size()))
+      throw Error("simulator: no sensor with index " + std::to_string(sensor));
     const SensorSpec& spec = scene_.sensors[static_cast<std::size_t>(sensor)];
     const double period = scene_.plan_for(spec).period;
     for (long k = first_tick(t0, period); static_cast<double>(k) * period < t1; ++k) {

@@ -1,10 +1,11 @@
 #pragma once
-// The cell pipeline: one cell's incremental processing of sweeps, fusion → change detection → re-segmentation
-// of the changed regions only → reconciliation with the current boxes. Its output is the cell's boxes, their
-// id counter and the map state to persist with them; no I/O, no DDS, no threads.
+// The cell pipeline: one cell's incremental processing of sweeps, self filter → fusion → change detection →
+// re-segmentation of the changed regions only → reconciliation with the current boxes. Its output is the
+// cell's boxes, their id counter and the map state to persist with them; no I/O, no DDS, no threads.
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,19 +16,36 @@
 #include "cellmap/environment/reconcile.hpp"
 #include "cellmap/occupancy/occupancy_config.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/robot/robot.hpp"
 #include "cellmap/segment/pipeline.hpp"
+#include "cellmap/self_filter/self_filter.hpp"
 #include "cellmap/sweep/sweep.hpp"
 
 namespace cellmap {
 
 class OccupiedVoxels;
 
-/// Everything the cell pipeline is configured with: four sections of a config file and the settling policy.
+/// One frame of a sweep window: posed in the cell (frame.X_CS set; cameras keep depth->intrinsics for the
+/// self filter) with the robot as it stood at the frame's stamp (JointBuffer::at); nullopt: the cell has no
+/// robot model, the frame is fused as it is.
+struct SweepFrame final {
+  Frame frame;
+  std::optional<RobotAt> robot;
+};
+
+/// The frames of every sensor in one sweep window, in the order taken. `stamp`: the last frame's, seconds.
+struct FrameSweep final {
+  double stamp = 0.0;
+  std::vector<SweepFrame> frames;
+};
+
+/// Everything the cell pipeline is configured with: five sections of a config file and the settling policy.
 struct CellPipelineConfig final {
-  OccupancyConfig occupancy;   ///< `occupancy` section
-  ChangeConfig change;         ///< `change` section (change detection)
-  SegmentConfig segment;       ///< `segment` section: the keys of config/segment.yaml
-  ReconcileOptions reconcile;  ///< `reconcile` section
+  OccupancyConfig occupancy;     ///< `occupancy` section
+  ChangeConfig change;           ///< `change` section (change detection)
+  SegmentConfig segment;         ///< `segment` section: the keys of config/segment.yaml
+  ReconcileOptions reconcile;    ///< `reconcile` section
+  SelfFilterConfig self_filter;  ///< `self_filter` section (used once the pipeline knows the robot)
   /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, [0, 100000]; default
   /// 15). A fresh map keeps gaining voxels for a while (surfaces seen at grazing angles need several sweeps
   /// to collect two hits, flying pixels in unobserved space decay slowly), so the first version is one
@@ -43,8 +61,8 @@ struct CellPipelineConfig final {
   /// versions change only what the change touched and may leave such voxels outside every box.
   bool cover_every_version = true;
 
-  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment` and `reconcile`
-  /// (cover_every_version included) of `root`
+  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment`, `reconcile`
+  /// (cover_every_version included) and `self_filter` of `root`
   /// and marks them read; absent keys keep the defaults above.
   /// @throws Error naming the key ("change.settle_sweeps: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static CellPipelineConfig from_yaml(YamlMap& root);
@@ -52,13 +70,16 @@ struct CellPipelineConfig final {
 
 /// What one sweep did, for the log line and the status topic.
 struct SweepReport final {
-  std::size_t points = 0;                          ///< points in the sweep
-  std::size_t hit_voxels = 0;                      ///< voxels that got a hit
-  std::size_t free_voxels = 0;                     ///< voxels that got free-space evidence
-  std::size_t flipped = 0;                         ///< voxels whose occupied/free state flipped in this sweep
-  std::size_t regions = 0;                         ///< confirmed change regions
-  std::size_t evidence = 0;                        ///< occupied voxels re-segmented
-  std::size_t boxes = 0;                           ///< boxes after the sweep
+  std::size_t points = 0;        ///< points fused as hits
+  std::size_t frames = 0;        ///< frames in the sweep
+  std::size_t robot_points = 0;  ///< points the self filter found on the robot (fused as clear-only rays)
+  double t_filter = 0;           ///< seconds the self filter took for all frames
+  std::size_t hit_voxels = 0;    ///< voxels that got a hit
+  std::size_t free_voxels = 0;   ///< voxels that got free-space evidence
+  std::size_t flipped = 0;       ///< voxels whose occupied/free state flipped in this sweep
+  std::size_t regions = 0;       ///< confirmed change regions
+  std::size_t evidence = 0;      ///< occupied voxels re-segmented
+  std::size_t boxes = 0;         ///< boxes after the sweep
   double t_fuse = 0, t_change = 0, t_segment = 0;  ///< seconds
   ChangeSet changes;                               ///< the change regions confirmed in this sweep
   std::optional<Reconciled> change;                ///< set when the boxes changed (a new version is due)
@@ -84,6 +105,15 @@ class CellPipeline final {
   explicit CellPipeline(const CellPipelineConfig& config, std::vector<Box> boxes = {},
                         std::uint64_t next_box_id = 1,
                         const std::optional<std::string>& map_state = std::nullopt);
+
+  /// Cuts the robot out of every frame that comes with one (SelfFilter, once filter_robot() was called and
+  /// `self_filter.enabled`), then process(Sweep) on the scans. @throws Error as SelfFilter::filter.
+  SweepReport process(const FrameSweep& sweep);
+  /// The robot the self filter cuts out of the frames from now on (its shapes padded once, here).
+  /// @throws Error if the self-filter config is invalid.
+  void filter_robot(const Robot& robot);
+  /// The self filter in use, if any (its cost and triangle count for logs).
+  [[nodiscard]] const SelfFilter* self_filter() const { return filter_.get(); }
 
   /// Fuses `sweep`, detects confirmed changes and, if there are any, re-segments the evidence they touch
   /// (resegment()) and applies the result. A pipeline that started from an empty map first settles: it
@@ -135,6 +165,7 @@ class CellPipeline final {
   void apply(Resegmentation resegmentation, SweepReport& report);
 
   CellPipelineConfig config_;
+  std::unique_ptr<SelfFilter> filter_;  // set by filter_robot()
   OccupancyMap map_;
   ChangeDetector detector_;
   std::vector<Box> boxes_;

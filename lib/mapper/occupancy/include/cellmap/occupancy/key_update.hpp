@@ -46,7 +46,10 @@ struct KeyUpdate final {
 /// used; the tree is not modified). Per scan, the points are first snapped to their voxel centres and
 /// de-duplicated, then one ray is walked (Amanatides–Woo) from the scan's `origin_C` to each distinct
 /// endpoint voxel. A point farther than `max_range` (metres, measured to its voxel centre) marks nothing
-/// occupied; its ray clears free space up to `max_range` only. For a one-scan sweep this equals OctoMap's
+/// occupied; its ray clears free space up to `max_range` only. A scan's clear-only ray ends (`clear_C`) are
+/// snapped and de-duplicated the same way (ends in a voxel that holds a point of the scan are dropped: its
+/// ray is walked already) and walked like a point's ray, but mark nothing occupied: a clear-only ray to voxel
+/// k clears exactly OctoMap's `computeRayKeys(origin, centre(k))`. For a one-scan sweep this equals OctoMap's
 /// `computeDiscreteUpdate(scan, origin, free, occupied, max_range)`; for several scans it is the union over
 /// the scans, with occupied winning over free across the whole sweep.
 ///

@@ -44,7 +44,7 @@ class OccupancyMap final {
   /// Fuses one sweep: computes its occupied and free voxels (compute_key_update, on config().threads
   /// threads), applies them with lazy inner-node updates and refreshes the inner nodes once. Cost is
   /// dominated by the number of distinct voxels observed, not by the number of points. Non-finite points are
-  /// skipped.
+  /// skipped. Clear-only rays (Scan::clear_C) add free-space evidence only, up to their ends.
   /// @return the voxels whose occupied/free state flipped, for change detection.
   /// @throws Error if a scan origin is not finite or outside the map's key range.
   OccupancyUpdate integrate(const Sweep& sweep);

@@ -78,6 +78,18 @@ struct SweepPlan final {
 /// Where a sensor is mounted: on the robot's tool (posed through the robot) or fixed in the cell.
 enum class Mount { kTool, kCell };
 
+/// Where a sensor sits: on the tool at X_ES, or fixed in the cell at X_CS (the other pose unused).
+struct SensorMount final {
+  Mount mount = Mount::kTool;
+  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+};
+
+/// Reads a sensor's mount from the map holding it, the one mount schema of scenes and cellmapd's sources:
+/// `mount: tool` or `mount: cell` with `pose: {position, rotation}` (X_ES or X_CS), or `mount: {position,
+/// rotation}` (X_ES on the tool); neither key: on the tool at identity. @throws Error naming the key.
+[[nodiscard]] SensorMount read_mount(YamlMap& map);
+
 /// One sensor, on the end-effector E with the hand-eye extrinsic X_ES, or fixed in the cell at X_CS.
 struct SensorSpec final {
   std::string name;

@@ -83,8 +83,10 @@ class Simulator final {
   /// window (stamp = capture time t; noise keyed by k, so a window repeats bit for bit), rendered with
   /// state_at(t); the controller reports a joint sample at each multiple of 1 / controller_rate in the
   /// window, stamped t + joint_stamp_delay, with its payload. What a daemon's simulated source needs: fuse
-  /// the frames, feed the joint samples to its joint buffer. @throws Error if t1 < t0 or t0 < 0.
-  [[nodiscard]] SimWindow window(double t0, double t1) const;
+  /// the frames, feed the joint samples to its joint buffer. `sensors` (indices into scene().sensors) limits
+  /// the frames to those sensors; empty: every sensor. @throws Error if t1 < t0 or t0 < 0, or a sensor index
+  /// is out of range.
+  [[nodiscard]] SimWindow window(double t0, double t1, const std::vector<int>& sensors = {}) const;
 
   /// All frames of one sweep of `sensor` along its plan: frame k at stop k, stamp start + k·period.
   /// `sweep_index` keys the noise, so successive sweeps see fresh noise and a repeated index repeats it.

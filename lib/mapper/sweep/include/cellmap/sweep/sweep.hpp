@@ -15,6 +15,10 @@ namespace cellmap {
 struct Scan final {
   Eigen::Vector3d origin_C = Eigen::Vector3d::Zero();
   Cloud points_C;
+  /// Ends of clear-only rays (cell frame): each clears free space from `origin_C` up to the end and marks
+  /// nothing occupied (the end's voxel is neither hit nor cleared) — a line of sight known to be free only up
+  /// to there, e.g. up to the robot's near surface (self_filter). Usually empty.
+  Cloud clear_C;
 };
 
 /// One sweep: every frame of one pass, in the order taken. `stamp` is the time of the last frame, seconds.
