@@ -16,6 +16,7 @@
 #include "daemon_config.hpp"
 #include "health.hpp"
 #include "latest_mailbox.hpp"
+#include "layer_publisher.hpp"
 #include "signals.hpp"
 #include "versions.hpp"
 
@@ -49,6 +50,7 @@ class Daemon final {
   VersionStore store_;
   dds::Participant participant_;
   transport::EnvironmentPublisher publisher_;
+  LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
   CellPipeline pipeline_;
   VersionKeeper keeper_;
   LatestMailbox<Sweep> mailbox_;

@@ -25,4 +25,8 @@ dds::Qos robot_state_qos() {
   return dds::Qos::make(false, 256);
 }
 
+dds::Qos layer_qos() {
+  return dds::Qos::make(false, 1);
+}
+
 }  // namespace cellmap::transport

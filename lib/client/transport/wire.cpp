@@ -75,12 +75,12 @@ std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::s
   return boxes;
 }
 
+}  // namespace
+
 std::string cell_of(const char* cell, const char* topic) {
   if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
   return cell;
 }
-
-}  // namespace
 
 EnvironmentSample::EnvironmentSample(const Environment& env)
     : cell_(env.cell()), boxes_(to_msgs(env.boxes())) {

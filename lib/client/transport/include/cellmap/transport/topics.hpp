@@ -13,6 +13,8 @@ inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta
 inline constexpr const char* kStatusTopic = "cellmap/status";
 inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
 inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
+inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
+inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
@@ -28,5 +30,9 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
 /// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
 [[nodiscard]] dds::Qos robot_state_qos();
+
+/// cellmap/layer/*: RELIABLE, VOLATILE, KEEP_LAST 1 (a layer is the daemon's current view; a reader only
+/// wants the newest, and the daemon writes it only while a reader is matched).
+[[nodiscard]] dds::Qos layer_qos();
 
 }  // namespace cellmap::transport

@@ -1,0 +1,95 @@
+#include "layer_publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <array>
+#include <chrono>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::daemon {
+namespace {
+
+using transport::Layer;
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// OctoMap's leaf keys at depth 16: key 2^15 is the voxel whose lower corner lies at 0 on that axis.
+constexpr int kKeyOfZero = 1 << 15;
+
+std::vector<transport::VoxelRun> occupied_runs(const OccupancyMap& map) {
+  std::vector<std::array<int, 3>> indices;
+  const std::vector<octomap::OcTreeKey> keys = map.occupied_keys();  // sorted (z, y, x)
+  indices.reserve(keys.size());
+  for (const octomap::OcTreeKey& key : keys)
+    indices.push_back({key[0] - kKeyOfZero, key[1] - kKeyOfZero, key[2] - kKeyOfZero});
+  return transport::voxel_runs(indices);
+}
+
+const char* name(Layer layer) {
+  return layer == Layer::kVoxels ? "voxels" : "change regions";
+}
+
+}  // namespace
+
+LayerPublisher::LayerPublisher(const dds::Participant& participant, std::string cell)
+    : writer_(participant, std::move(cell)) {}
+
+void LayerPublisher::after_sweep(std::uint64_t sweep, const OccupancyMap& map, const ChangeSet& changes) {
+  try {
+    if (read(Layer::kVoxels, voxels_read_)) publish_voxels(sweep, map);
+    if (read(Layer::kChangeRegions, regions_read_)) publish_regions(sweep, changes);
+  } catch (const Error& e) {
+    spdlog::warn("layers: {}; retrying after the next sweep", e.what());
+  }
+}
+
+bool LayerPublisher::read(Layer layer, bool& was_read) {
+  const bool is_read = writer_.readers(layer) > 0;
+  if (is_read != was_read) {
+    if (is_read) {
+      spdlog::info("layer {}: {} reader(s), publishing after each sweep", name(layer),
+                   writer_.readers(layer));
+    } else {
+      spdlog::info("layer {}: no reader, not published", name(layer));
+    }
+    was_read = is_read;
+  }
+  return is_read;
+}
+
+void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kVoxels);
+  std::vector<transport::VoxelRun> runs = occupied_runs(map);
+  if (runs == voxels_written_ && joined == voxel_readers_served_) return;
+  transport::VoxelLayer layer{writer_.cell(), sweep, now_ns(), map.config().resolution, std::move(runs)};
+  writer_.write(layer);
+  if (joined != voxel_readers_served_) {
+    spdlog::info("layer voxels: {} voxels in {} runs, {} bytes", layer.voxel_count(), layer.runs.size(),
+                 transport::wire_size(layer));
+  }
+  voxels_written_ = std::move(layer.runs);
+  voxel_readers_served_ = joined;
+}
+
+void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& changes) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kChangeRegions);
+  if (changes.empty() && joined == region_readers_served_) return;
+  transport::ChangeRegionLayer layer{writer_.cell(), sweep, now_ns(), {}};
+  for (const ChangeRegion& region : changes.regions) {
+    layer.regions.push_back({region.bounds, static_cast<std::uint32_t>(region.appeared.size()),
+                             static_cast<std::uint32_t>(region.vanished.size())});
+  }
+  writer_.write(layer);
+  if (!changes.empty()) {
+    spdlog::info("layer change regions: {} regions, {} bytes", layer.regions.size(),
+                 transport::wire_size(layer));
+  }
+  region_readers_served_ = joined;
+}
+
+}  // namespace cellmap::daemon

@@ -1,0 +1,137 @@
+// `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR]`: follows the cell(s) over DDS
+// as a planner does and serves a live 3D view of them at http://ADDR:P/ until SIGINT or SIGTERM.
+#include <csignal>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/view/cell_follower.hpp"
+#include "cellmap/view/web_server.hpp"
+#include "commands.hpp"
+
+namespace cellmap::cli {
+namespace {
+
+volatile std::sig_atomic_t stop_requested = 0;
+
+void request_stop(int) {
+  stop_requested = 1;
+}
+
+struct ViewOptions {
+  std::uint32_t domain = 0;
+  std::string cell;
+  view::WebServerOptions server;
+};
+
+// Which layers each page shows; a layer is read from DDS while at least one page shows it.
+class PageLayers {
+ public:
+  struct Wanted {
+    bool voxels = false;
+    bool regions = false;
+  };
+  /// Records what `page` shows now; returns the layers it newly turned on.
+  Wanted set(view::PageId page, Wanted wanted) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const Wanted before = pages_[page];
+    pages_[page] = wanted;
+    return {wanted.voxels && !before.voxels, wanted.regions && !before.regions};
+  }
+  void forget(view::PageId page) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    pages_.erase(page);
+  }
+  [[nodiscard]] Wanted any() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    Wanted out;
+    for (const auto& [page, wanted] : pages_) {
+      out.voxels = out.voxels || wanted.voxels;
+      out.regions = out.regions || wanted.regions;
+    }
+    return out;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<view::PageId, Wanted> pages_;
+};
+
+void run_view(const ViewOptions& options) {
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
+  const dds::Participant participant(options.domain);
+  view::ViewState state(options.domain, options.cell);
+  PageLayers layers;
+  std::mutex server_mutex;            // DDS and page callbacks may come before the server is set, or after
+  view::WebServer* server = nullptr;  // guarded by server_mutex
+
+  view::WebServer::Callbacks callbacks;
+  callbacks.state = [&state] { return state.state(); };
+  callbacks.on_message = [&](view::PageId page, const std::string& text) {
+    // A page only asks to see things; anything malformed is ignored.
+    std::string type;
+    PageLayers::Wanted turned_on;
+    try {
+      const nlohmann::json message = nlohmann::json::parse(text);
+      type = message.at("type").get<std::string>();
+      if (type == "layers")
+        turned_on = layers.set(page, {message.at("voxels").get<bool>(), message.at("regions").get<bool>()});
+    } catch (const nlohmann::json::exception&) {
+      return;
+    }
+    const std::lock_guard<std::mutex> lock(server_mutex);
+    if (server == nullptr) return;
+    if (type == "resync") server->send_state(page);
+    // A page that turns a layer on gets the latest one at once, if there is one; later ones come with
+    // everyone's.
+    if (turned_on.voxels)
+      for (std::string& layer : state.layers(transport::Layer::kVoxels)) server->send(page, std::move(layer));
+    if (turned_on.regions)
+      for (std::string& layer : state.layers(transport::Layer::kChangeRegions))
+        server->send(page, std::move(layer));
+  };
+  callbacks.on_close = [&layers](view::PageId page) { layers.forget(page); };
+
+  const auto publish = [&](std::string message) {
+    const std::lock_guard<std::mutex> lock(server_mutex);
+    if (server != nullptr) server->broadcast(std::move(message));
+  };
+  view::CellFollower follower(participant, options.cell, state, publish);
+  view::WebServer web(options.server, callbacks);
+  {
+    const std::lock_guard<std::mutex> lock(server_mutex);
+    server = &web;
+  }
+  std::cout << "cellmap view: " << web.url() << " (DDS domain " << options.domain << ", "
+            << (options.cell.empty() ? std::string("every cell") : "cell " + options.cell) << "; read-only)"
+            << std::endl;
+  while (stop_requested == 0) {
+    const PageLayers::Wanted wanted = layers.any();
+    follower.want_layers(wanted.voxels, wanted.regions);
+    follower.poll(std::chrono::milliseconds(100));
+  }
+  const std::lock_guard<std::mutex> lock(server_mutex);
+  server = nullptr;
+}
+
+}  // namespace
+
+void add_view_command(CLI::App& app) {
+  auto options = std::make_shared<ViewOptions>();
+  CLI::App* command = app.add_subcommand(
+      "view", "Serve a live 3D view of the cell(s) on a DDS domain as a web page (read-only)");
+  command->add_option("--domain", options->domain, "DDS domain id")->check(CLI::Range(0, 232));
+  command->add_option("--cell", options->cell, "the cell to show (default: every cell on the domain)");
+  command->add_option(
+      "--bind", options->server.bind,
+      "address to listen on (default 127.0.0.1: this machine only; 0.0.0.0: every interface)");
+  command->add_option("--port", options->server.port, "TCP port (default 8080)")->check(CLI::Range(1, 65535));
+  command->add_option("--three", options->server.three_dir,
+                      "folder of three.js (default: Debian's libjs-three, /usr/share/javascript/three)");
+  command->callback([options] { run_view(*options); });
+}
+
+}  // namespace cellmap::cli
