@@ -2,7 +2,7 @@
 """`cellmap view` in a real browser: cellmapd on the simulated cell (exact depths), `cellmap view`, `cellmap
 inject` and `cellmap render` as processes, and Debian's chromium (headless) driven by python3-selenium.
 
-Domains 220 (the live cell) and 221 (no daemon). CELLMAP_BROWSER_ROUNDS=N repeats the inject/remove/restart
+Domain 220. CELLMAP_BROWSER_ROUNDS=N repeats the inject/remove/restart
 round N times (default 1, the CI run). The last screenshot is written to view_browser.png in the working
 directory (the build's tests folder under ctest).
 """
@@ -24,6 +24,7 @@ import unittest
 from PIL import Image
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
 # Cyclone DDS on loopback only, as tests/transport/loopback.hpp (1 s lease: a killed daemon is noticed soon).
@@ -34,10 +35,10 @@ LOOPBACK = ('<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface
             '</Domain></CycloneDDS>')
 PATIENCE = 90  # seconds; passing runs take a few, the machine is shared
 LIVE_DOMAIN = 220
-EMPTY_DOMAIN = 221
 BACKGROUND = (0xfb, 0xfc, 0xfd)  # the scene's background colour in view.js
 TABLE_POINT = (1.0, 1.25, 0.75)  # on the default cell's table top, clear of every object (config/cell.yaml)
 NEW_BOX = ['add-box', '--center', '2.12,0.45,0.9', '--half-extents', '0.1,0.1,0.15']  # the README's example
+NEW_BOX_TOP = (2.12, 0.45, 1.05)
 
 ARGS = None
 
@@ -140,7 +141,9 @@ class ViewTest(unittest.TestCase):
     def start_daemon(self):
         config = os.path.join(self.dir, 'cellmapd.yaml')
         with open(config, 'w') as f:
-            f.write('cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n')
+            # Exact depths fill the map in two sweeps: a short settling is enough.
+            f.write('cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n'
+                    'change: {settle_sweeps: 4}\n')
         daemon = Process([ARGS.cellmapd, '--config', config, '--domain', str(LIVE_DOMAIN), '--state-dir',
                           os.path.join(self.dir, 'state')], os.path.join(self.dir, 'cellmapd.log'))
         self.processes.append(daemon)
@@ -200,22 +203,20 @@ class ViewTest(unittest.TestCase):
         self.assertGreater(difference, 30, f'the table at ({x:.0f}, {y:.0f}) is drawn as {pixel}: background')
 
     # ---- the tests ----
-    def test_page_without_daemon_says_so(self):
-        port = free_port()
-        self.start_view(EMPTY_DOMAIN, port)
-        self.browser.get(f'http://127.0.0.1:{port}/')
-        wait_for(lambda: self.js('cellmapView.connected()'), 'the page to connect')
-        text = wait_for(self.notice, 'the notice')
-        self.assertIn(f'No cellmapd on DDS domain {EMPTY_DOMAIN}', text)
-        self.assertEqual(self.box_count(), 0)
-
     def test_live_view_follows_the_daemon(self):
-        daemon = self.start_daemon()
         port = free_port()
         view = self.start_view(LIVE_DOMAIN, port)
-        self.browser.get(f'http://127.0.0.1:{port}/')
+        # Boxes glow for 4 s by default; long enough here that a loaded machine cannot miss it.
+        self.browser.get(f'http://127.0.0.1:{port}/?highlight=60')
         self.browser.execute_script('window.notReloaded = true;')
+        wait_for(lambda: self.js('cellmapView.connected()'), 'the page to connect')
+        self.assertIn(f'No cellmapd on DDS domain {LIVE_DOMAIN}', wait_for(self.notice, 'the page to say so'))
+        self.assertEqual(self.box_count(), 0)
+        self.log('the page says there is no daemon')
+
+        daemon = self.start_daemon()
         wait_for(lambda: self.js('cellmapView.version()') >= 1, 'the first version on the page')
+        self.log('the first version is on the page')
         self.wait_for_daemon_snapshot('the page to show the daemon\'s boxes')
         self.log(f'the page shows version {self.js("cellmapView.version()")}, {self.box_count()} boxes')
         self.assertEqual(self.notice(), '')
@@ -232,14 +233,21 @@ class ViewTest(unittest.TestCase):
         # Watched while the tool still runs: the box glows for a few seconds only.
         inject = Process([ARGS.cellmap, 'inject', '--domain', str(LIVE_DOMAIN), '--wait', '60', *NEW_BOX],
                          os.path.join(self.dir, 'inject.log'))
-        wait_for(lambda: self.box_count() == len(before) + 1, 'the new box on the page')
-        added = sorted(set(self.listed_ids()) - set(before))
-        self.assertEqual(len(added), 1, f'listed {self.listed_ids()}, before {before}')
+        # Count, list and the rows marked as changed in one look (the glow lasts a few seconds).
+        shown = wait_for(lambda: self.js(
+            '(() => { const n = Number(document.getElementById("box-count").textContent);'
+            f' if (n !== {len(before) + 1}) return null;'
+            ' const rows = [...document.querySelectorAll("#boxes tbody tr")];'
+            ' return { listed: rows.map((r) => Number(r.dataset.id)),'
+            '          changed: rows.filter((r) => r.classList.contains("changed")).map((r) => Number(r.dataset.id)) };'
+            ' })()'), 'the new box on the page')
+        added = sorted(set(shown['listed']) - set(before))
+        self.assertEqual(len(added), 1, f'listed {shown["listed"]}, before {before}')
         new_id = added[0]
-        row_class = self.js(f'document.querySelector(\'#boxes tr[data-id="{new_id}"]\').className')
-        self.assertIn('changed', row_class)
-        self.assertIn(new_id, self.js('cellmapView.highlighted()'))
+        self.assertIn(new_id, shown['changed'])
+        wait_for(lambda: new_id in self.js('cellmapView.highlighted()'), 'the new box to glow in the scene')
         self.report_latency()
+        self.check_click(new_id)
         self.check_screenshot()
         name = inject.line()
         self.assertEqual(inject.stop(), 0)
@@ -270,6 +278,22 @@ class ViewTest(unittest.TestCase):
                  'the page to show the boxes again')
         self.log(f'round {round_number + 1}: box {new_id} added and removed, daemon and viewer restarted')
         return daemon, view
+
+    def check_click(self, box_id):
+        """A click on the new box's top shows its details."""
+        canvas = self.browser.find_element(By.ID, 'canvas')
+        left, top, width, height = self.js('(() => { const r = document.getElementById("canvas")'
+                                           '.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()')
+        x, y = self.js('cellmapView.project(%s, %s, %s)' % NEW_BOX_TOP)
+        ActionChains(self.browser).move_to_element_with_offset(
+            canvas, int(x - left - width / 2), int(y - top - height / 2)).click().perform()
+        text = wait_for(lambda: self.browser.find_element(By.ID, 'selection').text, 'the box details')
+        self.assertIn(f'box {box_id}\n', text)
+        self.assertIn(f'changed in version {self.js("cellmapView.version()")}', text)
+        size = re.search(r'size ([\d.]+) × ([\d.]+) × ([\d.]+) m', text)
+        self.assertIsNotNone(size, text)
+        for edge in size.groups():  # the injected box is 0.2 × 0.2 × 0.3 m; boxes grow by up to a voxel
+            self.assertTrue(0.15 < float(edge) < 0.4, text)
 
     def report_latency(self):
         last = self.js('cellmapView.latency[cellmapView.latency.length - 1]')

@@ -3,10 +3,14 @@
 import * as THREE from '/three/build/three.module.js';
 import { OrbitControls } from '/three/examples/jsm/controls/OrbitControls.js';
 
-const HIGHLIGHT_MS = 4000;  // how long boxes of the latest version glow
-const GHOST_MS = 3000;      // how long a removed box stays as a red outline
+// How long boxes of the latest version glow (the page's ?highlight=SECONDS changes it) and a removed box stays
+// as a red outline; both fade out over their last FADE_MS.
+const HIGHLIGHT_MS = 1000 * (Number(new URLSearchParams(location.search).get('highlight')) || 4);
+const GHOST_MS = 3000;
+const FADE_MS = 1500;
 const TIMELINE_SHOWN = 200;
 const BOX_OPACITY = 0.88;
+const FADE_STEP_MS = 250;
 
 const $ = (id) => document.getElementById(id);
 
@@ -144,30 +148,40 @@ function fitCamera(cell) {
 
 // ---- highlights: the boxes of the latest version glow, then fade ----
 const highlightColour = new THREE.Color(0xff8a00);
+const selectedColour = new THREE.Color(0x1e5bc6);
 
+// Glow strength 1 until the last FADE_MS, then fading to 0; returns when the scene must be drawn again
+// (ms from now), or null when nothing glows.
 function applyHighlights(now) {
-  let active = false;
+  let next = null;
+  const wake = (ms) => { next = next === null ? ms : Math.min(next, ms); };
+  const strength = (until) => {
+    if (until > now + FADE_MS) wake(until - FADE_MS - now);
+    else if (until > now) wake(FADE_STEP_MS);
+    return Math.min(1, Math.max(0, (until - now) / FADE_MS));
+  };
   for (const [id, entry] of meshes) {
     const until = highlights.get(id);
-    const left = until ? Math.max(0, (until - now) / HIGHLIGHT_MS) : 0;
-    entry.mesh.material.emissive.copy(highlightColour).multiplyScalar(0.85 * left);
+    const left = until ? strength(until) : 0;
     const selected = id === selectedBox;
+    entry.glow = left;
+    entry.mesh.material.color.copy(boxColour(id)).lerp(highlightColour, left);
+    entry.mesh.material.emissive.copy(selected ? selectedColour : highlightColour)
+      .multiplyScalar(selected ? 0.45 : 0.35 * left);
     entry.edges.material.color.set(selected ? 0x1565c0 : left > 0 ? 0xd35400 : 0x2a3440);
-    if (left > 0) active = true;
   }
   for (const [id, until] of highlights) if (until <= now) highlights.delete(id);
   for (let i = ghosts.length - 1; i >= 0; --i) {
-    const left = (ghosts[i].until - now) / GHOST_MS;
+    const left = strength(ghosts[i].until);
     if (left <= 0) {
       ghostGroup.remove(ghosts[i].object);
       disposeObject(ghosts[i].object);
       ghosts.splice(i, 1);
     } else {
       ghosts[i].object.material.opacity = left;
-      active = true;
     }
   }
-  return active;
+  return next;
 }
 
 // ---- drawing on demand: a frame when something changed, and while highlights fade ----
@@ -184,14 +198,16 @@ function drawFrame() {
   if (!renderer) return;
   resize();
   const now = performance.now();
-  const animating = applyHighlights(now);
+  const redraw = applyHighlights(now);
   renderer.render(scene, camera);
   if (pendingFrameStamps.length > 0) {
     const drawn = Date.now();
     for (const entry of pendingFrameStamps) entry.frame_ms = drawn;
     pendingFrameStamps = [];
   }
-  if (animating) requestRender();
+  // A glow is drawn once, then a few frames a second while it fades: a browser drawing in software (no GPU)
+  // stays responsive.
+  if (redraw !== null) setTimeout(requestRender, redraw);
   updateBoxTable(false);
 }
 
@@ -462,6 +478,8 @@ function onVersion(m) {
   if (latency.length > 1000) latency.shift();
   updateAll();
   if (shown) {
+    const first = document.querySelector('#boxes tr.changed');
+    if (first) first.scrollIntoView({ block: 'nearest' });
     for (const box of [...m.added, ...m.modified]) putMesh(box);
     if (fittedCell !== selectedCell && cell.boxes.size > 0) rebuildScene();
     pendingFrameStamps.push(entry);
@@ -592,8 +610,10 @@ window.cellmapView = {
   cell: () => selectedCell,
   version: () => (cells.get(selectedCell) || { version: 0 }).version,
   boxIds: () => [...meshes.keys()].sort((a, b) => a - b),
-  highlighted: () => [...meshes.keys()].filter((id) => meshes.get(id).mesh.material.emissive.r > 0.01),
+  highlighted: () => [...meshes.keys()].filter((id) => meshes.get(id).glow > 0),  // as in the last frame drawn
   voxelRuns: () => layerGroup.children.filter((o) => o.isInstancedMesh).reduce((n, o) => n + o.count, 0),
+  // The sweep of the latest layer ("voxels" or "regions") of the shown cell, or null.
+  layerSweep: (type) => ((cells.get(selectedCell) || {})[type] || { sweep: null }).sweep,
   // Where a point of the cell frame appears in the page (CSS pixels from the top left of the document).
   project: (x, y, z) => {
     const p = new THREE.Vector3(x, y, z).project(camera);
