@@ -166,8 +166,9 @@ function applyHighlights(now) {
     const selected = id === selectedBox;
     entry.glow = left;
     entry.mesh.material.color.copy(boxColour(id)).lerp(highlightColour, left);
-    entry.mesh.material.emissive.copy(selected ? selectedColour : highlightColour)
-      .multiplyScalar(selected ? 0.45 : 0.35 * left);
+    // A glowing box stays orange when selected; its blue edges show the selection.
+    entry.mesh.material.emissive.copy(left > 0 ? highlightColour : selectedColour)
+      .multiplyScalar(left > 0 ? 0.35 * left : selected ? 0.45 : 0);
     entry.edges.material.color.set(selected ? 0x1565c0 : left > 0 ? 0xd35400 : 0x2a3440);
   }
   for (const [id, until] of highlights) if (until <= now) highlights.delete(id);
