@@ -3,20 +3,14 @@
 #include <spdlog/spdlog.h>
 
 #include <array>
-#include <chrono>
 
 #include "cellmap/common/error.hpp"
+#include "versions.hpp"
 
 namespace cellmap::daemon {
 namespace {
 
 using transport::Layer;
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // OctoMap's leaf keys at depth 16: key 2^15 is the voxel whose lower corner lies at 0 on that axis.
 constexpr int kKeyOfZero = 1 << 15;
@@ -66,7 +60,7 @@ void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map
   const std::uint32_t joined = writer_.readers_joined(Layer::kVoxels);
   std::vector<transport::VoxelRun> runs = occupied_runs(map);
   if (runs == voxels_written_ && joined == voxel_readers_served_) return;
-  transport::VoxelLayer layer{writer_.cell(), sweep, now_ns(), map.config().resolution, std::move(runs)};
+  transport::VoxelLayer layer{writer_.cell(), sweep, system_now_ns(), map.config().resolution, std::move(runs)};
   writer_.write(layer);
   if (joined != voxel_readers_served_) {
     spdlog::info("layer voxels: {} voxels in {} runs, {} bytes", layer.voxel_count(), layer.runs.size(),
@@ -79,7 +73,7 @@ void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map
 void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& changes) {
   const std::uint32_t joined = writer_.readers_joined(Layer::kChangeRegions);
   if (changes.empty() && joined == region_readers_served_) return;
-  transport::ChangeRegionLayer layer{writer_.cell(), sweep, now_ns(), {}};
+  transport::ChangeRegionLayer layer{writer_.cell(), sweep, system_now_ns(), {}};
   for (const ChangeRegion& region : changes.regions) {
     layer.regions.push_back({region.bounds, static_cast<std::uint32_t>(region.appeared.size()),
                              static_cast<std::uint32_t>(region.vanished.size())});
