@@ -103,7 +103,7 @@ void Daemon::handle(const Sweep& sweep, std::uint64_t number) {
         "fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; {} sweeps dropped",
         number, report.points, report.hit_voxels, report.free_voxels, report.flipped, report.regions,
         report.boxes, report.t_fuse, report.t_change, report.t_segment, mailbox_.dropped());
-    layers_.after_sweep(number, pipeline_.map(), report.changes);
+    layers_.after_sweep(number, sweep, pipeline_.map(), report.changes);
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
     spdlog::error("sweep {}: {}; keeping version {}", number, e.what(), keeper_.published().version());

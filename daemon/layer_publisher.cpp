@@ -25,7 +25,15 @@ std::vector<transport::VoxelRun> occupied_runs(const OccupancyMap& map) {
 }
 
 const char* name(Layer layer) {
-  return layer == Layer::kVoxels ? "voxels" : "change regions";
+  switch (layer) {
+    case Layer::kVoxels:
+      return "voxels";
+    case Layer::kChangeRegions:
+      return "change regions";
+    case Layer::kSensors:
+      return "sensors";
+  }
+  return "?";
 }
 
 }  // namespace
@@ -33,10 +41,12 @@ const char* name(Layer layer) {
 LayerPublisher::LayerPublisher(const dds::Participant& participant, std::string cell)
     : writer_(participant, std::move(cell)) {}
 
-void LayerPublisher::after_sweep(std::uint64_t sweep, const OccupancyMap& map, const ChangeSet& changes) {
+void LayerPublisher::after_sweep(std::uint64_t number, const Sweep& sweep, const OccupancyMap& map,
+                                 const ChangeSet& changes) {
   try {
-    if (read(Layer::kVoxels, voxels_read_)) publish_voxels(sweep, map);
-    if (read(Layer::kChangeRegions, regions_read_)) publish_regions(sweep, changes);
+    if (read(Layer::kVoxels, voxels_read_)) publish_voxels(number, map);
+    if (read(Layer::kChangeRegions, regions_read_)) publish_regions(number, changes);
+    if (read(Layer::kSensors, sensors_read_)) publish_sensors(number, sweep);
   } catch (const Error& e) {
     spdlog::warn("layers: {}; retrying after the next sweep", e.what());
   }
@@ -60,7 +70,8 @@ void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map
   const std::uint32_t joined = writer_.readers_joined(Layer::kVoxels);
   std::vector<transport::VoxelRun> runs = occupied_runs(map);
   if (runs == voxels_written_ && joined == voxel_readers_served_) return;
-  transport::VoxelLayer layer{writer_.cell(), sweep, system_now_ns(), map.config().resolution, std::move(runs)};
+  transport::VoxelLayer layer{writer_.cell(), sweep, system_now_ns(), map.config().resolution,
+                              std::move(runs)};
   writer_.write(layer);
   if (joined != voxel_readers_served_) {
     spdlog::info("layer voxels: {} voxels in {} runs, {} bytes", layer.voxel_count(), layer.runs.size(),
@@ -84,6 +95,17 @@ void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& chang
                  transport::wire_size(layer));
   }
   region_readers_served_ = joined;
+}
+
+void LayerPublisher::publish_sensors(std::uint64_t number, const Sweep& sweep) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kSensors);
+  transport::SensorLayer layer{writer_.cell(), number, system_now_ns(), {}};
+  for (const Scan& scan : sweep.scans) layer.views.push_back({scan.sensor, scan.X_CS, scan.field_of_view});
+  writer_.write(layer);
+  if (joined != sensor_readers_served_) {
+    spdlog::info("layer sensors: {} views, {} bytes", layer.views.size(), transport::wire_size(layer));
+  }
+  sensor_readers_served_ = joined;
 }
 
 }  // namespace cellmap::daemon

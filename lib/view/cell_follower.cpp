@@ -41,20 +41,17 @@ void CellFollower::poll(std::chrono::nanoseconds timeout) {
     if (!cell_.empty() && cell != cell_) continue;
     publish_(state_.on_daemon_gone(cell));
   }
-  bool voxels = false;
-  bool regions = false;
+  std::set<transport::Layer> wanted;
   {
     const std::lock_guard<std::mutex> lock(wanted_mutex_);
-    voxels = want_voxels_;
-    regions = want_regions_;
+    wanted = wanted_;
   }
-  open_or_close(voxels_, transport::Layer::kVoxels, voxels);
-  open_or_close(regions_, transport::Layer::kChangeRegions, regions);
+  for (const transport::Layer layer : transport::kLayers) open_or_close(layer, wanted.count(layer) != 0);
 }
 
-void CellFollower::open_or_close(std::optional<transport::LayerReader>& reader, transport::Layer layer,
-                                 bool wanted) {
-  if (wanted && !reader) reader.emplace(participant_, layer);
+void CellFollower::open_or_close(transport::Layer layer, bool wanted) {
+  std::unique_ptr<transport::LayerReader>& reader = layer_readers_[layer];
+  if (wanted && !reader) reader = std::make_unique<transport::LayerReader>(participant_, layer);
   if (!wanted && reader) reader.reset();
   if (!reader) return;
   for (const transport::LayerMessage& message : reader->take()) {
@@ -63,10 +60,9 @@ void CellFollower::open_or_close(std::optional<transport::LayerReader>& reader, 
   }
 }
 
-void CellFollower::want_layers(bool voxels, bool regions) {
+void CellFollower::want_layers(std::set<transport::Layer> layers) {
   const std::lock_guard<std::mutex> lock(wanted_mutex_);
-  want_voxels_ = voxels;
-  want_regions_ = regions;
+  wanted_ = std::move(layers);
 }
 
 }  // namespace cellmap::view

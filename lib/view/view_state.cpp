@@ -72,7 +72,47 @@ json regions_json(const transport::ChangeRegionLayer& layer) {
           {"regions", regions}};
 }
 
+json sensors_json(const transport::SensorLayer& layer) {
+  json views = json::array();
+  for (const transport::SensorView& view : layer.views) {
+    const Eigen::Quaterniond q_CS(view.X_CS.linear());
+    json outline = json::array();
+    if (view.field_of_view) {
+      for (const Eigen::Vector3d& ray : view.field_of_view->outline_S) outline.push_back(vector_json(ray));
+    }
+    views.push_back({{"sensor", view.sensor},
+                     {"position", vector_json(view.X_CS.translation())},
+                     {"rotation", json::array({q_CS.w(), q_CS.x(), q_CS.y(), q_CS.z()})},
+                     {"max_range", view.field_of_view ? view.field_of_view->max_range : 0.0},
+                     {"closed", view.field_of_view && view.field_of_view->closed},
+                     {"outline", outline}});
+  }
+  return {{"type", "sensors"},
+          {"cell", layer.cell},
+          {"sweep", layer.sweep},
+          {"stamp_ns", layer.stamp_ns},
+          {"views", views}};
+}
+
+struct LayerJson {
+  json operator()(const transport::VoxelLayer& layer) const { return voxels_json(layer); }
+  json operator()(const transport::ChangeRegionLayer& layer) const { return regions_json(layer); }
+  json operator()(const transport::SensorLayer& layer) const { return sensors_json(layer); }
+};
+
 }  // namespace
+
+const char* layer_name(transport::Layer layer) {
+  switch (layer) {
+    case transport::Layer::kVoxels:
+      return "voxels";
+    case transport::Layer::kChangeRegions:
+      return "regions";
+    case transport::Layer::kSensors:
+      return "sensors";
+  }
+  return "?";
+}
 
 ViewState::ViewState(std::uint32_t domain, std::string cell_filter, std::size_t timeline_length)
     : domain_(domain), cell_filter_(std::move(cell_filter)), timeline_length_(timeline_length) {}
@@ -142,15 +182,12 @@ std::string ViewState::on_daemon_gone(const std::string& cell_name) {
 }
 
 std::string ViewState::on_layer(const transport::LayerMessage& layer) {
-  const bool voxels = std::holds_alternative<transport::VoxelLayer>(layer);
-  const std::string& cell_name = voxels ? std::get<transport::VoxelLayer>(layer).cell
-                                        : std::get<transport::ChangeRegionLayer>(layer).cell;
+  const std::string& cell_name =
+      std::visit([](const auto& l) -> const std::string& { return l.cell; }, layer);
   if (!followed(cell_name)) return "";
-  std::string message = voxels ? voxels_json(std::get<transport::VoxelLayer>(layer)).dump()
-                               : regions_json(std::get<transport::ChangeRegionLayer>(layer)).dump();
+  std::string message = std::visit(LayerJson{}, layer).dump();
   const std::lock_guard<std::mutex> lock(mutex_);
-  Cell& cell = cells_[cell_name];
-  (voxels ? cell.voxels : cell.regions) = message;
+  cells_[cell_name].layers[transport::layer_of(layer)] = message;
   return message;
 }
 
@@ -190,9 +227,8 @@ std::vector<std::string> ViewState::layers(transport::Layer layer) const {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> messages;
   for (const auto& [name, cell] : cells_) {
-    const std::optional<std::string>& message =
-        layer == transport::Layer::kVoxels ? cell.voxels : cell.regions;
-    if (message) messages.push_back(*message);
+    const auto found = cell.layers.find(layer);
+    if (found != cell.layers.end()) messages.push_back(found->second);
   }
   return messages;
 }

@@ -1,12 +1,16 @@
 // The daemon's layers: written after a sweep only while read, only when they changed or a reader joined
-// (real participants on loopback, domain 223).
+// (real participants on loopback, domain 223); sensor views from real frames through the sweep stage.
 #include "layer_publisher.hpp"
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <chrono>
+#include <cmath>
 #include <thread>
 
+#include "cellmap/sweep/sweep.hpp"
 #include "transport/loopback.hpp"
 
 namespace cellmap::daemon {
@@ -58,11 +62,11 @@ TEST_F(LayerPublisherTest, VoxelsGoOutWhenTheyChangeOrAReaderJoins) {
   LayerPublisher layers(daemon, "cell-1");
   OccupancyMap map;
   map.integrate(floor_sweep(5, 3));
-  layers.after_sweep(1, map, {});  // nobody reads: nothing is computed or written
+  layers.after_sweep(1, {}, map, {});  // nobody reads: nothing is computed or written
 
   transport::LayerReader reader(viewer, Layer::kVoxels);
   wait_until_read(daemon, Layer::kVoxels, 1);
-  layers.after_sweep(2, map, {});
+  layers.after_sweep(2, {}, map, {});
   const auto first = next_layer<transport::VoxelLayer>(reader);
   EXPECT_EQ(first.cell, "cell-1");
   EXPECT_EQ(first.sweep, 2u);
@@ -70,16 +74,16 @@ TEST_F(LayerPublisherTest, VoxelsGoOutWhenTheyChangeOrAReaderJoins) {
   const std::vector<transport::VoxelRun> rows{{0, 0, 0, 5}, {0, 1, 0, 5}, {0, 2, 0, 5}};
   EXPECT_EQ(first.runs, rows);
 
-  layers.after_sweep(3, map, {});  // unchanged and nobody new: not written
+  layers.after_sweep(3, {}, map, {});  // unchanged and nobody new: not written
   map.integrate(floor_sweep(6, 3));
-  layers.after_sweep(4, map, {});
+  layers.after_sweep(4, {}, map, {});
   const auto second = next_layer<transport::VoxelLayer>(reader);
   EXPECT_EQ(second.sweep, 4u);  // not 3
   EXPECT_EQ(second.voxel_count(), 18u);
 
   transport::LayerReader newcomer(viewer, Layer::kVoxels);
   wait_until_read(daemon, Layer::kVoxels, 2);
-  layers.after_sweep(5, map, {});  // unchanged, but the newcomer has nothing yet
+  layers.after_sweep(5, {}, map, {});  // unchanged, but the newcomer has nothing yet
   EXPECT_EQ(next_layer<transport::VoxelLayer>(newcomer).sweep, 5u);
   EXPECT_EQ(next_layer<transport::VoxelLayer>(reader).sweep, 5u);
 }
@@ -92,16 +96,16 @@ TEST_F(LayerPublisherTest, ChangeRegionsGoOutForSweepsThatConfirmedSome) {
   transport::LayerReader reader(viewer, Layer::kChangeRegions);
   wait_until_read(daemon, Layer::kChangeRegions, 1);
 
-  layers.after_sweep(1, map, {});  // the reader just joined: it learns there is nothing yet
+  layers.after_sweep(1, {}, map, {});  // the reader just joined: it learns there is nothing yet
   EXPECT_TRUE(next_layer<transport::ChangeRegionLayer>(reader).regions.empty());
-  layers.after_sweep(2, map, {});  // nothing confirmed: not written
+  layers.after_sweep(2, {}, map, {});  // nothing confirmed: not written
   ChangeSet changes;
   ChangeRegion region;
   region.bounds = {{0.1, 0.2, 0.3}, {0.4, 0.5, 0.6}};
   region.appeared.resize(7);
   region.vanished.resize(2);
   changes.regions.push_back(region);
-  layers.after_sweep(3, map, changes);
+  layers.after_sweep(3, {}, map, changes);
   const auto got = next_layer<transport::ChangeRegionLayer>(reader);
   EXPECT_EQ(got.sweep, 3u);
   ASSERT_EQ(got.regions.size(), 1u);
@@ -109,6 +113,53 @@ TEST_F(LayerPublisherTest, ChangeRegionsGoOutForSweepsThatConfirmedSome) {
   EXPECT_EQ(got.regions[0].bounds.max, region.bounds.max);
   EXPECT_EQ(got.regions[0].appeared, 7u);
   EXPECT_EQ(got.regions[0].vanished, 2u);
+}
+
+// A camera frame (a 4 × 2 depth image, 1 m everywhere) and a line scanner's frame at two poses.
+std::vector<Frame> camera_and_scanner_frames() {
+  Frame camera;
+  camera.sensor = "kinect";
+  camera.X_CS = Eigen::Translation3d(1.0, 2.0, 2.4) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX());
+  camera.depth = DepthImage{{4, 2, 2.0, 2.0, 1.5, 0.5, 0.001, 0.5, 4.5}, std::vector<std::uint16_t>(8, 1000)};
+  camera.points_S = depth_to_points(*camera.depth);
+  Frame scanner;
+  scanner.sensor = "os32c";
+  scanner.X_CS = Eigen::Translation3d(0.5, 0.0, 1.0) * Eigen::Isometry3d::Identity();
+  scanner.field_of_view = FieldOfView{{{1, 0, 0}, {0, 1, 0}}, false, 10.0};
+  return {camera, scanner};
+}
+
+TEST_F(LayerPublisherTest, SensorViewsGoOutAfterEachSweepWhileRead) {
+  dds::Participant daemon(kDomain);
+  dds::Participant viewer(kDomain);
+  LayerPublisher layers(daemon, "cell-1");
+  const OccupancyMap map;
+  const Sweep sweep = merge_frames(camera_and_scanner_frames());
+  layers.after_sweep(1, sweep, map, {});  // nobody reads: not written
+
+  transport::LayerReader reader(viewer, Layer::kSensors);
+  wait_until_read(daemon, Layer::kSensors, 1);
+  layers.after_sweep(2, sweep, map, {});
+  const auto got = next_layer<transport::SensorLayer>(reader);
+  EXPECT_EQ(got.sweep, 2u);
+  ASSERT_EQ(got.views.size(), 2u);
+  EXPECT_EQ(got.views[0].sensor, "kinect");
+  EXPECT_TRUE(got.views[0].X_CS.isApprox(sweep.scans[0].X_CS, 1e-12));
+  ASSERT_TRUE(got.views[0].field_of_view);
+  const FieldOfView& frustum = *got.views[0].field_of_view;
+  EXPECT_TRUE(frustum.closed);
+  EXPECT_EQ(frustum.max_range, 4.5);
+  ASSERT_EQ(frustum.outline_S.size(), 4u);
+  // The image's top left edge, (-0.5, -0.5) in pixels, is at x = (-0.5 - 1.5) / 2, y = (-0.5 - 0.5) / 2.
+  EXPECT_TRUE(frustum.outline_S[0].isApprox(Eigen::Vector3d(-1.0, -0.5, 1.0).normalized(), 1e-12));
+  EXPECT_TRUE(frustum.outline_S[2].isApprox(Eigen::Vector3d(1.0, 0.5, 1.0).normalized(), 1e-12));
+  EXPECT_EQ(got.views[1].sensor, "os32c");
+  ASSERT_TRUE(got.views[1].field_of_view);
+  EXPECT_FALSE(got.views[1].field_of_view->closed);
+  EXPECT_EQ(got.views[1].field_of_view->outline_S, sweep.scans[1].field_of_view->outline_S);
+
+  layers.after_sweep(3, sweep, map, {});  // the sensors move with every sweep: written each time
+  EXPECT_EQ(next_layer<transport::SensorLayer>(reader).sweep, 3u);
 }
 
 }  // namespace

@@ -50,6 +50,15 @@ TEST(LayerWireSizeTest, EightBytesPerRunAndFiftySixPerRegion) {
   EXPECT_EQ(wire_size(regions) - ten_regions, 560u);  // six doubles and two uint32 each
 }
 
+TEST(LayerWireSizeTest, TwentyFourBytesPerOutlineRay) {
+  SensorView view{"kinect", Eigen::Isometry3d::Identity(), FieldOfView{{}, true, 4.5}};
+  view.field_of_view->outline_S.assign(4, Eigen::Vector3d::UnitZ());
+  SensorLayer layer{"cell-1", 3, 0, {view}};
+  const std::size_t four_rays = wire_size(layer);
+  layer.views[0].field_of_view->outline_S.resize(14, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(wire_size(layer) - four_rays, 240u);  // x, y, z as doubles
+}
+
 class LayerDdsTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { test::use_loopback(); }

@@ -226,6 +226,7 @@ class ViewTest(unittest.TestCase):
         for round_number in range(rounds):
             daemon, view = self.round(daemon, view, port, round_number)
         self.check_layers(daemon)
+        self.check_sensors(daemon)
         self.assertTrue(self.js('window.notReloaded === true'), 'the page was reloaded')
 
     def round(self, daemon, view, port, round_number):
@@ -314,6 +315,54 @@ class ViewTest(unittest.TestCase):
         self.check_screenshot()
         self.browser.find_element(By.ID, 'layer-voxels').click()
         wait_for(lambda: 'layer voxels: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+
+
+    def check_sensors(self, daemon):
+        """Ticking "sensors" makes the daemon publish its frames' poses and fields of view, and the page draws
+        each frustum: along the lines from each sensor, pixels turn the frustum colour."""
+        before = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+        self.browser.find_element(By.ID, 'layer-sensors').click()
+        logged = wait_for(lambda: re.search(r'layer sensors: (\d+) views, (\d+) bytes', daemon.log_text()),
+                          'the daemon to publish the sensor views')
+        views, size = int(logged.group(1)), int(logged.group(2))
+        self.log(f'sensor layer: {views} views, {size} bytes per sweep')
+        self.assertGreater(views, 0)
+        segments = wait_for(lambda: (lambda s: s if len(s) == views else None)(self.js('cellmapView.sensorSegments()')),
+                            'the sensor views on the page')
+        ratio = self.js('window.devicePixelRatio')
+        samples = []
+        for segment in segments:
+            self.assertIsNotNone(segment, 'a simulated camera knows its field of view')
+            origin, end = segment
+            # The upper part of each line: above every object of the default cell, so nothing hides it.
+            for t in [0.05 + 0.3 * i / 9 for i in range(10)]:
+                point = [o + t * (e - o) for o, e in zip(origin, end)]
+                x, y = self.js('cellmapView.project(%f, %f, %f)' % tuple(point))
+                samples.append((int(x * ratio), int(y * ratio)))
+
+        def drawn_fraction():
+            after = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+            hits = sum(1 for x, y in samples if frustum_pixel_near(before, after, x, y))
+            return hits / len(samples)
+        fraction = wait_for(lambda: (lambda f: f if f >= 0.8 else None)(drawn_fraction()),
+                            'the frustum lines drawn')
+        self.log(f'{fraction:.0%} of {len(samples)} points along the frustum lines drawn in its colour')
+        self.browser.find_element(By.ID, 'layer-sensors').click()
+        wait_for(lambda: 'layer sensors: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+
+
+def frustum_pixel_near(before, after, x, y, radius=2):
+    """Whether a pixel within `radius` of (x, y) turned the frustum colour (teal, 0x008c8c, antialiased over
+    the light background: green and blue well above red)."""
+    for dx in range(-radius, radius + 1):
+        for dy in range(-radius, radius + 1):
+            p = (x + dx, y + dy)
+            if not (0 <= p[0] < after.width and 0 <= p[1] < after.height):
+                continue
+            r, g, b = after.getpixel(p)
+            if g - r > 40 and b - r > 40 and abs(g - b) < 50 and after.getpixel(p) != before.getpixel(p):
+                return True
+    return False
 
 
 def main():

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 namespace cellmap::view {
@@ -165,6 +168,30 @@ TEST(ViewStateTest, LayersAreForwardedAndTheLatestIsKept) {
   voxels.sweep = 14;
   state.on_layer(voxels);
   EXPECT_EQ(json::parse(state.layers(transport::Layer::kVoxels)[0])["sweep"], 14);
+}
+
+TEST(ViewStateTest, SensorViewsCarryPoseAndOutline) {
+  ViewState state(0, "");
+  transport::SensorView camera{"kinect", Eigen::Isometry3d::Identity(), FieldOfView{{{0, 0, 1}}, true, 4.5}};
+  camera.X_CS.translation() = Eigen::Vector3d(1, 2, 3);
+  camera.X_CS.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const transport::SensorView unknown{"replay", Eigen::Isometry3d::Identity(), std::nullopt};
+  const json message =
+      json::parse(state.on_layer(transport::SensorLayer{"cell-a", 7, 99, {camera, unknown}}));
+  EXPECT_EQ(message["type"], "sensors");
+  ASSERT_EQ(message["views"].size(), 2u);
+  const json& view = message["views"][0];
+  EXPECT_EQ(view["sensor"], "kinect");
+  EXPECT_EQ(view["position"], json::array({1.0, 2.0, 3.0}));
+  EXPECT_NEAR(view["rotation"][0].get<double>(), std::sqrt(0.5), 1e-12);  // w of 90° about z
+  EXPECT_NEAR(view["rotation"][3].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(view["outline"], json::array({json::array({0.0, 0.0, 1.0})}));
+  EXPECT_EQ(view["closed"], true);
+  EXPECT_EQ(view["max_range"], 4.5);
+  EXPECT_EQ(message["views"][1]["outline"], json::array());
+  EXPECT_EQ(message["views"][1]["max_range"], 0.0);
+  EXPECT_EQ(state.layers(transport::Layer::kSensors).size(), 1u);
+  EXPECT_TRUE(state.layers(transport::Layer::kChangeRegions).empty());
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/view/cell_follower.hpp"
@@ -26,38 +27,43 @@ struct ViewOptions {
   view::WebServerOptions server;
 };
 
+using Layers = std::set<transport::Layer>;
+
 // Which layers each page shows; a layer is read from DDS while at least one page shows it.
 class PageLayers {
  public:
-  struct Wanted {
-    bool voxels = false;
-    bool regions = false;
-  };
   /// Records what `page` shows now; returns the layers it newly turned on.
-  Wanted set(view::PageId page, Wanted wanted) {
+  Layers set(view::PageId page, Layers shown) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    const Wanted before = pages_[page];
-    pages_[page] = wanted;
-    return {wanted.voxels && !before.voxels, wanted.regions && !before.regions};
+    Layers turned_on;
+    for (const transport::Layer layer : shown)
+      if (pages_[page].count(layer) == 0) turned_on.insert(layer);
+    pages_[page] = std::move(shown);
+    return turned_on;
   }
   void forget(view::PageId page) {
     const std::lock_guard<std::mutex> lock(mutex_);
     pages_.erase(page);
   }
-  [[nodiscard]] Wanted any() const {
+  [[nodiscard]] Layers any() const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    Wanted out;
-    for (const auto& [page, wanted] : pages_) {
-      out.voxels = out.voxels || wanted.voxels;
-      out.regions = out.regions || wanted.regions;
-    }
+    Layers out;
+    for (const auto& [page, shown] : pages_) out.insert(shown.begin(), shown.end());
     return out;
   }
 
  private:
   mutable std::mutex mutex_;
-  std::map<view::PageId, Wanted> pages_;
+  std::map<view::PageId, Layers> pages_;
 };
+
+// {"type":"layers", NAME: bool...}: the layers a page shows (a missing name is not shown).
+Layers layers_shown(const nlohmann::json& message) {
+  Layers shown;
+  for (const transport::Layer layer : transport::kLayers)
+    if (message.value(view::layer_name(layer), false)) shown.insert(layer);
+  return shown;
+}
 
 void run_view(const ViewOptions& options) {
   std::signal(SIGINT, request_stop);
@@ -73,12 +79,11 @@ void run_view(const ViewOptions& options) {
   callbacks.on_message = [&](view::PageId page, const std::string& text) {
     // A page only asks to see things; anything malformed is ignored.
     std::string type;
-    PageLayers::Wanted turned_on;
+    Layers turned_on;
     try {
       const nlohmann::json message = nlohmann::json::parse(text);
       type = message.at("type").get<std::string>();
-      if (type == "layers")
-        turned_on = layers.set(page, {message.at("voxels").get<bool>(), message.at("regions").get<bool>()});
+      if (type == "layers") turned_on = layers.set(page, layers_shown(message));
     } catch (const nlohmann::json::exception&) {
       return;
     }
@@ -87,11 +92,8 @@ void run_view(const ViewOptions& options) {
     if (type == "resync") server->send_state(page);
     // A page that turns a layer on gets the latest one at once, if there is one; later ones come with
     // everyone's.
-    if (turned_on.voxels)
-      for (std::string& layer : state.layers(transport::Layer::kVoxels)) server->send(page, std::move(layer));
-    if (turned_on.regions)
-      for (std::string& layer : state.layers(transport::Layer::kChangeRegions))
-        server->send(page, std::move(layer));
+    for (const transport::Layer layer : turned_on)
+      for (std::string& message : state.layers(layer)) server->send(page, std::move(message));
   };
   callbacks.on_close = [&layers](view::PageId page) { layers.forget(page); };
 
@@ -109,8 +111,7 @@ void run_view(const ViewOptions& options) {
             << (options.cell.empty() ? std::string("every cell") : "cell " + options.cell) << "; read-only)"
             << std::endl;
   while (stop_requested == 0) {
-    const PageLayers::Wanted wanted = layers.any();
-    follower.want_layers(wanted.voxels, wanted.regions);
+    follower.want_layers(layers.any());
     follower.poll(std::chrono::milliseconds(100));
   }
   const std::lock_guard<std::mutex> lock(server_mutex);

@@ -40,6 +40,7 @@ SimFrame Simulator::render(int sensor, const Eigen::VectorXd& q, double stamp, s
   out.frame.sensor = spec.name;
   out.frame.stamp = stamp;
   out.frame.X_CS = X_CS;
+  if (!spec.is_camera()) out.frame.field_of_view = spec.scanner.field_of_view();
   return out;
 }
 

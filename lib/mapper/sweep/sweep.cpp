@@ -20,6 +20,9 @@ std::size_t Sweep::point_count() const {
 Scan to_scan(const Frame& frame) {
   Scan scan;
   scan.origin_C = frame.X_CS.translation();
+  scan.sensor = frame.sensor;
+  scan.X_CS = frame.X_CS;
+  scan.field_of_view = field_of_view(frame);
   const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
   scan.points_C.reserve(frame.points_S.size());
   for (const pcl::PointXYZ& p : frame.points_S) {

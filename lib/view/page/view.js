@@ -419,13 +419,14 @@ $('cell-select').addEventListener('change', (e) => {
 // ---- messages from the server ----
 function newCell(name) {
   return { name, version: 0, stamp_ns: 0, joined_at: 0, boxes: new Map(), timeline: [], status: null,
-           voxels: null, regions: null };
+           voxels: null, regions: null, sensors: null };
 }
 
 function onState(message) {
   domain = message.domain;
   cellFilter = message.cell_filter;
-  const layers = new Map([...cells].map(([name, c]) => [name, { voxels: c.voxels, regions: c.regions }]));
+  const layers = new Map([...cells].map(([name, c]) => [name, { voxels: c.voxels, regions: c.regions,
+                                                                   sensors: c.sensors }]));
   cells.clear();
   for (const c of message.cells) {
     const cell = newCell(c.cell);
@@ -521,6 +522,7 @@ function rebuildLayers() {
   for (const entry of meshes.values()) entry.mesh.material.opacity = voxels ? 0.25 : BOX_OPACITY;
   if (voxels) layerGroup.add(voxelObject(cell.voxels));
   if ($('layer-regions').checked && cell.regions) layerGroup.add(regionObject(cell.regions));
+  if ($('layer-sensors').checked && cell.sensors) layerGroup.add(sensorObject(cell.sensors));
   requestRender();
 }
 
@@ -560,12 +562,48 @@ function regionObject(layer) {
   return group;
 }
 
+// Each frame's sensor: a small axes cross at its pose, and its field of view as lines from the sensor out to
+// its range or to the floor (z = 0), whichever is nearer; a camera's far corners joined into its frustum.
+const SENSOR_COLOUR = 0x008c8c;
+
+function sensorObject(layer) {
+  const group = new THREE.Group();
+  const material = new THREE.LineBasicMaterial({ color: SENSOR_COLOUR });
+  const segments = [];  // per view: [origin, end of the first ray] in the cell frame, for tests
+  for (const view of layer.views) {
+    const origin = new THREE.Vector3(...view.position);
+    const [w, x, y, z] = view.rotation;
+    const rotation = new THREE.Quaternion(x, y, z, w);
+    const axes = new THREE.AxesHelper(0.1);
+    axes.position.copy(origin);
+    axes.quaternion.copy(rotation);
+    group.add(axes);
+    const ends = view.outline.map((ray) => {
+      const direction = new THREE.Vector3(...ray).applyQuaternion(rotation);
+      const toFloor = direction.z < 0 ? -origin.z / direction.z : Infinity;
+      return origin.clone().addScaledVector(direction, Math.min(view.max_range, toFloor));
+    });
+    const points = [];
+    for (const end of ends) points.push(origin, end);
+    for (let i = 0; i + 1 < ends.length; ++i) points.push(ends[i], ends[i + 1]);
+    if (view.closed && ends.length > 2) points.push(ends[ends.length - 1], ends[0]);
+    if (points.length > 0) {
+      group.add(new THREE.LineSegments(new THREE.BufferGeometry().setFromPoints(points), material));
+    }
+    segments.push(ends.length > 0 ? [origin, ends[0]] : null);
+  }
+  group.userData.segments = segments;
+  return group;
+}
+
 function sendLayers() {
-  send({ type: 'layers', voxels: $('layer-voxels').checked, regions: $('layer-regions').checked });
+  send({ type: 'layers', voxels: $('layer-voxels').checked, regions: $('layer-regions').checked,
+         sensors: $('layer-sensors').checked });
   rebuildLayers();
 }
 $('layer-voxels').addEventListener('change', sendLayers);
 $('layer-regions').addEventListener('change', sendLayers);
+$('layer-sensors').addEventListener('change', sendLayers);
 
 // ---- the WebSocket: reconnects by itself, and the server sends the whole state on each connection ----
 let retryMs = 500;
@@ -594,7 +632,7 @@ function connect() {
     if (message.type === 'state') onState(message);
     else if (message.type === 'version') onVersion(message);
     else if (message.type === 'status') onStatus(message);
-    else if (message.type === 'voxels' || message.type === 'regions') onLayer(message);
+    else if (['voxels', 'regions', 'sensors'].includes(message.type)) onLayer(message);
   };
   socket.onclose = () => {
     if (connected) setConnection('reconnecting', 'bad');
@@ -620,6 +658,11 @@ window.cellmapView = {
     const p = new THREE.Vector3(x, y, z).project(camera);
     const rect = canvas.getBoundingClientRect();
     return [rect.left + ((p.x + 1) / 2) * rect.width, rect.top + ((1 - p.y) / 2) * rect.height];
+  },
+  // The sensor views drawn: per view, its origin and the end of its first ray as drawn (cell frame), or null.
+  sensorSegments: () => {
+    const group = layerGroup.children.find((o) => o.userData.segments);
+    return group ? group.userData.segments.map((s) => s && s.map((p) => [p.x, p.y, p.z])) : [];
   },
   latency,
 };

@@ -10,7 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
+#include <set>
 #include <string>
 
 #include "cellmap/transport/environment_subscriber.hpp"
@@ -35,13 +35,13 @@ class CellFollower final {
   void poll(std::chrono::nanoseconds timeout);
   /// Which layers some page shows. A layer's reader exists only while it is wanted, and that reader is what
   /// makes the daemons publish the layer.
-  void want_layers(bool voxels, bool regions);
+  void want_layers(std::set<transport::Layer> layers);
   /// The cells followed so far.
   [[nodiscard]] std::size_t cells() const { return subscribers_.size(); }
 
  private:
   void follow(const std::string& cell);
-  void open_or_close(std::optional<transport::LayerReader>& reader, transport::Layer layer, bool wanted);
+  void open_or_close(transport::Layer layer, bool wanted);
 
   const dds::Participant& participant_;
   std::string cell_;
@@ -49,12 +49,10 @@ class CellFollower final {
   Publish publish_;
   transport::StatusReader status_;
   std::map<std::string, std::unique_ptr<transport::EnvironmentSubscriber>> subscribers_;
-  std::optional<transport::LayerReader> voxels_;
-  std::optional<transport::LayerReader> regions_;
+  std::map<transport::Layer, std::unique_ptr<transport::LayerReader>> layer_readers_;
 
   std::mutex wanted_mutex_;
-  bool want_voxels_ = false;   // guarded by wanted_mutex_
-  bool want_regions_ = false;  // guarded by wanted_mutex_
+  std::set<transport::Layer> wanted_;  // guarded by wanted_mutex_
 };
 
 }  // namespace cellmap::view

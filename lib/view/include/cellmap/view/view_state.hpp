@@ -10,13 +10,17 @@
 //   {"type":"status", STATUS}                                        a daemon's report, or that it is gone
 //   {"type":"voxels", "cell", "sweep", "stamp_ns", "resolution", "runs":[x,y,z,length, ...]}
 //   {"type":"regions", "cell", "sweep", "stamp_ns", "regions":[{"min", "max", "appeared", "vanished"}...]}
+//   {"type":"sensors", "cell", "sweep", "stamp_ns", "views":[{"sensor", "position", "rotation" [w,x,y,z],
+//    "max_range", "closed", "outline":[[x,y,z]...]}...]}  (outline: unit rays in the sensor frame; empty and
+//    max_range 0 when unknown)
 // CELL = {"cell", "version", "stamp_ns", "boxes":[BOX...], "timeline":[ENTRY...], "status":STATUS|null}
 // BOX = {"id", "center", "half_extents", "rotation" [w,x,y,z], "points", "changed_in"} where changed_in is
 //   the version that added or last modified the box, null if that was before the viewer joined
 // ENTRY = {"from_version", "to_version", "stamp_ns", "received_ns", "added", "modified", "removed"} (counts)
 // STATUS = {"cell", "daemon" (false once it is gone), "state", "sensors":[{"name","state"}...],
 //   "last_sweep_ns", "sweeps", "dropped_frames", "boxes", "version"}
-// Page → server: {"type":"layers", "voxels":bool, "regions":bool} (which layers this page shows) and
+// Page → server: {"type":"layers", "voxels":bool, "regions":bool, "sensors":bool} (which layers this page
+// shows; a missing key is false) and
 // {"type":"resync"} (the page missed a version: it gets a "state" again).
 
 #include <cstddef>
@@ -33,6 +37,9 @@
 
 namespace cellmap::view {
 
+/// A layer's name in the page protocol: its message type and its key in a "layers" request.
+[[nodiscard]] const char* layer_name(transport::Layer layer);
+
 /// Thread-safe: DDS callbacks update it while the web server reads it.
 class ViewState final {
  public:
@@ -48,7 +55,8 @@ class ViewState final {
   /// The cell's daemon is gone (its status writer left or its lease expired). Returns the "status" message,
   /// with daemon false and the last report's fields.
   std::string on_daemon_gone(const std::string& cell);
-  /// A layer arrived. Returns the "voxels" or "regions" message, which is also kept for pages that ask later.
+  /// A layer arrived. Returns its message ("voxels", "regions" or "sensors"), which is also kept for pages
+  /// that ask later.
   std::string on_layer(const transport::LayerMessage& layer);
 
   /// The "state" message: every cell as it is now.
@@ -72,7 +80,7 @@ class ViewState final {
     std::deque<TimelineEntry> timeline;
     std::optional<transport::CellStatus> status;
     bool daemon = false;
-    std::optional<std::string> voxels, regions;  // the latest layer messages
+    std::map<transport::Layer, std::string> layers;  // the latest message of each layer
   };
 
   [[nodiscard]] bool followed(const std::string& cell) const;

@@ -15,6 +15,7 @@ inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
 inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
 inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
 inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
+inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
