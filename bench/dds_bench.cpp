@@ -4,6 +4,12 @@
 //
 // Latency is one way, publisher write -> subscriber callback, on the shared CLOCK_MONOTONIC; each change is
 // published once the previous one arrived (no queueing). Bytes are the serialized sample (wire_size).
+//
+// The cost of DDS Security, in the same run: the delta path again with both processes secured (credentials
+// made by the library of `cellmap security init`), data signed (AES-GMAC) and encrypted (AES-GCM), against
+// the plain one; latency, and the bytes that cross the loopback interface per change (every RTPS message:
+// data, heartbeats, acknowledgements; /sys/class/net/lo, so run it where nothing else uses loopback, e.g. in
+// a network namespace).
 #include <benchmark/benchmark.h>
 #include <poll.h>
 #include <signal.h>
@@ -15,10 +21,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "cellmap/security/cell_setup.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "ratio_report.hpp"
@@ -74,10 +84,63 @@ Environment one_box_moved(const Environment& env) {
   return Environment(kCell, env.version() + 1, 0, std::move(boxes));
 }
 
+// Credentials for the secured runs, one set per data protection, removed at exit.
+class BenchCredentials {
+ public:
+  BenchCredentials() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "cellmap-bench-dds-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) std::abort();
+    directory_ = pattern;
+    write(signed_directory(), kSignedDomain, security::DataProtection::kSign);
+    write(encrypted_directory(), kEncryptedDomain, security::DataProtection::kEncrypt);
+  }
+  ~BenchCredentials() {
+    std::error_code ec;
+    std::filesystem::remove_all(directory_, ec);
+  }
+  [[nodiscard]] std::filesystem::path signed_directory() const { return directory_ / "signed"; }
+  [[nodiscard]] std::filesystem::path encrypted_directory() const { return directory_ / "encrypted"; }
+  static constexpr std::uint32_t kSignedDomain = 142;
+  static constexpr std::uint32_t kEncryptedDomain = 143;
+
+ private:
+  static void write(const std::filesystem::path& directory, std::uint32_t domain,
+                    security::DataProtection data) {
+    security::CellSetup setup;
+    setup.directory = directory;
+    setup.cell = kCell;
+    setup.domain = domain;
+    setup.valid_from = std::chrono::system_clock::now() - std::chrono::hours(1);
+    setup.valid_until = setup.valid_from + std::chrono::hours(24);
+    setup.grants = transport::role_grants();
+    setup.data_protection = data;
+    security::write_cell_credentials(setup);
+  }
+  std::filesystem::path directory_;
+};
+
+BenchCredentials& credentials() {
+  static BenchCredentials made;
+  return made;
+}
+
+// Bytes sent over the loopback interface so far (0 where the counter cannot be read).
+std::uint64_t loopback_bytes() {
+  std::ifstream in("/sys/class/net/lo/statistics/tx_bytes");
+  std::uint64_t bytes = 0;
+  in >> bytes;
+  return bytes;
+}
+
+std::optional<security::Setting> secured_as(const std::string& directory, security::Role role) {
+  if (directory.empty()) return std::nullopt;
+  return security::Setting{directory, role};
+}
+
 // --- the subscriber process -------------------------------------------------------------------------------
 
-int run_delta_subscriber(std::uint32_t domain) {
-  const dds::Participant participant(domain);
+int run_delta_subscriber(std::uint32_t domain, const std::string& security_directory) {
+  const dds::Participant participant(domain, secured_as(security_directory, security::Role::kPlanner));
   transport::EnvironmentSubscriber subscriber(
       participant, kCell, [](const Environment& env, const EnvironmentDelta&) { report(env.version()); });
   ::pause();  // killed by the parent
@@ -105,7 +168,8 @@ int run_snapshot_subscriber(std::uint32_t domain) {
 
 class SubscriberProcess {
  public:
-  SubscriberProcess(const char* mode, std::uint32_t domain) {
+  /// With a security directory, the subscriber joins as its planner.
+  SubscriberProcess(const char* mode, std::uint32_t domain, const std::string& security_directory = "") {
     int fds[2];
     if (::pipe(fds) != 0) std::abort();
     pid_ = ::fork();
@@ -114,7 +178,8 @@ class SubscriberProcess {
       ::close(fds[0]);
       ::close(fds[1]);
       const std::string domain_text = std::to_string(domain);
-      ::execl("/proc/self/exe", "cellmap-bench-dds", "--subscriber", mode, domain_text.c_str(), nullptr);
+      ::execl("/proc/self/exe", "cellmap-bench-dds", "--subscriber", mode, domain_text.c_str(),
+              security_directory.c_str(), nullptr);
       std::_Exit(127);
     }
     ::close(fds[1]);
@@ -177,19 +242,46 @@ void measure(benchmark::State& state, const std::string& name, SubscriberProcess
   set_percentiles(state, name, latencies_us);
 }
 
-void BM_DeltaOneBoxChange(benchmark::State& state) {
-  SubscriberProcess subscriber("delta", 140);
-  const dds::Participant participant(140);
+// Loopback bytes per change of each delta benchmark, kept for the security ratio lines.
+std::map<std::string, double>& loopback_bytes_per_change() {
+  static std::map<std::string, double> by_benchmark;
+  return by_benchmark;
+}
+
+// The delta path: publisher here, planner client in the subscriber process, both secured from `directory`
+// (as daemon and planner) unless it is empty.
+void delta_one_box_change(benchmark::State& state, const std::string& name, std::uint32_t domain,
+                          const std::string& directory) {
+  SubscriberProcess subscriber("delta", domain, directory);
+  const dds::Participant participant(domain, secured_as(directory, security::Role::kDaemon));
   transport::EnvironmentPublisher publisher(participant, kCell);
   const Environment first = cell_with_boxes(1);
   publisher.publish(first);
   if (!subscriber.wait_for(1)) return state.SkipWithError("the subscriber never got version 1");
-  measure(state, "BM_DeltaOneBoxChange", subscriber, first,
-          [&](const Environment& before, const Environment& after) {
-            publisher.publish(after, diff(before, after));
-          });
+  const std::uint64_t bytes_before = loopback_bytes();
+  measure(state, name, subscriber, first, [&](const Environment& before, const Environment& after) {
+    publisher.publish(after, diff(before, after));
+  });
   state.counters["bytes_per_change"] =
       static_cast<double>(transport::wire_size(diff(first, one_box_moved(first))));
+  const double loopback =
+      static_cast<double>(loopback_bytes() - bytes_before) / static_cast<double>(state.iterations());
+  state.counters["loopback_bytes_per_change"] = loopback;
+  loopback_bytes_per_change()[name] = loopback;
+}
+
+void BM_DeltaOneBoxChange(benchmark::State& state) {
+  delta_one_box_change(state, "BM_DeltaOneBoxChange", 140, "");
+}
+
+void BM_DeltaOneBoxChangeSigned(benchmark::State& state) {
+  delta_one_box_change(state, "BM_DeltaOneBoxChangeSigned", BenchCredentials::kSignedDomain,
+                       credentials().signed_directory().string());
+}
+
+void BM_DeltaOneBoxChangeEncrypted(benchmark::State& state) {
+  delta_one_box_change(state, "BM_DeltaOneBoxChangeEncrypted", BenchCredentials::kEncryptedDomain,
+                       credentials().encrypted_directory().string());
 }
 
 void BM_FullSnapshotEachChange(benchmark::State& state) {
@@ -211,15 +303,42 @@ void BM_FullSnapshotEachChange(benchmark::State& state) {
 
 BENCHMARK(BM_DeltaOneBoxChange)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FullSnapshotEachChange)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DeltaOneBoxChangeSigned)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DeltaOneBoxChangeEncrypted)->Iterations(3000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+// "ratio dds security cost, ...": secured over plain, both measured above (above 1: what security costs).
+void print_security_costs() {
+  const auto plain = percentiles().find("BM_DeltaOneBoxChange");
+  const auto plain_bytes = loopback_bytes_per_change().find("BM_DeltaOneBoxChange");
+  for (const char* kind : {"Signed", "Encrypted"}) {
+    const std::string name = std::string("BM_DeltaOneBoxChange") + kind;
+    const auto secured = percentiles().find(name);
+    if (plain == percentiles().end() || secured == percentiles().end()) continue;
+    const char* label = kind[0] == 'S' ? "signed" : "encrypted";
+    std::printf("ratio dds security cost, one-box change latency p50, %s: %.2fx (%.1f us vs plain %.1f us)\n",
+                label, secured->second.first / plain->second.first, secured->second.first,
+                plain->second.first);
+    std::printf("ratio dds security cost, one-box change latency p99, %s: %.2fx (%.1f us vs plain %.1f us)\n",
+                label, secured->second.second / plain->second.second, secured->second.second,
+                plain->second.second);
+    const auto bytes = loopback_bytes_per_change().find(name);
+    if (plain_bytes != loopback_bytes_per_change().end() && bytes != loopback_bytes_per_change().end() &&
+        plain_bytes->second > 0) {
+      std::printf(
+          "ratio dds security cost, loopback bytes per one-box change, %s: %.2fx (%.0f B vs plain %.0f B)\n",
+          label, bytes->second / plain_bytes->second, bytes->second, plain_bytes->second);
+    }
+  }
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   ::setenv("CYCLONEDDS_URI", kLoopbackConfig, 0);  // keep the caller's configuration if there is one
-  if (argc == 4 && std::strcmp(argv[1], "--subscriber") == 0) {
+  if (argc == 5 && std::strcmp(argv[1], "--subscriber") == 0) {
     try {
       const auto domain = static_cast<std::uint32_t>(std::stoul(argv[3]));
-      return std::strcmp(argv[2], "delta") == 0 ? run_delta_subscriber(domain)
+      return std::strcmp(argv[2], "delta") == 0 ? run_delta_subscriber(domain, argv[4])
                                                 : run_snapshot_subscriber(domain);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cellmap-bench-dds subscriber: %s\n", e.what());
@@ -244,5 +363,6 @@ int main(int argc, char** argv) {
   std::printf("ratio dds bytes per one-box change (%d boxes): %.2fx (delta %zu B, snapshot %zu B)\n", kBoxes,
               static_cast<double>(snapshot_bytes) / static_cast<double>(delta_bytes), delta_bytes,
               snapshot_bytes);
+  print_security_costs();
   return status;
 }

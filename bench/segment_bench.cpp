@@ -6,6 +6,8 @@
 //   region_growing_gap  ours                           vs pcl::RegionGrowing + the gap in validatePoint
 //   obb              ours (PCA + axis refinement)      vs pcl::MomentOfInertiaEstimation::getOBB
 // on the segments of our own pipeline for the OBB stage. A ratio above 1 means ours is faster.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 //
 // And the cell pipeline (cellmap/cell/cell_pipeline.hpp, with cellmapd's defaults) on a simulated 30-object
 // cell (the default cell's floor, table and legs plus 24 objects on the table, Kinect model with noise): the

@@ -4,8 +4,8 @@
 #   cellmap::cellmap  every stage (the umbrella target `cellmap`)
 #   cellmap::client   what a planner needs: subscribe to a cell (transport), environments, collision, paths
 #   cellmap::<stage>  each stage library, e.g. cellmap::transport
-# in two components: `client` (cellmap::client and the stages it links: needs Eigen and Cyclone DDS only) and
-# `mapper` (every other stage; needs PCL, OctoMap, urdfdom, yaml-cpp and the camera libraries).
+# in two components: `client` (cellmap::client and the stages it links: needs Eigen, Cyclone DDS and OpenSSL
+# only) and `mapper` (every other stage; needs PCL, OctoMap, urdfdom, yaml-cpp and the camera libraries).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 

@@ -21,13 +21,25 @@ Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
+// Readers report the DDS inputs they refuse here: counted in the status, logged at most once a second.
+transport::OnRefused refuse(InputRefusals& refusals) {
+  return [&refusals](const std::string& reason) { refusals.refuse(reason); };
+}
+
+// Scene edits must stay inside the simulated cell.
+transport::InputLimits inside(const SimulatedCell& cell) {
+  transport::InputLimits limits;
+  limits.cell = Eigen::AlignedBox3d(cell.scene().cell.min, cell.scene().cell.max);
+  return limits;
+}
+
 // The simulated cell: one sweep every sweep_period (or as fast as taken), scene edits applied between sweeps.
 class SimAcquisition final : public Acquisition {
  public:
   SimAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
       : cell_name_(config.cell),
         cell_(config.source),
-        edits_(participant),
+        edits_(participant, inside(cell_), refuse(output.refusals)),
         output_(output),
         sweep_period_(config.sweep_period) {}
 
@@ -70,7 +82,7 @@ class SimAcquisition final : public Acquisition {
       try {
         spdlog::info("scene edit applied: {}", cell_.apply(edit));
       } catch (const Error& e) {
-        spdlog::warn("scene edit rejected: {}", e.what());
+        output_.refusals.refuse(e.what());
       }
     }
   }
@@ -86,7 +98,7 @@ class SimAcquisition final : public Acquisition {
 class CameraAcquisition final : public Acquisition {
  public:
   CameraAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
-      : camera_(config.source, participant, config.cell),
+      : camera_(config.source, participant, config.cell, refuse(output.refusals)),
         output_(output),
         pose_tolerance_(config.source.camera.pose_tolerance) {
     const auto* replay = std::get_if<ReplayConfig>(&config.source.camera.source);

@@ -11,6 +11,7 @@
 #include "cellmap/transport/dds.hpp"
 #include "daemon_config.hpp"
 #include "health.hpp"
+#include "input_refusals.hpp"
 #include "latest_mailbox.hpp"
 
 namespace cellmap::daemon {
@@ -19,6 +20,8 @@ namespace cellmap::daemon {
 struct AcquisitionOutput {
   LatestMailbox<Sweep>& mailbox;
   Health& health;
+  /// The DDS inputs the source refused (scene edits, robot poses): outside the limits or not applicable.
+  InputRefusals& refusals;
   /// The version subscribers have, named in the log lines of a sensor that stops streaming.
   const std::atomic<std::uint64_t>& published_version;
 };

@@ -4,6 +4,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/sensor/replay_source.hpp"
+#include "cellmap/transport/topics.hpp"
 
 namespace cellmap::daemon {
 namespace {
@@ -16,11 +17,15 @@ std::size_t pose_capacity(const SourceConfig& config) {
 }  // namespace
 
 CameraInput::CameraInput(const SourceConfig& config, const dds::Participant& participant,
-                         const std::string& cell)
+                         const std::string& cell, transport::OnRefused on_refused)
     : source_(make_depth_source(config.camera)),
       poses_(config.camera.pose_tolerance, pose_capacity(config)),
-      assembler_(config.grouping, config.camera.X_ES) {
-  if (!std::holds_alternative<ReplayConfig>(config.camera.source)) robot_.emplace(participant, cell);
+      assembler_(config.grouping, config.camera.X_ES),
+      on_refused_(std::move(on_refused)) {
+  transport::InputLimits limits;
+  limits.max_stamp_skew = kMaxPoseSkew;
+  if (!std::holds_alternative<ReplayConfig>(config.camera.source))
+    robot_.emplace(participant, cell, limits, on_refused_);
 }
 
 SourceStatus CameraInput::open() {
@@ -38,8 +43,9 @@ std::vector<Sweep> CameraInput::step(std::chrono::milliseconds timeout) {
       try {
         poses_.push(static_cast<double>(state.stamp_ns) * 1e-9, state.X_CE);
         ++poses_received_;
-      } catch (const Error&) {
+      } catch (const Error& e) {
         ++poses_refused_;
+        if (on_refused_) on_refused_(std::string(transport::kRobotStateTopic) + ": " + e.what());
       }
     }
   }

@@ -17,12 +17,20 @@
 
 namespace cellmap::daemon {
 
+/// How far from the daemon's clock a robot pose's stamp may be. Frames are matched to poses within
+/// `source.pose_tolerance` (0.05 s by default), so a controller whose clock is off by more is useless anyway.
+inline constexpr std::chrono::seconds kMaxPoseSkew{5};
+
 /// Not thread-safe: the acquisition thread owns it. `participant` must outlive it.
 class CameraInput final {
  public:
+  /// Live cameras read the cell's robot poses; a pose outside the cell (transport::kMaxCellCoordinate) or
+  /// stamped more than kMaxPoseSkew from now is refused like a malformed one: counted, passed to
+  /// `on_refused`, never used.
   /// @throws Error if the camera settings are invalid (the source's constructor) or the robot-state reader
   /// cannot be created.
-  CameraInput(const SourceConfig& config, const dds::Participant& participant, const std::string& cell);
+  CameraInput(const SourceConfig& config, const dds::Participant& participant, const std::string& cell,
+              transport::OnRefused on_refused = {});
 
   /// Opens the camera; a missing device is not an error (the status says disconnected and it is retried).
   /// A replay's recorded poses are loaded into the pose buffer.
@@ -44,6 +52,7 @@ class CameraInput final {
   std::unique_ptr<DepthSource> source_;
   PoseBuffer poses_;
   SweepAssembler assembler_;
+  transport::OnRefused on_refused_;
   std::optional<transport::RobotStateReader> robot_;  // live cameras only
   std::uint64_t poses_received_ = 0;
   std::uint64_t poses_refused_ = 0;  // well-formed on the wire but refused by the pose buffer

@@ -14,22 +14,45 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
+// Once, at start: who may talk to this daemon.
+void log_dds_security(const dds::Participant& participant, int domain) {
+  const std::optional<security::Credentials>& credentials = participant.credentials();
+  if (!credentials) {
+    spdlog::warn(
+        "DDS Security off: any participant on DDS domain {} can publish scene edits and robot poses to this "
+        "daemon and read or forge its environment (see `cellmap security init`)",
+        domain);
+    return;
+  }
+  spdlog::info("DDS Security on: {} ({}), credentials valid until {}", credentials->subject,
+               credentials->files.certificate.parent_path().string(),
+               security::utc_text(credentials->expires));
+  const auto left = credentials->expires - std::chrono::system_clock::now();
+  if (left < std::chrono::hours(24 * 30)) {
+    spdlog::warn(
+        "DDS Security: the credentials expire in {} days; issue new ones (README, DDS Security: rotating)",
+        std::chrono::duration_cast<std::chrono::hours>(left).count() / 24);
+  }
+}
+
 }  // namespace
 
 Daemon::Daemon(DaemonConfig config, RunOptions options)
     : config_(std::move(config)),
       options_(std::move(options)),
       store_(config_.state_dir, config_.cell),
-      participant_(static_cast<std::uint32_t>(config_.domain)),
+      participant_(static_cast<std::uint32_t>(config_.domain), config_.security),
       publisher_(participant_, config_.cell, config_.delta_depth),
       layers_(participant_, config_.cell),
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
       keeper_(store_, [this](const Environment& env,
                              const EnvironmentDelta& delta) { publisher_.publish(env, delta); }),
-      health_(config_.cell, config_.source.sensor) {
+      health_(config_.cell, config_.source.sensor),
+      refusals_([](const std::string& line) { spdlog::warn("{}", line); }) {
+  log_dds_security(participant_, config_.domain);
   keeper_.resume(pipeline_);
   published_version_ = keeper_.published().version();
-  acquisition_ = make_acquisition(config_, participant_, {mailbox_, health_, published_version_});
+  acquisition_ = make_acquisition(config_, participant_, {mailbox_, health_, refusals_, published_version_});
   spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
                store_.directory().string(), acquisition_->describe(), keeper_.published().version());
 }
@@ -119,6 +142,7 @@ void Daemon::publish_status() {
   status.dropped_frames = mailbox_.dropped() + acquisition_->dropped_frames();
   status.boxes = keeper_.published().boxes().size();
   status.version = keeper_.published().version();
+  status.refused_inputs = refusals_.count();
   try {
     publisher_.publish_status(status);
     status_fault_.clear();

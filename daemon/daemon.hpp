@@ -15,6 +15,7 @@
 #include "cellmap/transport/environment_publisher.hpp"
 #include "daemon_config.hpp"
 #include "health.hpp"
+#include "input_refusals.hpp"
 #include "latest_mailbox.hpp"
 #include "layer_publisher.hpp"
 #include "signals.hpp"
@@ -55,6 +56,7 @@ class Daemon final {
   VersionKeeper keeper_;
   LatestMailbox<Sweep> mailbox_;
   Health health_;
+  InputRefusals refusals_;
   std::atomic<std::uint64_t> published_version_{0};  // for the acquisition thread's log lines
   std::unique_ptr<Acquisition> acquisition_;
   std::atomic<bool> stop_{false};

@@ -3,6 +3,7 @@
 #include <set>
 
 #include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/error.hpp"
 #include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap::daemon {
@@ -18,8 +19,22 @@ std::optional<SourceKind> source_kind(const std::string& text) {
   return std::nullopt;
 }
 
-// A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by the
-// user replaces the default pose whole instead of merging into it.
+// The `security` section: off while `directory` is empty.
+std::optional<security::Setting> read_security(YamlMap section, const std::filesystem::path& base_dir) {
+  const std::string directory = section.get<std::string>("directory", "");
+  const std::string role = section.get<std::string>("role", "daemon");
+  std::optional<security::Setting> setting;
+  try {
+    if (!directory.empty()) setting = security::Setting{base_dir / directory, security::parse_role(role)};
+  } catch (const Error&) {
+    section.fail("role", "must be one of daemon, planner, robot, tool");
+  }
+  section.expect_all_read();
+  return setting;
+}
+
+// A pose's position and rotation belong together (and `translation` spells `position`), so a pose given by
+// the user replaces the default pose whole instead of merging into it.
 bool is_pose(const YAML::Node& map) {
   return map["position"] || map["translation"] || map["rotation"];
 }
@@ -109,6 +124,7 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
 
   c.source = read_source(root.child("source"), c.sweep_period, base_dir);
   c.pipeline = CellPipelineConfig::from_yaml(root);
+  c.security = read_security(root.child("security"), base_dir);
   root.expect_all_read();
   return c;
 }

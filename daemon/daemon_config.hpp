@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/security/credentials.hpp"
 #include "cellmap/sensor/sensor_config.hpp"
 #include "cellmap/sweep/sweep_assembler.hpp"
 
@@ -51,6 +52,9 @@ struct DaemonConfig final {
   double status_period = 1.0;  ///< `status_period`: seconds between status messages
   std::uint32_t delta_depth = 16;  ///< `delta_depth`: deltas kept for late joiners
   std::string log_level = "info";  ///< `log_level`: trace | debug | info | warn | error
+  /// `security` section (`directory`, `role`; --security, --role override): DDS Security with the credentials
+  /// `cellmap security init` wrote (a relative directory is relative to the config file); nullopt = off.
+  std::optional<security::Setting> security;
   SourceConfig source;
   /// The sections `occupancy`, `change`, `segment` and `reconcile`: what makes the map and the boxes.
   CellPipelineConfig pipeline;

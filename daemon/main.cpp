@@ -22,6 +22,14 @@ int main(int argc, char** argv) {
       app.add_option("--domain", domain, "DDS domain id (overrides the config)")->check(CLI::Range(0, 232));
   auto* state_option = app.add_option("--state-dir", state_dir, "state directory (overrides the config)");
   app.add_option("--sweeps", options.max_sweeps, "stop after this many sweeps (0 = run until SIGTERM)");
+  std::string security_dir;
+  std::string role = "daemon";
+  auto* security_option = app.add_option(
+      "--security", security_dir, "DDS Security on, with the credentials in DIR (overrides the config)");
+  app.add_option("--role", role, "the role whose credentials to use")
+      ->check(CLI::IsMember({"daemon", "planner", "robot", "tool"}))
+      ->needs(security_option)
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -41,6 +49,8 @@ int main(int argc, char** argv) {
         config_file.empty() ? DaemonConfig::parse("", "defaults", ".") : DaemonConfig::load(config_file);
     if (*domain_option) config.domain = domain;
     if (*state_option) config.state_dir = state_dir;
+    if (*security_option)
+      config.security = cellmap::security::Setting{security_dir, cellmap::security::parse_role(role)};
     spdlog::set_level(spdlog::level::from_str(config.log_level));
     Daemon daemon(std::move(config), options);
     daemon.run(signals);

@@ -9,6 +9,7 @@
 //
 //   cellmap_example_planner [--domain N] [--cell ID] [--control-points "x,y,z;x,y,z;..."]
 //                           [--half-extents A,B,C] [--margin M] [--checkpoints N] [--json] [--every]
+//                           [--security DIR [--role planner]]
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
@@ -145,6 +146,8 @@ int main(int argc, char** argv) {
   int checkpoints = 50;
   bool json = false;
   bool every = false;
+  std::string security_dir;  // DDS Security credentials (`cellmap security init`); empty: off
+  std::string role = "planner";
   app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--cell", cell, "cell id to follow");
   app.add_option(
@@ -155,6 +158,11 @@ int main(int argc, char** argv) {
   app.add_option("--checkpoints", checkpoints, "checkpoints along the path");
   app.add_flag("--json", json, "one JSON object per line instead of text");
   app.add_flag("--every", every, "one line per new version, not only when the path's state changes");
+  auto* security_option =
+      app.add_option("--security", security_dir, "DDS Security on, with the credentials in DIR");
+  app.add_option("--role", role, "the role whose credentials to use")
+      ->needs(security_option)
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   // SIGINT/SIGTERM are taken by sigwait below; blocked before the DDS threads start so they inherit it.
@@ -178,7 +186,10 @@ int main(int argc, char** argv) {
       if (changed || every)
         std::cout << describe(state, env, delta, json) << std::endl;  // flushed: read by scripts
     };
-    const cellmap::dds::Participant participant(static_cast<std::uint32_t>(domain));
+    std::optional<cellmap::security::Setting> security;
+    if (!security_dir.empty())
+      security = cellmap::security::Setting{security_dir, cellmap::security::parse_role(role)};
+    const cellmap::dds::Participant participant(static_cast<std::uint32_t>(domain), security);
     const cellmap::transport::EnvironmentSubscriber subscriber(participant, cell, on_change);
     std::cerr << "following cell '" << cell << "' on DDS domain " << domain << std::endl;
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cellmap/boxes/volume.hpp"
 #include "cellmap/common/error.hpp"
 
 namespace cellmap::sim {
@@ -66,7 +67,40 @@ class VoxelGrid {
 
 constexpr std::uint8_t kObstacle = 1, kBox = 2;
 
+std::vector<ObjectScore> score_objects(const std::vector<Obstacle>& obstacles, const std::vector<Box>& boxes,
+                                       const Region& region) {
+  std::vector<ObjectScore> objects;
+  for (const Obstacle& o : obstacles) {
+    if (!region.contains(o.X_CO.translation())) continue;
+    ObjectScore score{o.name, 0.0, 0};
+    const Box truth = tight_box(o);
+    for (const Box& b : boxes) {
+      const double iou = volume_iou(truth, b);
+      if (iou > score.iou) score = {o.name, iou, b.id};
+    }
+    objects.push_back(score);
+  }
+  return objects;
+}
+
 }  // namespace
+
+Box tight_box(const Obstacle& obstacle) {
+  Box box;
+  box.center = obstacle.X_CO.translation();
+  box.half_extents = obstacle_half_extents(obstacle);
+  box.rotation = Eigen::Quaterniond(obstacle.X_CO.linear()).normalized();
+  return box;
+}
+
+double BoxScore::median_iou() const {
+  if (objects.empty()) return 0.0;
+  std::vector<double> iou;
+  for (const ObjectScore& o : objects) iou.push_back(o.iou);
+  std::sort(iou.begin(), iou.end());
+  const std::size_t n = iou.size();
+  return n % 2 ? iou[n / 2] : 0.5 * (iou[n / 2 - 1] + iou[n / 2]);
+}
 
 BoxScore score_boxes(const std::vector<Obstacle>& obstacles, const std::vector<Box>& boxes,
                      const Cloud& true_surface_C, const Region& region, double voxel, double tolerance) {
@@ -92,6 +126,8 @@ BoxScore score_boxes(const std::vector<Obstacle>& obstacles, const std::vector<B
   score.box_volume = grid.volume(kBox, kBox);
   score.lost_free_space = (score.box_volume - score.true_volume) / score.true_volume;
   score.blocked_free_space = grid.volume(kBox | kObstacle, kBox) / score.true_volume;
+  score.volume_coverage = grid.volume(kBox | kObstacle, kBox | kObstacle) / score.true_volume;
+  score.objects = score_objects(obstacles, boxes, region);
 
   std::size_t covered = 0;
   for (const pcl::PointXYZ& point : true_surface_C) {

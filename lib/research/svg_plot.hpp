@@ -2,6 +2,8 @@
 // Internal to the research stage: the one SVG writer behind its figures (the paper's fig. 6b line plot, the
 // sensor comparison's bar charts). Plain SVG 1.1 text, white background, sans-serif 12 px; coordinates in
 // pixels, y down.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <cmath>
 #include <sstream>

@@ -1,8 +1,12 @@
 // cellmapd's acquisition of the simulated cell: sweeps into the mailbox, scene edits over real DDS applied
-// when they are for this cell (or every cell) and ignored when they are for another.
+// when they are for this cell (or every cell), ignored when they are for another, refused and counted when
+// they leave the cell.
 #include "acquisition.hpp"
 
 #include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
 
 #include "cellmap/transport/scene_edits.hpp"
 #include "transport/loopback.hpp"
@@ -46,9 +50,11 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   const dds::Participant participant(kSimDomain);
   LatestMailbox<Sweep> mailbox;
   Health health(config.cell, config.source.sensor);
+  std::vector<std::string> refusal_lines;
+  InputRefusals refusals([&](const std::string& line) { refusal_lines.push_back(line); });
   const std::atomic<std::uint64_t> version{0};
   const std::unique_ptr<Acquisition> acquisition =
-      make_acquisition(config, participant, {mailbox, health, version});
+      make_acquisition(config, participant, {mailbox, health, refusals, version});
   EXPECT_EQ(acquisition->describe().rfind("sim (sensor 'kinect', ", 0), 0u) << acquisition->describe();
 
   // Two free spots on the table (top at z = 0.75), both in the Kinect's view.
@@ -57,6 +63,7 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   ASSERT_TRUE(writer.wait_for_reader(30s));
   writer.write(add_box("bench-7", "mine", mine));
   writer.write(add_box("bench-8", "theirs", theirs));
+  writer.write(add_box("bench-7", "far", Eigen::Vector3d(1e300, 0.45, 0.9)));
   ASSERT_TRUE(writer.wait_for_acks(30s));
 
   const std::atomic<bool> stop{false};
@@ -66,6 +73,10 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   EXPECT_EQ(mailbox.dropped(), 1u);  // the first was replaced: nobody took it
   EXPECT_GT(points_above_table(*sweep, mine, half), 100u) << "the edit for this cell was not applied";
   EXPECT_EQ(points_above_table(*sweep, theirs, half), 0u) << "the edit for another cell was applied";
+  EXPECT_EQ(refusals.count(), 1u);
+  ASSERT_EQ(refusal_lines.size(), 1u);
+  EXPECT_NE(refusal_lines[0].find("'far'"), std::string::npos) << refusal_lines[0];
+  EXPECT_NE(refusal_lines[0].find("outside the cell"), std::string::npos) << refusal_lines[0];
   EXPECT_EQ(health.status().sensors[0].state, "streaming");
 }
 

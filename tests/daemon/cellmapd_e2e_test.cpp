@@ -1,6 +1,6 @@
 // cellmapd on the simulated cell as a real process, a planner subscriber on loopback DDS, and `cellmap
 // inject` as a separate process: injected changes arrive as exact deltas; versions survive SIGKILL without
-// reuse.
+// reuse. Each test runs plain and with DDS Security on every participant.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,27 +13,40 @@ namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-// Transport tests use 110-149; each test here has its own domain so ctest -j runs them side by side.
+// Transport tests use 110-149; each test here has its own domain so ctest -j runs them side by side; the
+// secured variants use 190-191.
 constexpr int kAddRemoveDomain = 150;
 constexpr int kRestartDomain = 151;
-using test::inject;
+constexpr int kSecureAddRemoveDomain = 190;
+constexpr int kSecureRestartDomain = 191;
 using test::kPatience;
 using test::settled;
 
-class CellmapdE2eTest : public ::testing::Test {
+// The parameter: DDS Security on.
+class CellmapdE2eTest : public ::testing::TestWithParam<bool> {
  protected:
-  static void SetUpTestSuite() { test::use_loopback(); }
-
+  // This test's domain (plain or secured), with the service set up for it.
+  int use_domain(int plain, int secure) {
+    const int domain = GetParam() ? secure : plain;
+    service_.emplace("e2e", GetParam() ? std::optional(domain) : std::nullopt);
+    return domain;
+  }
   [[nodiscard]] std::unique_ptr<test::ChildProcess> start_daemon(int domain) const {
-    return service_.start_daemon(domain);
+    return service_->start_daemon(domain);
+  }
+  std::string inject(int domain, const std::vector<std::string>& args) const {
+    return service_->inject(domain, args);
   }
 
-  test::ServiceFixture service_{"e2e"};
+  std::optional<test::ServiceFixture> service_;
 };
 
-TEST_F(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
-  auto daemon = start_daemon(kAddRemoveDomain);
-  const dds::Participant participant(kAddRemoveDomain);
+INSTANTIATE_TEST_SUITE_P(, CellmapdE2eTest, ::testing::Bool(), test::security_name);
+
+TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
+  const int domain = use_domain(kAddRemoveDomain, kSecureAddRemoveDomain);
+  auto daemon = start_daemon(domain);
+  const dds::Participant participant = service_->participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber planner(participant, "e2e", std::ref(recorder));
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "no first version from the daemon";
@@ -43,7 +56,7 @@ TEST_F(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   // A box standing on a free part of the table (top at z = 0.75) between the fixture and the drum.
   const Eigen::Vector3d centre(2.12, 0.45, 0.9);
   const std::string name =
-      inject(kAddRemoveDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+      inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(planner.wait_for_version(before.version() + 1, kPatience)) << "the added box never arrived";
   const EnvironmentDelta added = recorder.last();
@@ -60,7 +73,7 @@ TEST_F(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
     EXPECT_TRUE(same_box(*same, old)) << "box " << old.id << " changed";
   }
 
-  inject(kAddRemoveDomain, {"remove", "--name", name});
+  inject(domain, {"remove", "--name", name});
   ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, kPatience)) << "the removal never arrived";
   const EnvironmentDelta removed = recorder.last();
   EXPECT_EQ(removed.removed, std::vector<std::uint64_t>{box.id});
@@ -70,11 +83,12 @@ TEST_F(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   EXPECT_EQ(daemon->wait(), 0);
 }
 
-TEST_F(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGetsLatest) {
-  auto daemon = start_daemon(kRestartDomain);
+TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGetsLatest) {
+  const int domain = use_domain(kRestartDomain, kSecureRestartDomain);
+  auto daemon = start_daemon(domain);
   std::optional<Environment> before_kill;
   {
-    const dds::Participant participant(kRestartDomain);
+    const dds::Participant participant = service_->participant(domain);
     transport::EnvironmentSubscriber planner(participant, "e2e");
     ASSERT_TRUE(planner.wait_for_version(1, kPatience));
     before_kill = settled(planner, 5s);
@@ -83,9 +97,9 @@ TEST_F(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
   daemon->signal(SIGKILL);
   daemon->wait();
 
-  daemon = start_daemon(kRestartDomain);
+  daemon = start_daemon(domain);
   // A late joiner gets the persisted environment at once, under the version it had.
-  const dds::Participant participant(kRestartDomain);
+  const dds::Participant participant = service_->participant(domain);
   transport::EnvironmentSubscriber late(participant, "e2e");
   ASSERT_TRUE(late.wait_for_version(last, kPatience));
   const Environment resumed = *late.environment();
@@ -97,8 +111,7 @@ TEST_F(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
   EXPECT_EQ(resumed.boxes().size(), before_kill->boxes().size());
 
   EXPECT_FALSE(
-      inject(kRestartDomain, {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
-          .empty());
+      inject(domain, {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"}).empty());
   // The resumed daemon goes on making versions: the injected box arrives in one above the resumed one.
   const Eigen::Vector3d injected(0.5, 1.5, 0.95);
   const auto holds_injected = [&] {

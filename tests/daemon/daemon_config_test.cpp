@@ -111,5 +111,17 @@ TEST(DaemonConfigTest, LiveCamerasTakeTheirSectionsWithDocumentedDefaults) {
             0u);
 }
 
+TEST(DaemonConfigTest, SecurityIsOffByDefaultAndItsDirectoryIsRelativeToTheFile) {
+  EXPECT_FALSE(DaemonConfig::parse("", "empty.yaml", ".").security.has_value());
+  const DaemonConfig c =
+      DaemonConfig::parse("security: {directory: keys/cell-1}\n", "my.yaml", "/etc/cellmap");
+  ASSERT_TRUE(c.security.has_value());
+  EXPECT_EQ(c.security->directory, std::filesystem::path("/etc/cellmap/keys/cell-1"));
+  EXPECT_EQ(c.security->role, security::Role::kDaemon);
+  EXPECT_EQ(error_of("security: {directory: k, role: admin}\n"),
+            "my.yaml: security.role: must be one of daemon, planner, robot, tool");
+  EXPECT_EQ(error_of("security: {dir: k}\n"), "my.yaml: security.dir: unknown key");
+}
+
 }  // namespace
 }  // namespace cellmap::daemon

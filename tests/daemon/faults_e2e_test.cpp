@@ -109,8 +109,9 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   // Read-only: the version with the injected box is held until the directory can be written again.
   disk_.make_read_only(true);
   const Eigen::Vector3d centre(2.12, 0.45, 0.9);
-  ASSERT_FALSE(test::inject(kFirstVersionDomain,
-                            {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"})
+  ASSERT_FALSE(service
+                   .inject(kFirstVersionDomain,
+                           {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"})
                    .empty());
   const auto read_only = test::wait_for_status(reader, service.cell(), degraded_by("Read-only file system"));
   ASSERT_TRUE(read_only.has_value()) << "no degraded status while the state directory is read-only";
@@ -135,8 +136,9 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
 
   disk_.fill();
   const Eigen::Vector3d centre(0.5, 1.5, 0.95);
-  ASSERT_FALSE(test::inject(kLaterVersionDomain,
-                            {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
+  ASSERT_FALSE(service
+                   .inject(kLaterVersionDomain,
+                           {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
                    .empty());
   const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
   ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";

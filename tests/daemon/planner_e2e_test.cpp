@@ -1,6 +1,7 @@
 // The example planner (examples/planner) as a real process against cellmapd on the simulated cell: a box
 // injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
-// by it; removing the box frees the path again; a clean daemon restart does not read as "all removed".
+// by it; removing the box frees the path again; a clean daemon restart does not read as "all removed". Plain
+// and with DDS Security on every process and participant.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@ namespace {
 
 using namespace std::chrono_literals;
 constexpr int kPlannerDomain = 170;
+constexpr int kSecurePlannerDomain = 192;
 
 // The next JSON line the planner prints, or a failure.
 nlohmann::json next_state(test::ChildProcess& planner) {
@@ -24,24 +26,29 @@ nlohmann::json next_state(test::ChildProcess& planner) {
   return nlohmann::json::parse(*line);
 }
 
-TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
-  test::use_loopback();
-  test::ServiceFixture service("planner");
-  auto daemon = service.start_daemon(kPlannerDomain);
-  const dds::Participant participant(kPlannerDomain);
+// The parameter: DDS Security on.
+class PlannerE2eTest : public ::testing::TestWithParam<bool> {};
+INSTANTIATE_TEST_SUITE_P(, PlannerE2eTest, ::testing::Bool(), test::security_name);
+
+TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
+  const int domain = GetParam() ? kSecurePlannerDomain : kPlannerDomain;
+  const test::ServiceFixture service("planner", GetParam() ? std::optional(domain) : std::nullopt);
+  auto daemon = service.start_daemon(domain);
+  const dds::Participant participant = service.participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
   // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
-  test::ChildProcess planner(
-      {CELLMAP_PLANNER, "--domain", std::to_string(kPlannerDomain), "--cell", "planner", "--json"});
+  std::vector<std::string> planner_argv = service.planner(domain);
+  planner_argv.push_back("--json");
+  test::ChildProcess planner(planner_argv);
 
   ASSERT_TRUE(observer.wait_for_version(1, test::kPatience)) << "no first version from the daemon";
   const nlohmann::json first = next_state(planner);
   EXPECT_EQ(first.value("state", ""), "free") << first.dump();
   const Environment before = test::settled(observer, 5s);
 
-  const std::string name = test::inject(
-      kPlannerDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  const std::string name =
+      service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kPatience)) << "the box never arrived";
   const EnvironmentDelta added = recorder.last();
@@ -64,7 +71,7 @@ TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_LT(blocked.value("distance", 1.0), 0.02);
 
   const Environment with_box = test::settled(observer, 3s);
-  test::inject(kPlannerDomain, {"remove", "--name", name});
+  service.inject(domain, {"remove", "--name", name});
   ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
   EXPECT_EQ(recorder.last().removed, std::vector<std::uint64_t>{box.id});
   const nlohmann::json free = next_state(planner);
@@ -78,9 +85,9 @@ TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_EQ(daemon->wait(), 0);
   std::this_thread::sleep_for(2s);  // past the 1 s lease: the writers are gone for the readers too
   EXPECT_EQ(*observer.environment(), last);
-  daemon = service.start_daemon(kPlannerDomain);
-  const std::string again = test::inject(
-      kPlannerDomain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  daemon = service.start_daemon(domain);
+  const std::string again =
+      service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kPatience)) << "nothing after the restart";
   const nlohmann::json blocked_again = next_state(planner);
   EXPECT_EQ(blocked_again.value("state", ""), "blocked") << blocked_again.dump();
@@ -94,7 +101,7 @@ TEST(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_EQ(daemon->wait(), 0);
 }
 
-TEST(PlannerE2eTest, BadPathIsRefusedWithOneLine) {
+TEST(PlannerCommandLineTest, BadPathIsRefusedWithOneLine) {
   // stderr through the pipe: the reason is the only output.
   test::ChildProcess planner(
       {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1", CELLMAP_PLANNER, "--control-points", "1,2;3,4,5"});

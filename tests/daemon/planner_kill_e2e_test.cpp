@@ -108,8 +108,8 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
 
   for (int round = 0; round < kRounds; ++round) {
     const char* spot = kSpots[rng() % std::size(kSpots)];
-    EXPECT_FALSE(
-        test::inject(kKillDomain, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"}).empty());
+    EXPECT_FALSE(service.inject(kKillDomain, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"})
+                     .empty());
     // The daemon reports a new box within about five sweeps (1 s): the kill lands before, during (fusion,
     // persisting, publishing) or after that version.
     std::this_thread::sleep_for(uniform(0.0, 2.5));
@@ -139,7 +139,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   collect();
   const std::uint64_t before = seen.latest();
   EXPECT_FALSE(
-      test::inject(kKillDomain, {"add-box", "--center", "1.0,1.2,1.2", "--half-extents", "0.08,0.08,0.08"})
+      service.inject(kKillDomain, {"add-box", "--center", "1.0,1.2,1.2", "--half-extents", "0.08,0.08,0.08"})
           .empty());
   const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
   while (seen.latest() <= before && std::chrono::steady_clock::now() < deadline) {

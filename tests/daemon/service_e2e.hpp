@@ -1,6 +1,7 @@
 #pragma once
 // Helpers for end-to-end tests of the service: cellmapd on the simulated cell as a real process (exact
-// depths, a private state directory), `cellmap inject` as a process, and in-process planner subscribers.
+// depths, a private state directory), `cellmap inject` as a process, and in-process planner subscribers; all
+// of them with DDS Security on when the test asks for it.
 
 #include <gtest/gtest.h>
 
@@ -17,6 +18,7 @@
 
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "cellmap/transport/status_reader.hpp"
+#include "support/test_credentials.hpp"
 #include "support/test_support.hpp"
 #include "transport/child_process.hpp"
 #include "transport/loopback.hpp"
@@ -28,43 +30,95 @@ inline constexpr std::chrono::seconds kPatience{90};
 /// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:
 /// these tests are about versions and deltas; noise robustness is tested where the noise is modelled.
 /// `extra_yaml` is appended to the config; `state_dir` replaces the private one.
+///
+/// With `secure_domain`, DDS Security is on for that domain: credentials are written for the cell, and the
+/// daemon joins as daemon, inject as tool, planners (processes and participant()) as planner. The fixture
+/// sets CYCLONEDDS_URI (loopback; the 10 s lease when secured), so make it before any participant.
 class ServiceFixture {
  public:
   explicit ServiceFixture(std::string cell, const std::string& extra_yaml = "",
-                          std::optional<std::filesystem::path> state_dir = std::nullopt)
+                          std::optional<std::filesystem::path> state_dir = std::nullopt,
+                          std::optional<int> secure_domain = std::nullopt)
       : cell_(std::move(cell)), state_dir_(state_dir.value_or(dir_.path() / "state")) {
     config_ = dir_.path() / "cellmapd.yaml";
     std::ofstream(config_) << "cell: " << cell_
                            << "\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n"
                            << extra_yaml;
+    if (secure_domain) credentials_.emplace(cell_, *secure_domain);
+    if (secure_domain) {
+      use_secure_loopback();
+    } else {
+      use_loopback();
+    }
   }
+  /// The default config, secured on `secure_domain` when it is given.
+  ServiceFixture(std::string cell, std::optional<int> secure_domain)
+      : ServiceFixture(std::move(cell), "", std::nullopt, secure_domain) {}
 
   /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess.
   [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain, bool log_on_stdout = false) const {
     std::vector<std::string> argv{
         CELLMAPD,      "--config",          config_.string(), "--domain", std::to_string(domain),
         "--state-dir", state_dir().string()};
+    append_flags(argv, security::Role::kDaemon);
     if (log_on_stdout) argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
     return std::make_unique<ChildProcess>(argv);
   }
-  [[nodiscard]] const std::filesystem::path& state_dir() const { return state_dir_; }
-  [[nodiscard]] const std::string& cell() const { return cell_; }
+
+  /// `cellmap inject --domain N ARGS...`; returns its first output line (add-box prints the new name).
+  std::string inject(int domain, const std::vector<std::string>& args) const {
+    std::vector<std::string> argv{CELLMAP_TOOL, "inject", "--domain", std::to_string(domain), "--wait", "60"};
+    append_flags(argv, security::Role::kTool);
+    argv.insert(argv.end(), args.begin(), args.end());
+    ChildProcess tool(argv);
+    const std::string out = tool.read_line(kPatience).value_or("");
+    EXPECT_EQ(tool.wait(), 0) << "cellmap inject failed";
+    return out;
+  }
+
+  /// A participant for an in-process planner (or observer) on `domain`.
+  [[nodiscard]] dds::Participant participant(int domain) const {
+    return dds::Participant(
+        static_cast<std::uint32_t>(domain),
+        credentials_ ? std::optional(credentials_->as(security::Role::kPlanner)) : std::nullopt);
+  }
+#ifdef CELLMAP_PLANNER
+  /// The example planner's command line: `--domain N --cell C` and, when secured, its credentials.
+  [[nodiscard]] std::vector<std::string> planner(int domain) const {
+    std::vector<std::string> argv{CELLMAP_PLANNER, "--domain", std::to_string(domain), "--cell", cell_};
+    append_flags(argv, security::Role::kPlanner);
+    return argv;
+  }
+#endif
+
+  [[nodiscard]] const std::filesystem::path& state_dir() const {
+    return state_dir_;
+  }
+  [[nodiscard]] const std::string& cell() const {
+    return cell_;
+  }
+  [[nodiscard]] const std::optional<TestCredentials>& credentials() const {
+    return credentials_;
+  }
 
  private:
+  void append_flags(std::vector<std::string>& argv, security::Role role) const {
+    if (!credentials_) return;
+    const std::vector<std::string> flags = credentials_->flags(role);
+    argv.insert(argv.end(), flags.begin(), flags.end());
+  }
+
   std::string cell_;
   TempDir dir_;
   std::filesystem::path state_dir_;
   std::filesystem::path config_;
+  std::optional<TestCredentials> credentials_;
 };
 
-/// `cellmap inject --domain N ARGS...`; returns its first output line (add-box prints the new name).
-inline std::string inject(int domain, const std::vector<std::string>& args) {
-  std::vector<std::string> argv{CELLMAP_TOOL, "inject", "--domain", std::to_string(domain), "--wait", "60"};
-  argv.insert(argv.end(), args.begin(), args.end());
-  ChildProcess tool(argv);
-  const std::string out = tool.read_line(kPatience).value_or("");
-  EXPECT_EQ(tool.wait(), 0) << "cellmap inject failed";
-  return out;
+/// End-to-end tests that run twice, plain and with DDS Security on, are parameterized by this; each variant
+/// has a domain of its own.
+inline std::string security_name(const ::testing::TestParamInfo<bool>& info) {
+  return info.param ? "Secure" : "Plain";
 }
 
 /// Waits until no new version came for `quiet` (the map has settled); returns the environment then.

@@ -1,4 +1,6 @@
 // `cellmap sensor-comparison` on the bundled cell: the paper's finding, reproduced in simulation.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>

@@ -194,7 +194,11 @@ TEST(SegmentConfig, TheConfigFileHoldsTheDefaults) {
   EXPECT_EQ(file.split.max_extent, defaults.split.max_extent);
   EXPECT_EQ(file.split.voxel_resolution, defaults.split.voxel_resolution);
   EXPECT_EQ(file.split.seed_resolution, defaults.split.seed_resolution);
+  EXPECT_EQ(file.split_method, defaults.split_method);
+  EXPECT_EQ(file.split_min_gain, defaults.split_min_gain);
+  EXPECT_EQ(file.join_max_growth, defaults.join_max_growth);
   EXPECT_EQ(file.box_kind, defaults.box_kind);
+  EXPECT_EQ(file.voxel, defaults.voxel);
   EXPECT_FALSE(file.workspace.has_value());
   EXPECT_EQ(defaults.merge_params.gap, defaults.region_growing.gap);
 }

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <future>
 #include <mutex>
+#include <string>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/environment_monitor.hpp"
@@ -14,6 +16,7 @@
 #include "cellmap/transport/status_reader.hpp"
 #include "loopback.hpp"
 #include "scene_steps.hpp"
+#include "support/test_credentials.hpp"
 
 namespace cellmap::transport {
 namespace {
@@ -303,6 +306,30 @@ TEST_F(TransportTest, PublisherRefusesWrongVersionsAndCells) {
   wrong.to_version = 4;
   EXPECT_THROW(publisher.publish(v3, wrong), Error);
   EXPECT_THROW(dds::Participant(100000), Error);  // domain ids end at 232
+}
+
+// Cyclone DDS gives every participant of a process on a domain the first one's DDS Security setting, so a
+// second setting on the same domain must be refused rather than silently replaced.
+TEST_F(TransportTest, AProcessTakesOneSecuritySettingPerDomain) {
+  const test::TestCredentials credentials("guarded", 124);
+  const auto refused = [](const std::function<void()>& join) {
+    try {
+      join();
+    } catch (const Error& e) {
+      return std::string(e.what()).find("one security setting per domain and process") != std::string::npos;
+    }
+    return false;
+  };
+  {
+    const dds::Participant planner(124, credentials.as(security::Role::kPlanner));
+    const dds::Participant same_setting(124, credentials.as(security::Role::kPlanner));
+    EXPECT_TRUE(refused([] { dds::Participant plain(124); }));
+    EXPECT_TRUE(refused([&] { dds::Participant tool(124, credentials.as(security::Role::kTool)); }));
+    const dds::Participant other_domain(126);
+  }
+  // Once the secured participants are gone the domain takes any setting again.
+  const dds::Participant plain(124);
+  EXPECT_FALSE(plain.credentials());
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// `cellmap echo [--domain N] [--count K] [--timeout SEC]`: one JSON line per snapshot/delta received.
+// `cellmap echo [--domain N] [--count K] [--timeout SEC] [--security DIR [--role R]]`: one JSON line per
+// snapshot/delta received.
 #include <chrono>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -7,13 +8,14 @@
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/environment_monitor.hpp"
 #include "commands.hpp"
+#include "security_options.hpp"
 
 namespace cellmap::cli {
 namespace {
 
 using nlohmann::json;
 
-// The boxes in the boxes-file form of ARCHITECTURE.md, produced by the one serialiser of that contract.
+// The boxes in the form of the boxes JSON file (docs/boxes-json.md), produced by its one serialiser.
 json boxes_json(const std::vector<Box>& boxes) {
   return json::parse(to_json(BoxSet{0, "cell", boxes}))["boxes"];
 }
@@ -42,10 +44,11 @@ struct EchoOptions {
   std::uint32_t domain = 0;
   std::uint64_t count = 0;
   double timeout = 0;
+  SecurityOptions security;
 };
 
 void run_echo(const EchoOptions& options) {
-  const dds::Participant participant(options.domain);
+  const dds::Participant participant(options.domain, options.security.setting());
   transport::EnvironmentMonitor monitor(participant);
   using Clock = std::chrono::steady_clock;
   const bool forever = options.timeout <= 0;
@@ -85,6 +88,7 @@ void add_echo_command(CLI::App& app) {
   echo->add_option("--timeout", options->timeout,
                    "Fail after this many seconds without --count messages (0: never)")
       ->check(CLI::NonNegativeNumber);
+  add_security_options(echo, options->security, security::Role::kTool);
   echo->callback([options] { run_echo(*options); });
 }
 

@@ -1,4 +1,5 @@
-// `cellmap inject [--domain N] add-box|remove|move ...`: edits the simulated scene of a running cellmapd.
+// `cellmap inject [--domain N] [--security DIR [--role R]] add-box|remove|move ...`: edits the simulated
+// scene of a running cellmapd.
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include "cellmap/transport/scene_edits.hpp"
 #include "commands.hpp"
 #include "parse.hpp"
+#include "security_options.hpp"
 
 namespace cellmap::cli {
 namespace {
@@ -21,6 +23,7 @@ struct InjectOptions {
   std::string center;
   std::string half_extents;
   double yaw = 0.0;
+  SecurityOptions security;
 };
 
 Eigen::Vector3d vector3(const std::string& text, const std::string& what) {
@@ -38,7 +41,7 @@ std::string fresh_name() {
 
 void send(const InjectOptions& options, transport::SceneEdit edit) {
   edit.cell = options.cell;
-  const dds::Participant participant(options.domain);
+  const dds::Participant participant(options.domain, options.security.setting());
   const transport::SceneEditWriter writer(participant);
   const auto wait =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(options.wait));
@@ -61,9 +64,11 @@ void add_inject_command(CLI::App& app) {
   inject->add_option("--cell", options->cell, "only this cell's daemon (default: every simulating daemon)");
   inject->add_option("--wait", options->wait, "seconds to wait for the daemon")
       ->check(CLI::NonNegativeNumber);
+  add_security_options(inject, options->security, security::Role::kTool);
   inject->require_subcommand(1);
 
-  CLI::App* add = inject->add_subcommand("add-box", "Add a box obstacle; prints its name");
+  // Each edit lets --domain, --security ... through to inject, so they may come after it too.
+  CLI::App* add = inject->add_subcommand("add-box", "Add a box obstacle; prints its name")->fallthrough();
   add->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
   add->add_option("--half-extents", options->half_extents, "A,B,C, metres")->required();
   add->add_option("--yaw", options->yaw, "rotation about the cell's z axis, radians");
@@ -76,11 +81,11 @@ void add_inject_command(CLI::App& app) {
     std::cout << edit.name << std::endl;
   });
 
-  CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name");
+  CLI::App* remove = inject->add_subcommand("remove", "Remove an obstacle by name")->fallthrough();
   remove->add_option("--name", options->name, "obstacle name")->required();
   remove->callback([options] { send(*options, transport::SceneEdit::remove(options->name)); });
 
-  CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre");
+  CLI::App* move = inject->add_subcommand("move", "Move an obstacle to a new centre")->fallthrough();
   move->add_option("--name", options->name, "obstacle name")->required();
   move->add_option("--center", options->center, "X,Y,Z in the cell frame, metres")->required();
   move->callback([options] {

@@ -1,4 +1,6 @@
 // `cellmap paper-figure -o DIR`: the paper's minimum-distance sweep (GJK vs spheres N = 1, 2, 6).
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 #include <filesystem>
 #include <iostream>
 

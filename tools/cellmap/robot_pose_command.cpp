@@ -10,6 +10,7 @@
 #include "cellmap/transport/robot_state.hpp"
 #include "commands.hpp"
 #include "parse.hpp"
+#include "security_options.hpp"
 
 namespace cellmap::cli {
 namespace {
@@ -21,6 +22,7 @@ struct RobotPoseOptions {
   double rate = 100.0;
   double duration = 10.0;
   double wait = 10.0;
+  SecurityOptions security;
 };
 
 void publish(const RobotPoseOptions& options) {
@@ -34,7 +36,7 @@ void publish(const RobotPoseOptions& options) {
       throw Error("--pose: the rotation must be a unit quaternion qw,qx,qy,qz");
     state.X_CE.linear() = q.normalized().toRotationMatrix();
   }
-  const dds::Participant participant(options.domain);
+  const dds::Participant participant(options.domain, options.security.setting());
   const transport::RobotStateWriter writer(participant);
   const auto wait =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(options.wait));
@@ -74,6 +76,7 @@ void add_robot_pose_command(CLI::App& app) {
   command->add_option("--duration", options->duration, "seconds to publish (0 = until interrupted)")
       ->check(CLI::NonNegativeNumber);
   command->add_option("--wait", options->wait, "seconds to wait for a daemon")->check(CLI::NonNegativeNumber);
+  add_security_options(command, options->security, security::Role::kRobot);
   command->callback([options] { publish(*options); });
 }
 

@@ -2,6 +2,8 @@
 // sensor comparison on a simulated cell. Every sensor of the scene sweeps the same cell; its merged cloud
 // goes through the batch pipeline (cellmap segment's library call) and the boxes are scored against the
 // scene's true obstacles: coverage of the surface the sensor saw (its own exact sweep) and lost free space.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 #include <filesystem>
 #include <iostream>
 #include <memory>

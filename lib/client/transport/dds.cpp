@@ -1,6 +1,8 @@
 #include "cellmap/transport/dds.hpp"
 
 #include <algorithm>
+#include <map>
+#include <mutex>
 #include <thread>
 #include <utility>
 
@@ -50,6 +52,11 @@ Qos& Qos::autodispose(bool on) {
   return *this;
 }
 
+Qos& Qos::property(const std::string& name, const std::string& value) {
+  dds_qset_prop(qos_, name.c_str(), value.c_str());
+  return *this;
+}
+
 Entity::~Entity() {
   reset();
 }
@@ -70,9 +77,105 @@ void Entity::reset() {
   handle_ = 0;
 }
 
-Participant::Participant(std::uint32_t domain)
-    : Entity(check(dds_create_participant(domain, nullptr, nullptr),
-                   "cannot join DDS domain " + std::to_string(domain) + " (check CYCLONEDDS_URI)")) {}
+namespace {
+
+// Cyclone's three DDS Security plugins (Debian's libddsc0debian ships them; found by their bare names) and
+// the role's files, as the participant properties of the DDS Security specification name them.
+Qos security_qos(const security::Credentials& credentials) {
+  const auto file = [](const std::filesystem::path& path) { return "file:" + path.string(); };
+  const security::RoleFiles& files = credentials.files;
+  Qos qos;
+  qos.property("dds.sec.auth.library.path", "dds_security_auth")
+      .property("dds.sec.auth.library.init", "init_authentication")
+      .property("dds.sec.auth.library.finalize", "finalize_authentication")
+      .property("dds.sec.crypto.library.path", "dds_security_crypto")
+      .property("dds.sec.crypto.library.init", "init_crypto")
+      .property("dds.sec.crypto.library.finalize", "finalize_crypto")
+      .property("dds.sec.access.library.path", "dds_security_ac")
+      .property("dds.sec.access.library.init", "init_access_control")
+      .property("dds.sec.access.library.finalize", "finalize_access_control")
+      .property("dds.sec.auth.identity_ca", file(files.identity_ca))
+      .property("dds.sec.auth.identity_certificate", file(files.certificate))
+      .property("dds.sec.auth.private_key", file(files.private_key))
+      .property("dds.sec.access.permissions_ca", file(files.permissions_ca))
+      .property("dds.sec.access.governance", file(files.governance))
+      .property("dds.sec.access.permissions", file(files.permissions));
+  return qos;
+}
+
+// The DDS Security setting of each domain this process is on, with how many live participants hold it.
+struct DomainSettings {
+  std::mutex mutex;
+  std::map<std::uint32_t, std::pair<std::string, int>> held;
+};
+DomainSettings& domain_settings() {
+  static DomainSettings settings;
+  return settings;
+}
+
+std::string describe(const std::optional<security::Credentials>& credentials) {
+  if (!credentials) return "without DDS Security";
+  return "as " + credentials->subject + " (" + credentials->files.certificate.parent_path().string() + ")";
+}
+
+void claim_setting(std::uint32_t domain, const std::optional<security::Credentials>& credentials) {
+  DomainSettings& settings = domain_settings();
+  const std::lock_guard<std::mutex> lock(settings.mutex);
+  auto& [setting, count] = settings.held[domain];
+  const std::string wanted = describe(credentials);
+  if (count > 0 && setting != wanted) {
+    throw Error("cannot join DDS domain " + std::to_string(domain) + " " + wanted +
+                ": this process is on it " + setting +
+                ", and Cyclone DDS takes one security setting per domain and process");
+  }
+  setting = wanted;
+  ++count;
+}
+
+void release_setting(std::uint32_t domain) {
+  DomainSettings& settings = domain_settings();
+  const std::lock_guard<std::mutex> lock(settings.mutex);
+  const auto it = settings.held.find(domain);
+  if (it != settings.held.end() && --it->second.second == 0) settings.held.erase(it);
+}
+
+dds_entity_t create_participant(std::uint32_t domain,
+                                const std::optional<security::Credentials>& credentials) {
+  const std::string what = "cannot join DDS domain " + std::to_string(domain);
+  if (!credentials)
+    return check(dds_create_participant(domain, nullptr, nullptr), what + " (check CYCLONEDDS_URI)");
+  const Qos qos = security_qos(*credentials);
+  return check(dds_create_participant(domain, qos.get(), nullptr),
+               what + " as " + credentials->subject + " with DDS Security");
+}
+
+// Claims the domain's setting first, so a participant that would get another one is never created.
+dds_entity_t join(std::uint32_t domain, const std::optional<security::Credentials>& credentials) {
+  claim_setting(domain, credentials);
+  try {
+    return create_participant(domain, credentials);
+  } catch (...) {
+    release_setting(domain);
+    throw;
+  }
+}
+
+}  // namespace
+
+Participant::Participant(std::uint32_t domain, const std::optional<security::Setting>& security)
+    : Participant(domain, security ? std::optional(security::check(*security, domain)) : std::nullopt,
+                  Checked{}) {}
+
+Participant::Participant(std::uint32_t domain, std::optional<security::Credentials> credentials, Checked)
+    : Entity(join(domain, credentials)), credentials_(std::move(credentials)), claim_(domain) {}
+
+Participant::~Participant() {
+  reset();
+}
+
+Participant::SettingClaim::~SettingClaim() {
+  if (held_) release_setting(domain_);
+}
 
 Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* type, const std::string& name)
     : Entity(check(dds_create_topic(participant.get(), type, name.c_str(), nullptr, nullptr),

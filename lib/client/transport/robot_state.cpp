@@ -28,8 +28,11 @@ bool RobotStateWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_acks(timeout);
 }
 
-RobotStateReader::RobotStateReader(const dds::Participant& participant, std::string cell)
+RobotStateReader::RobotStateReader(const dds::Participant& participant, std::string cell, InputLimits limits,
+                                   OnRefused on_refused)
     : cell_(std::move(cell)),
+      limits_(std::move(limits)),
+      on_refused_(std::move(on_refused)),
       topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
       reader_(participant, topic_, robot_state_qos()),
       waitset_(participant) {
@@ -47,13 +50,19 @@ RobotStateReader::~RobotStateReader() {
 std::vector<RobotState> RobotStateReader::take(std::chrono::nanoseconds timeout) {
   if (timeout.count() > 0) waitset_.wait(timeout);
   std::vector<RobotState> states;
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count();
   reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
     const auto& msg = *static_cast<const cellmap_msg_RobotState*>(sample);
     if (msg.cell != nullptr && cell_ != msg.cell) return;
     try {
-      states.push_back(wire::from_wire(msg));
-    } catch (const Error&) {
+      RobotState state = wire::from_wire(msg);
+      check_limits(state, limits_, now_ns);
+      states.push_back(std::move(state));
+    } catch (const Error& e) {
       ++rejected_;
+      if (on_refused_) on_refused_(e.what());
     }
   });
   return states;

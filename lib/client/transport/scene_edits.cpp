@@ -24,8 +24,11 @@ bool SceneEditWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_acks(timeout);
 }
 
-SceneEditReader::SceneEditReader(const dds::Participant& participant)
-    : topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
+SceneEditReader::SceneEditReader(const dds::Participant& participant, InputLimits limits,
+                                 OnRefused on_refused)
+    : limits_(std::move(limits)),
+      on_refused_(std::move(on_refused)),
+      topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
       reader_(participant, topic_, scene_edit_qos()),
       waitset_(participant) {
   waitset_.attach(reader_);
@@ -44,9 +47,12 @@ std::vector<SceneEdit> SceneEditReader::take(std::chrono::nanoseconds timeout) {
   std::vector<SceneEdit> edits;
   reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
     try {
-      edits.push_back(wire::from_wire(*static_cast<const cellmap_msg_SceneEdit*>(sample)));
-    } catch (const Error&) {
+      SceneEdit edit = wire::from_wire(*static_cast<const cellmap_msg_SceneEdit*>(sample));
+      check_limits(edit, limits_);
+      edits.push_back(std::move(edit));
+    } catch (const Error& e) {
       ++rejected_;
+      if (on_refused_) on_refused_(e.what());
     }
   });
   return edits;

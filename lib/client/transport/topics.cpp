@@ -29,4 +29,16 @@ dds::Qos layer_qos() {
   return dds::Qos::make(false, 1);
 }
 
+std::map<security::Role, security::TopicGrants> role_grants() {
+  using security::Role;
+  const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
+  std::vector<std::string> environment_and_layers = environment;
+  environment_and_layers.insert(environment_and_layers.end(),
+                                {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic});
+  return {{Role::kDaemon, {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
+          {Role::kPlanner, {{}, environment_and_layers}},
+          {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}}},
+          {Role::kTool, {{kSceneEditTopic}, environment}}};
+}
+
 }  // namespace cellmap::transport

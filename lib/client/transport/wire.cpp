@@ -116,6 +116,7 @@ StatusSample::StatusSample(const CellStatus& status) : status_(status) {
   msg_.boxes = status_.boxes;
   msg_.version = status_.version;
   msg_.reason = text(status_.reason);
+  msg_.refused_inputs = status_.refused_inputs;
 }
 
 SceneEditSample::SceneEditSample(const SceneEdit& edit) : edit_(edit) {
@@ -185,6 +186,7 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
   status.boxes = msg.boxes;
   status.version = msg.version;
   status.reason = msg.reason ? msg.reason : "";
+  status.refused_inputs = msg.refused_inputs;
   return status;
 }
 

@@ -26,13 +26,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// A point anywhere inside a voxel of edge r around a fitted centre lies within r/2 · ‖a‖₁ of it along a unit
-// box axis a, so growing each half extent by that covers the whole voxel.
-void grow_by_voxel(Box& box, double resolution) {
-  const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
-  for (int axis = 0; axis < 3; ++axis) box.half_extents[axis] += 0.5 * resolution * R.col(axis).lpNorm<1>();
-}
-
 bool contains_id(const std::vector<std::uint64_t>& ids, std::uint64_t id) {
   return std::find(ids.begin(), ids.end(), id) != ids.end();
 }
@@ -46,6 +39,8 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
       detector_(config.change),
       boxes_(std::move(boxes)),
       next_box_id_(next_box_id) {
+  // The points segmented are occupied voxel centres: boxes hold the whole voxels.
+  config_.segment.voxel = config_.occupancy.resolution;
   if (config_.settle_sweeps < 0 || config_.settle_sweeps > 100000)
     throw Error("change.settle_sweeps: must be an integer in [0, 100000], got " +
                 std::to_string(config_.settle_sweeps));
@@ -193,9 +188,7 @@ std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const 
   evidence = cloud.size();
   if (cloud.empty()) return {};
   cloud.sensor_origin_ = Eigen::Vector4f(viewpoint_C_.x(), viewpoint_C_.y(), viewpoint_C_.z(), 0.0f);
-  SegmentResult result = segment_cloud(cloud, config_.segment);
-  for (Box& box : result.boxes.boxes) grow_by_voxel(box, map_.config().resolution);
-  return std::move(result.boxes.boxes);
+  return segment_cloud(cloud, config_.segment).boxes.boxes;
 }
 
 Resegmentation CellPipeline::resegment_everything() const {

@@ -4,114 +4,127 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "minimum_volume.hpp"
 
 namespace cellmap {
 namespace {
 
-// The extent of the points along the axes R (columns, in the points' frame), as low and high corners.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> extent_along(const Cloud& cloud, const std::vector<int>& indices,
-                                                         const Eigen::Matrix3d& R) {
+using Points = std::vector<Eigen::Vector3d>;
+
+// The box with axes R (columns, in the points' frame) that holds all points and their cubes.
+Box enclose(const Points& points, const Eigen::Matrix3d& R, double cube) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
-  for (int i : indices) {
-    const Eigen::Vector3d p_B = R.transpose() * cloud[i].getVector3fMap().cast<double>();
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d p_B = R.transpose() * p;
     low = low.cwiseMin(p_B);
     high = high.cwiseMax(p_B);
   }
-  return {low, high};
-}
-
-// The box with axes R that holds all points, as centre and half extents.
-Box enclose(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
-  const auto [low, high] = extent_along(cloud, indices, R);
   Box box;
   box.center = R * (0.5 * (low + high));
   box.half_extents = (0.5 * (high - low)).array() + kBoxFitSlack;
   box.rotation = Eigen::Quaterniond(R).normalized();
-  box.points = indices.size();
+  box.points = points.size();
+  grow_to_hold_cubes(box, cube);
   return box;
 }
 
-double volume_with_axes(const Cloud& cloud, const std::vector<int>& indices, const Eigen::Matrix3d& R) {
-  const auto [low, high] = extent_along(cloud, indices, R);
-  return (high - low).prod();
+// Principal axes of the points' covariance, largest variance first, as a proper rotation.
+std::optional<Eigen::Matrix3d> principal_axes(const Points& points, const Eigen::Vector3d& origin) {
+  // Covariance about a nearby origin, which keeps coordinates of a few metres from cancelling.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d d = p - origin;
+    mean += d;
+    scatter.noalias() += d * d.transpose();
+  }
+  const double n = static_cast<double>(points.size());
+  mean /= n;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter / n - mean * mean.transpose());
+  if (solver.info() != Eigen::Success) return std::nullopt;
+  Eigen::Matrix3d R;
+  R.col(0) = solver.eigenvectors().col(2).normalized();
+  R.col(1) = solver.eigenvectors().col(1).normalized();
+  R.col(2) = R.col(0).cross(R.col(1)).normalized();
+  R.col(1) = R.col(2).cross(R.col(0));
+  return R;
 }
 
-// Principal axes of a partly seen object are tilted (three visible faces of a box skew the covariance), so
-// the PCA rotation is refined by turning it about each of its axes to the smallest volume: a coarse then a
-// fine sweep, on at most 2000 evenly spread points. Hand-written: neither Eigen nor PCL offers a
-// minimum-volume box (PCL's MomentOfInertiaEstimation is PCA as well, and slow).
-Eigen::Matrix3d refine_axes(const Cloud& cloud, const std::vector<int>& indices, Eigen::Matrix3d R) {
-  std::vector<int> sample;
-  const std::size_t stride = std::max<std::size_t>(1, indices.size() / 2000);
-  for (std::size_t i = 0; i < indices.size(); i += stride) sample.push_back(indices[i]);
-  double best = volume_with_axes(cloud, sample, R);
-  constexpr double kDegree = 3.14159265358979323846 / 180.0;
-  for (const auto& [range, step] : {std::pair<double, double>{45.0, 3.0}, {3.0, 0.5}}) {
-    for (int axis = 0; axis < 3; ++axis) {
-      Eigen::Matrix3d best_R = R;
-      for (double angle = -range; angle <= range + 1e-9; angle += step) {
-        if (angle == 0.0) continue;
-        const Eigen::Matrix3d candidate =
-            R * Eigen::AngleAxisd(angle * kDegree, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
-        const double volume = volume_with_axes(cloud, sample, candidate);
-        if (volume < best) {
-          best = volume;
-          best_R = candidate;
-        }
-      }
-      R = best_R;
-    }
+// The minimum-volume axes, searched on the hull's vertices (they have the same extents as all points). The
+// candidate face normals: the hull's facet directions (grouped within about 1°) covering the most area, the
+// principal axes and the frame's axes.
+Eigen::Matrix3d minimum_volume_axes(const Points& points, const Eigen::Matrix3d& principal, double cube) {
+  constexpr std::size_t kDirections = 24;
+  std::vector<detail::FaceDirection> faces;
+  const Points hull = detail::hull_vertices(points, &faces);
+  std::vector<Eigen::Vector3d> normals;
+  for (std::size_t f = 0; f < std::min(faces.size(), kDirections); ++f) normals.push_back(faces[f].normal);
+  for (int axis = 0; axis < 3; ++axis) {
+    normals.push_back(principal.col(axis));
+    normals.push_back(Eigen::Vector3d::Unit(axis));
   }
-  return R;
+  return detail::minimum_volume_axes(hull, normals, 2 * kBoxFitSlack + cube);
 }
 
 }  // namespace
 
 BoxKind box_kind_from_string(const std::string& text, const std::string& what) {
   if (text == "aabb") return BoxKind::kAxisAligned;
+  if (text == "pca") return BoxKind::kPrincipalAxes;
   if (text == "obb") return BoxKind::kOriented;
-  throw Error(what + ": must be 'obb' or 'aabb', got '" + text + "'");
+  throw Error(what + ": must be 'obb', 'pca' or 'aabb', got '" + text + "'");
 }
 
 const char* to_string(BoxKind kind) {
-  return kind == BoxKind::kAxisAligned ? "aabb" : "obb";
+  switch (kind) {
+    case BoxKind::kAxisAligned:
+      return "aabb";
+    case BoxKind::kPrincipalAxes:
+      return "pca";
+    case BoxKind::kOriented:
+      break;
+  }
+  return "obb";
 }
 
-Box fit_box(const Cloud& cloud, const std::vector<int>& indices, BoxKind kind) {
+void grow_to_hold_cubes(Box& box, double edge) {
+  if (!(edge > 0)) return;
+  const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+  for (int axis = 0; axis < 3; ++axis) box.half_extents[axis] += 0.5 * edge * R.col(axis).lpNorm<1>();
+}
+
+std::vector<Eigen::Vector3d> hull_vertices(const std::vector<Eigen::Vector3d>& points) {
+  return detail::hull_vertices(points, nullptr);
+}
+
+Box fit_box(const std::vector<Eigen::Vector3d>& points, BoxKind kind, double cube) {
+  if (points.empty()) throw Error("fit_box: no points");
+  const Box aabb = enclose(points, Eigen::Matrix3d::Identity(), cube);
+  if (kind == BoxKind::kAxisAligned || points.size() < 3) return aabb;
+  const std::optional<Eigen::Matrix3d> principal = principal_axes(points, aabb.center);
+  if (!principal) return aabb;
+  const Box pca = enclose(points, *principal, cube);
+  if (kind == BoxKind::kPrincipalAxes) return pca;
+  const Box obb = enclose(points, minimum_volume_axes(points, *principal, cube), cube);
+  const Box& smaller = pca.volume() < aabb.volume() ? pca : aabb;
+  return obb.volume() < smaller.volume() ? obb : smaller;
+}
+
+Box fit_box(const Cloud& cloud, const std::vector<int>& indices, BoxKind kind, double cube) {
   if (indices.empty()) throw Error("fit_box: no points");
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(indices.size());
   for (int i : indices) {
     if (i < 0 || static_cast<std::size_t>(i) >= cloud.size())
       throw Error("fit_box: point index out of range");
+    points.push_back(cloud[i].getVector3fMap().cast<double>());
   }
-  Box aabb = enclose(cloud, indices, Eigen::Matrix3d::Identity());
-  aabb.rotation = Eigen::Quaterniond::Identity();
-  if (kind == BoxKind::kAxisAligned || indices.size() < 3) return aabb;
-
-  // Covariance about the AABB centre, which keeps float coordinates of a few metres from cancelling.
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (int i : indices) {
-    const Eigen::Vector3d d = cloud[i].getVector3fMap().cast<double>() - aabb.center;
-    mean += d;
-    scatter.noalias() += d * d.transpose();
-  }
-  const double n = static_cast<double>(indices.size());
-  mean /= n;
-  const Eigen::Matrix3d covariance = scatter / n - mean * mean.transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-  if (solver.info() != Eigen::Success) return aabb;
-  // Largest variance first, third axis from the cross product: a proper rotation (det = +1).
-  Eigen::Matrix3d R;
-  R.col(0) = solver.eigenvectors().col(2).normalized();
-  R.col(1) = solver.eigenvectors().col(1).normalized();
-  R.col(2) = R.col(0).cross(R.col(1)).normalized();
-  R.col(1) = R.col(2).cross(R.col(0));
-  const Box obb = enclose(cloud, indices, refine_axes(cloud, indices, R));
-  return obb.volume() < aabb.volume() ? obb : aabb;
+  return fit_box(points, kind, cube);
 }
 
 }  // namespace cellmap

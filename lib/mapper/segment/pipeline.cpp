@@ -1,3 +1,5 @@
+// Equation and algorithm numbers are those of K. Zauner, J. El Dib, H. Gattringer, A. Müller,
+// "Workspace Registration and Collision Detection for Industrial Robotics Applications", AIRoV 2024.
 #include "cellmap/segment/pipeline.hpp"
 
 #include <algorithm>
@@ -47,6 +49,46 @@ Cloud subset(const Cloud& cloud, const std::vector<int>& indices) {
   out.sensor_origin_ = cloud.sensor_origin_;
   out.sensor_orientation_ = cloud.sensor_orientation_;
   return out;
+}
+
+// Free space is judged in direction bins one point spacing (the median distance to the nearest neighbour)
+// wide at the points' median range from the viewpoint; a surface is a spacing (or half a voxel) thick.
+BoxSplitParams box_split_params(const SegmentConfig& config, const Cloud& cloud, const Neighbourhoods& nb,
+                                const Eigen::Vector3d& viewpoint, double gap) {
+  BoxSplitParams p;
+  p.kind = config.box_kind;
+  p.cube = config.voxel;
+  p.min_gain = config.split_min_gain;
+  p.max_growth = config.join_max_growth;
+  p.gap = gap;
+  std::vector<double> range, spacing;
+  range.reserve(cloud.size());
+  for (int i = 0; i < nb.size(); ++i) {
+    range.push_back((cloud[i].getVector3fMap().cast<double>() - viewpoint).norm());
+    if (nb.k > 0 && nb.neighbour(i, 0) >= 0) spacing.push_back(std::sqrt(nb.sq_distance(i, 0)));
+  }
+  const auto median = [](std::vector<double>& v, double fallback) {
+    if (v.empty()) return fallback;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  const double step = std::max(median(spacing, gap), 1e-4);
+  p.angular_step = step / std::max(median(range, 1.0), 10 * step);
+  p.margin = std::max(step, 0.5 * config.voxel);
+  p.adjacency = std::max(gap, config.voxel);
+  return p;
+}
+
+const char* split_method_name(SplitMethod method) {
+  switch (method) {
+    case SplitMethod::kFreeSpace:
+      return "free_space";
+    case SplitMethod::kOff:
+      return "off";
+    case SplitMethod::kSupervoxels:
+      break;
+  }
+  return "supervoxels";
 }
 
 }  // namespace
@@ -102,6 +144,17 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
   }
   {
     YamlMap m = root.child("split");
+    const std::string method = m.get<std::string>("method", split_method_name(c.split_method));
+    if (method == "free_space") {
+      c.split_method = SplitMethod::kFreeSpace;
+    } else if (method == "supervoxels") {
+      c.split_method = SplitMethod::kSupervoxels;
+    } else if (method == "off") {
+      c.split_method = SplitMethod::kOff;
+    } else {
+      m.fail("method", "must be free_space, supervoxels or off, got '" + method + "'");
+    }
+    c.split_min_gain = m.number("min_gain", c.split_min_gain, 1e-3, 1.0);
     SplitParams& s = c.split;
     s.max_extent = m.number("max_extent", s.max_extent, 1e-3, 1e3);
     s.voxel_resolution = m.number("voxel_resolution", s.voxel_resolution, 1e-4, 1.0);
@@ -110,10 +163,19 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
     m.expect_all_read();
   }
   {
+    YamlMap m = root.child("join");
+    c.join_max_growth = m.number("max_growth", c.join_max_growth, 0.0, 0.99);
+    if (c.join_max_growth >= c.split_min_gain && c.split_method == SplitMethod::kFreeSpace) {
+      m.fail("max_growth", "must be below split.min_gain (a join must not undo a split)");
+    }
+    m.expect_all_read();
+  }
+  {
     YamlMap m = root.child("boxes");
     const std::string kind = m.get<std::string>("kind", to_string(c.box_kind));
     c.box_kind =
         box_kind_from_string(kind, (m.source().empty() ? "" : m.source() + ": ") + m.key_path("kind"));
+    c.voxel = m.number("voxel", c.voxel, 0.0, 1.0);
     m.expect_all_read();
   }
   if (root.has("workspace")) {
@@ -191,12 +253,22 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   stats.merged_segments = static_cast<std::size_t>(segments.count);
   stats.t_merge = clock.lap();
 
-  segments = split_large_segments(cloud, segments, config.split, &stats.split_segments);
+  const BoxSplitParams parts = box_split_params(config, cloud, nb, viewpoint.cast<double>(), growing.gap);
+  if (config.split_method == SplitMethod::kFreeSpace) {
+    segments =
+        split_by_free_space(cloud, nb, segments, viewpoint.cast<double>(), parts, &stats.split_segments);
+  } else if (config.split_method == SplitMethod::kSupervoxels) {
+    segments = split_large_segments(cloud, segments, config.split, &stats.split_segments);
+  }
   stats.t_split = clock.lap();
+  if (config.join_max_growth > 0) {
+    segments = join_by_free_space(cloud, segments, viewpoint.cast<double>(), parts, &stats.joins);
+  }
+  stats.t_join = clock.lap();
 
   for (const std::vector<int>& members : segments.members()) {
     if (members.empty()) continue;
-    Box box = fit_box(cloud, members, config.box_kind);
+    Box box = fit_box(cloud, members, config.box_kind, config.voxel);
     box.id = result.boxes.boxes.size() + 1;
     for (int i : members) result.box_of_point[index[i]] = static_cast<int>(result.boxes.boxes.size());
     result.boxes.boxes.push_back(box);
@@ -210,13 +282,14 @@ std::string summary(const SegmentStats& s) {
   char line[512];
   std::snprintf(line, sizeof line,
                 "points %zu, dropped: outside workspace %zu, outliers sparse %zu dense %zu, isolated %zu; "
-                "gap %.4f m, regions %zu, leftovers attached %zu own segments %zu, merged to %zu, split %zu; "
-                "boxes %zu; "
-                "time %.3f s (features %.3f, outliers %.3f, grow %.3f, merge %.3f, split %.3f)",
+                "gap %.4f m, regions %zu, leftovers attached %zu own segments %zu, merged to %zu, split %zu, "
+                "joined %zu; boxes %zu; "
+                "time %.3f s (features %.3f, outliers %.3f, grow %.3f, merge %.3f, split %.3f, join %.3f, "
+                "boxes %.3f)",
                 s.points_in, s.outside_workspace, s.outliers_sparse, s.outliers_dense, s.leftovers.isolated,
                 s.gap, s.regions, s.leftovers.attached, s.leftovers.own_segments, s.merged_segments,
-                s.split_segments, s.boxes, s.t_total(), s.t_features, s.t_outliers, s.t_grow, s.t_merge,
-                s.t_split);
+                s.split_segments, s.joins, s.boxes, s.t_total(), s.t_features, s.t_outliers, s.t_grow,
+                s.t_merge, s.t_split, s.t_join, s.t_boxes);
   return line;
 }
 

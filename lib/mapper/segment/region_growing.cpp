@@ -1,3 +1,5 @@
+// Equation and algorithm numbers are those of K. Zauner, J. El Dib, H. Gattringer, A. Müller,
+// "Workspace Registration and Collision Detection for Industrial Robotics Applications", AIRoV 2024.
 #include "cellmap/segment/region_growing.hpp"
 
 #include <pcl/search/kdtree.h>
@@ -58,10 +60,10 @@ Segments grow_regions(const Neighbourhoods& nb, const RegionGrowingParams& param
         // Neighbours come nearest first: the first one beyond the gap ends the list (eq. 3).
         if (other < 0 || nb.sq_distance(i, j) > max_sq_gap) break;
         if (label[other] >= 0) continue;
-        if (nb.normals[i].dot(nb.normals[other]) < min_cos) continue;  // eq. 6
+        if (nb.normals[i].dot(nb.normals[other]) < min_cos) continue;  // eq. 5
         label[other] = region;
         ++size;
-        if (nb.curvature[other] <= max_curvature) queue.push_back(other);  // eq. 5
+        if (nb.curvature[other] <= max_curvature) queue.push_back(other);  // eq. 4
       }
     }
     region_size.push_back(size);

@@ -147,6 +147,10 @@ void write_sweep_pcd(const std::filesystem::path& path, const Sweep& sweep) {
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Scan& scan : sweep.scans) mean += scan.origin_C / static_cast<double>(sweep.scans.size());
+  cloud.sensor_origin_ = Eigen::Vector4f(static_cast<float>(mean.x()), static_cast<float>(mean.y()),
+                                         static_cast<float>(mean.z()), 0.0f);
   save_binary_pcd(path, cloud);
 }
 

@@ -26,7 +26,7 @@ struct Box final {
   [[nodiscard]] bool is_axis_aligned() const;
 };
 
-/// A set of boxes with the version and frame they belong to: the boxes file of ARCHITECTURE.md.
+/// A set of boxes with the version and frame they belong to: the boxes JSON file (docs/boxes-json.md).
 struct BoxSet final {
   std::uint64_t version = 0;
   std::string frame = "cell";

@@ -1,6 +1,8 @@
 #pragma once
 // The paper's comparison (section 5.3, fig. 6b): a cube moved along y past a row of boxes; its minimum
 // distance by GJK and by bounding spheres with N = 1, 2, 6 per box, and the constraints each method costs.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 //
 // Scene (cell frame, metres): the moving cube has half extents 0.1 and centre (0, y, 0.1), y from −1.5 to 1.5
 // in steps of 0.01 (301 checkpoints). The row: three boxes of half extents (0.1, 0.2, 0.1) centred at x =

@@ -2,6 +2,8 @@
 // The paper's sensor comparison on a simulated cell: every sensor of the scene sweeps the same cell once, its
 // merged cloud (downsampled to equal density) goes through the batch pipeline, and the boxes are scored
 // against the scene's true obstacles (coverage of the surface the sensor saw, lost and blocked free space).
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <cstddef>
 #include <string>

@@ -1,5 +1,7 @@
 #pragma once
 // Batch distance queries: robot boxes × environment boxes × checkpoints → the constraint vector of the paper.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <Eigen/Core>
 

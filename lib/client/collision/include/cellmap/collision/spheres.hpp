@@ -1,6 +1,8 @@
 #pragma once
 // Bounding spheres: the paper's cheap, conservative approximation of a box by N spheres, and the sphere
 // queries.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <Eigen/Core>
 

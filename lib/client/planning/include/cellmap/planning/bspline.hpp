@@ -1,5 +1,7 @@
 #pragma once
 // The paper's path representation: a clamped uniform cubic B-spline z(d, t) over control points d.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <Eigen/Core>
 

@@ -11,8 +11,11 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "cellmap/security/credentials.hpp"
 
 namespace cellmap::dds {
 
@@ -35,6 +38,8 @@ class Qos final {
   /// Writers only: when false, deleting the writer (a daemon restart) unregisters its instances without
   /// disposing them, so readers keep the data instead of seeing it removed.
   Qos& autodispose(bool on);
+  /// Sets a named property (participants: e.g. DDS Security's "dds.sec.*").
+  Qos& property(const std::string& name, const std::string& value);
   [[nodiscard]] const dds_qos_t* get() const { return qos_; }
 
  private:
@@ -61,10 +66,47 @@ class Entity {
 };
 
 /// A domain participant. The configuration comes from CYCLONEDDS_URI as usual.
+///
+/// With a security setting it joins with DDS Security on (Cyclone's auth, access-control and crypto plugins,
+/// configured through participant properties): it then talks only to participants of the same cell's CAs,
+/// and creating a writer or reader its role's permissions do not grant throws ("Not Allowed By Security").
+/// Every class of lib/client/transport takes its participant, so this one setting secures all of them.
+///
+/// Cyclone DDS 0.10 loads DDS Security once per domain and process, from the first participant's setting,
+/// and gives every later participant of that process on that domain the same identity whatever it asked
+/// for. So one process is one role on a domain: a participant whose setting differs from that of a live
+/// participant of this process on the same domain is refused.
 class Participant final : public Entity {
  public:
-  /// @throws Error if the domain cannot be joined (bad id, bad CYCLONEDDS_URI, no usable interface).
-  explicit Participant(std::uint32_t domain);
+  /// @throws Error if the credentials are refused (security::check: "<file>: <reason>"), this process is on
+  /// the domain with another setting, or the domain cannot be joined (bad id, bad CYCLONEDDS_URI, no usable
+  /// interface).
+  explicit Participant(std::uint32_t domain, const std::optional<security::Setting>& security = std::nullopt);
+  /// Deletes the participant before giving back its claim on the domain's setting.
+  ~Participant();
+  Participant(Participant&& other) noexcept = default;
+  /// The credentials it joined with; nullopt when DDS Security is off.
+  [[nodiscard]] const std::optional<security::Credentials>& credentials() const { return credentials_; }
+
+ private:
+  // This participant's share of its domain's setting in this process, given back when it goes.
+  class SettingClaim final {
+   public:
+    explicit SettingClaim(std::uint32_t domain) : domain_(domain) {}
+    ~SettingClaim();
+    SettingClaim(SettingClaim&& other) noexcept : domain_(other.domain_), held_(other.held_) {
+      other.held_ = false;
+    }
+    SettingClaim& operator=(SettingClaim&&) = delete;
+
+   private:
+    std::uint32_t domain_;
+    bool held_ = true;
+  };
+  struct Checked {};
+  Participant(std::uint32_t domain, std::optional<security::Credentials> credentials, Checked);
+  std::optional<security::Credentials> credentials_;
+  SettingClaim claim_;
 };
 
 /// A topic of one generated type (its idlc descriptor, e.g. &cellmap_msg_Environment_desc).

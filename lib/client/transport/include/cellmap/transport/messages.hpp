@@ -27,6 +27,8 @@ struct CellStatus final {
   std::uint64_t boxes = 0;
   std::uint64_t version = 0;
   std::string reason;  ///< why the state is "degraded" (one line); empty otherwise
+  /// scene edits and robot poses refused, never applied (input_limits.hpp)
+  std::uint64_t refused_inputs = 0;
 };
 
 /// cellmap/sim/scene_edits: one edit of a simulated scene (what `cellmap inject` sends, what tests plant;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellmap/transport/dds.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
 
 namespace cellmap::transport {
@@ -34,18 +35,24 @@ class RobotStateWriter final {
 /// Receives tool poses for one cell (cellmapd's side). `participant` must outlive it. Not thread-safe.
 class RobotStateReader final {
  public:
-  /// @param cell  only this cell's poses are returned; others are skipped (not counted as rejected).
-  RobotStateReader(const dds::Participant& participant, std::string cell);
+  /// @param cell       only this cell's poses are returned; others are skipped (not counted as rejected).
+  /// @param limits     poses outside them are refused (input_limits.hpp; stamps against CLOCK_REALTIME)
+  /// @param on_refused called with the reason of each refused pose, from take()
+  RobotStateReader(const dds::Participant& participant, std::string cell, InputLimits limits = {},
+                   OnRefused on_refused = {});
   ~RobotStateReader();
   RobotStateReader(const RobotStateReader&) = delete;
   RobotStateReader& operator=(const RobotStateReader&) = delete;
   /// Waits up to `timeout` for data (zero: just looks) and returns the poses received, oldest first.
-  /// Malformed samples (empty cell, non-finite numbers, non-unit quaternion) are skipped and counted.
+  /// Malformed samples (empty cell, non-finite numbers, non-unit quaternion) and poses outside the limits are
+  /// refused: skipped, counted in rejected() and passed to on_refused.
   std::vector<RobotState> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
 
  private:
   std::string cell_;
+  InputLimits limits_;
+  OnRefused on_refused_;
   dds::Topic topic_;
   dds::Reader reader_;
   dds::WaitSet waitset_;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cellmap/transport/dds.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
 
 namespace cellmap::transport {
@@ -30,16 +31,21 @@ class SceneEditWriter final {
 /// Receives scene edits (the simulator side). `participant` must outlive it. Not thread-safe.
 class SceneEditReader final {
  public:
-  explicit SceneEditReader(const dds::Participant& participant);
+  /// @param limits     edits outside them are refused (input_limits.hpp)
+  /// @param on_refused called with the reason of each refused edit, from take()
+  explicit SceneEditReader(const dds::Participant& participant, InputLimits limits = {},
+                           OnRefused on_refused = {});
   ~SceneEditReader();
   SceneEditReader(const SceneEditReader&) = delete;
   SceneEditReader& operator=(const SceneEditReader&) = delete;
   /// Waits up to `timeout` (zero: just looks) and returns the edits received, oldest first. Malformed edits
-  /// are skipped and counted in rejected().
+  /// and edits outside the limits are refused: skipped, counted in rejected() and passed to on_refused.
   std::vector<SceneEdit> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
 
  private:
+  InputLimits limits_;
+  OnRefused on_refused_;
   dds::Topic topic_;
   dds::Reader reader_;
   dds::WaitSet waitset_;

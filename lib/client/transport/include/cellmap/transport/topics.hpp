@@ -1,9 +1,11 @@
 #pragma once
-// cellmap's DDS topics and their QoS, exactly as ARCHITECTURE.md states them. Writers and readers both use
-// these, so a reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
+// cellmap's DDS topics and their QoS (the contract: docs/dds.md). Writers and readers both use these, so a
+// reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.
 
 #include <cstdint>
+#include <map>
 
+#include "cellmap/security/cell_setup.hpp"
 #include "cellmap/transport/dds.hpp"
 
 namespace cellmap::transport {
@@ -16,6 +18,9 @@ inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
 inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
 inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
 inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
+/// Reserved for the robot's joint states (no type yet): already in the DDS Security grants (robot writes,
+/// daemon reads), so credentials issued now stay valid when it arrives.
+inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
@@ -35,5 +40,12 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/layer/*: RELIABLE, VOLATILE, KEEP_LAST 1 (a layer is the daemon's current view; a reader only
 /// wants the newest, and the daemon writes it only while a reader is matched).
 [[nodiscard]] dds::Qos layer_qos();
+
+/// What each DDS Security role may write and read (`cellmap security init` signs these into the permissions):
+///   daemon   writes environment, delta, status, layers;  reads robot state and joints, scene edits (sim)
+///   planner  writes nothing;                             reads environment, delta, status, layers (`view`)
+///   robot    writes robot state and joints;              reads nothing
+///   tool     writes scene edits (`inject`);              reads environment, delta, status (`echo`)
+[[nodiscard]] std::map<security::Role, security::TopicGrants> role_grants();
 
 }  // namespace cellmap::transport

@@ -58,10 +58,10 @@ struct Resegmentation final {
   std::size_t evidence = 0;  ///< occupied voxels that were segmented
 };
 
-/// The incremental pipeline of one cell. Boxes are fitted to the centres of occupied voxels and then grown by
-/// the voxel's extent along each box axis, so every sensor point that fell into an occupied voxel of a
-/// re-segmented region is inside a box. Box ids are never reused: every new box gets the next id of the
-/// counter. Not thread-safe; one instance per cell, driven by one thread.
+/// The incremental pipeline of one cell. Boxes are fitted to the centres of occupied voxels so that they hold
+/// the whole voxels (`segment.voxel` is set to the map's resolution), so every sensor point that fell into an
+/// occupied voxel of a re-segmented region is inside a box. Box ids are never reused: every new box gets the
+/// next id of the counter. Not thread-safe; one instance per cell, driven by one thread.
 class CellPipeline final {
  public:
   /// Starts from `boxes` and, if `map_state` is given, the map saved by map_state() (else an empty map, which

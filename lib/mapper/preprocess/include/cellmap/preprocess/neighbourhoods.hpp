@@ -1,5 +1,7 @@
 #pragma once
 // Per-point k-neighbourhoods and the features the paper derives from them (eq. 1 and 2).
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <Eigen/Core>
 

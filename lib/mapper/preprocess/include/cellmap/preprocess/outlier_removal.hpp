@@ -1,5 +1,7 @@
 #pragma once
 // Statistical outlier removal on the mean neighbour distance (paper eq. 1).
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <vector>
 

@@ -1,6 +1,9 @@
 #pragma once
 // The paper's batch pipeline on one cloud: crop → neighbourhoods and features (eq. 1, 2) → outlier removal →
-// region growing → leftovers → convex merge → VCCS split → boxes.
+// region growing → leftovers → convex merge → split (the paper's VCCS, or by free space) → join by free space
+// → boxes.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <optional>
 #include <string>
@@ -11,12 +14,20 @@
 #include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/outlier_removal.hpp"
 #include "cellmap/preprocess/workspace.hpp"
+#include "cellmap/segment/box_split.hpp"
 #include "cellmap/segment/convex_merge.hpp"
 #include "cellmap/segment/fit.hpp"
 #include "cellmap/segment/region_growing.hpp"
 #include "cellmap/segment/supervoxel_split.hpp"
 
 namespace cellmap {
+
+/// How segments that are too big for one box are split.
+enum class SplitMethod {
+  kFreeSpace,    ///< "free_space": cut where the parts' boxes block markedly less free space (box_split.hpp)
+  kSupervoxels,  ///< "supervoxels": the paper's VCCS supervoxels of segments longer than max_extent
+  kOff,          ///< "off": one box per segment
+};
 
 /// Every parameter of the pipeline. The defaults here are the documented ones of config/segment.yaml.
 struct SegmentConfig final {
@@ -31,8 +42,13 @@ struct SegmentConfig final {
   int leftover_min_points = 3;  ///< smaller leftover groups are dropped (counted)
   bool merge = true;            ///< convex merging on/off
   ConvexMergeParams merge_params;
-  SplitParams split;
+  SplitMethod split_method = SplitMethod::kSupervoxels;
+  double split_min_gain = 0.25;  ///< free_space: see BoxSplitParams::min_gain
+  SplitParams split;             ///< supervoxels
+  double join_max_growth = 0.0;  ///< see BoxSplitParams::max_growth; 0 = no joining
   BoxKind box_kind = BoxKind::kOriented;
+  /// Metres: the points are centres of voxels of this edge (0 = plain points); boxes hold the whole voxels.
+  double voxel = 0.0;
   std::optional<Workspace> workspace;  ///< crop region; none = no crop
 };
 
@@ -54,13 +70,14 @@ struct SegmentStats final {
   LeftoverStats leftovers;
   MergeStats merge;
   std::size_t merged_segments = 0;  ///< segments after merging
-  std::size_t split_segments = 0;   ///< segments that VCCS split
+  std::size_t split_segments = 0;   ///< segments that were split
+  std::size_t joins = 0;            ///< pairs of parts joined into one box
   std::size_t boxes = 0;
   /// Seconds per stage.
   double t_crop = 0, t_outliers = 0, t_features = 0, t_grow = 0, t_leftovers = 0, t_merge = 0, t_split = 0,
-         t_boxes = 0;
+         t_join = 0, t_boxes = 0;
   [[nodiscard]] double t_total() const {
-    return t_crop + t_outliers + t_features + t_grow + t_leftovers + t_merge + t_split + t_boxes;
+    return t_crop + t_outliers + t_features + t_grow + t_leftovers + t_merge + t_split + t_join + t_boxes;
   }
   [[nodiscard]] std::size_t dropped() const {
     return outside_workspace + outliers_sparse + outliers_dense + leftovers.isolated;

@@ -1,5 +1,7 @@
 #pragma once
 // Region growing segmentation (paper Alg. 1) and the coverage of the points it leaves over.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include "cellmap/frame/cloud.hpp"
 #include "cellmap/preprocess/neighbourhoods.hpp"
@@ -10,8 +12,8 @@ namespace cellmap {
 /// The paper's three region conditions.
 struct RegionGrowingParams final {
   double gap = 0.01;  ///< d_th (eq. 3), metres: a neighbour farther than this never joins the region
-  double max_curvature = 0.03;  ///< κ_th (eq. 5): only points with κ <= κ_th continue the growth (seeds)
-  double max_angle = 0.07;      ///< α_th (eq. 6), radians (4°): max angle between the normals of neighbours
+  double max_curvature = 0.03;  ///< κ_th (eq. 4): only points with κ <= κ_th continue the growth (seeds)
+  double max_angle = 0.07;      ///< α_th (eq. 5), radians (4°): max angle between the normals of neighbours
   int min_cluster_size = 50;    ///< regions with fewer points are dissolved (their points become leftovers)
 };
 

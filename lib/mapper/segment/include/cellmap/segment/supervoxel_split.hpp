@@ -1,5 +1,7 @@
 #pragma once
-// Splitting oversized segments into VCCS supervoxels (paper fig. 3/4).
+// Splitting oversized segments into VCCS supervoxels (paper fig. 3/4): one box around a very large cluster
+// swallows free workspace. The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration
+// and Collision Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include "cellmap/frame/cloud.hpp"
 #include "cellmap/segment/segments.hpp"

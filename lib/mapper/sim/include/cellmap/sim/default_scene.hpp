@@ -1,5 +1,7 @@
 #pragma once
 // The bundled default scene (config/cell.yaml), embedded at build time.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include "cellmap/sim/scene.hpp"
 

@@ -1,5 +1,7 @@
 #pragma once
 // The sensor noise models of the paper's three sensors, applied to exact (ray-cast) depths and ranges.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 //
 // Deterministic by construction: every random number is a hash of (seed, sweep, frame, pixel, purpose), so a
 // pixel's noise does not depend on the order of evaluation, the thread count or the rest of the scene — two

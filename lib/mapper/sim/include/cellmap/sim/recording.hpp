@@ -44,8 +44,9 @@ void write_intrinsics(const std::filesystem::path& path, const PinholeIntrinsics
 void write_pcd(const std::filesystem::path& path, const Cloud& cloud);
 
 /// Writes a sweep's merged cloud as binary PCD with fields x y z vp_x vp_y vp_z (PCL's PointWithViewpoint):
-/// every point in the cell frame with the sensor origin it was seen from. Readers that want only x y z can
-/// load it as a plain cloud. @throws Error on I/O failure.
+/// every point in the cell frame with the sensor origin it was seen from; the header's VIEWPOINT is their
+/// mean. Readers that want only x y z can load it as a plain cloud (normals then face the mean origin).
+/// @throws Error on I/O failure.
 void write_sweep_pcd(const std::filesystem::path& path, const Sweep& sweep);
 
 }  // namespace cellmap::sim

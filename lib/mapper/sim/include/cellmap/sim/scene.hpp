@@ -1,6 +1,8 @@
 #pragma once
 // The simulated cell: its bounds, the obstacles in it, the robot, the sensors on the robot and the sweep
 // plan.
+// The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
+// Detection for Industrial Robotics Applications", AIRoV 2024.
 
 #include <Eigen/Geometry>
 

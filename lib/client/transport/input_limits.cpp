@@ -1,0 +1,56 @@
+#include "cellmap/transport/input_limits.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/transport/topics.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+std::string text(const Eigen::Vector3d& v) {
+  std::ostringstream out;
+  out << v.x() << ", " << v.y() << ", " << v.z();
+  return out.str();
+}
+
+void require_inside(const Eigen::Vector3d& p_C, const InputLimits& limits, const std::string& where) {
+  if (!limits.cell.contains(p_C)) {
+    throw Error(where + ": (" + text(p_C) + ") is outside the cell [" + text(limits.cell.min()) + "] - [" +
+                text(limits.cell.max()) + "]");
+  }
+}
+
+}  // namespace
+
+void check_limits(const SceneEdit& edit, const InputLimits& limits) {
+  const std::string where = std::string(kSceneEditTopic) + " '" + edit.name.substr(0, kMaxNameLength) + "'";
+  if (edit.name.size() > kMaxNameLength)
+    throw Error(where + ": name: longer than " + std::to_string(kMaxNameLength) + " bytes");
+  if (edit.kind == SceneEdit::Kind::kRemove) return;
+  require_inside(edit.center, limits, where + ": center");
+  if (edit.kind != SceneEdit::Kind::kAddBox) return;
+  const double largest = 0.5 * limits.cell.sizes().maxCoeff();
+  if (!(edit.half_extents.minCoeff() > 0.0) || edit.half_extents.maxCoeff() > largest) {
+    throw Error(where + ": half_extents: (" + text(edit.half_extents) + ") must be positive and at most " +
+                std::to_string(largest) + " (half the cell's largest side)");
+  }
+  if (std::abs(edit.yaw) > 2 * M_PI)
+    throw Error(where + ": yaw: " + std::to_string(edit.yaw) + " is beyond ±2π");
+}
+
+void check_limits(const RobotState& state, const InputLimits& limits, std::int64_t now_ns) {
+  const std::string where =
+      std::string(kRobotStateTopic) + " '" + state.cell + "' at " + std::to_string(state.stamp_ns);
+  require_inside(state.X_CE.translation(), limits, where + ": position");
+  if (limits.max_stamp_skew.count() <= 0) return;
+  // In double: an attacker's stamp near INT64_MIN must not overflow the difference.
+  const double skew_s = (static_cast<double>(state.stamp_ns) - static_cast<double>(now_ns)) * 1e-9;
+  if (std::abs(skew_s) > std::chrono::duration<double>(limits.max_stamp_skew).count()) {
+    throw Error(where + ": stamp_ns: " + std::to_string(skew_s) + " s from now (limit ±" +
+                std::to_string(std::chrono::duration<double>(limits.max_stamp_skew).count()) + " s)");
+  }
+}
+
+}  // namespace cellmap::transport

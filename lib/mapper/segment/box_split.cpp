@@ -1,0 +1,365 @@
+#include "cellmap/segment/box_split.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <tuple>
+#include <utility>
+
+#include "cellmap/common/error.hpp"
+#include "cellmap/segment/free_space.hpp"
+
+namespace cellmap {
+namespace {
+
+using Points = std::vector<Eigen::Vector3d>;
+
+Points points_of(const Cloud& cloud, const std::vector<int>& indices) {
+  Points points;
+  points.reserve(indices.size());
+  for (int i : indices) points.push_back(cloud[i].getVector3fMap().cast<double>());
+  return points;
+}
+
+// The box with axes R spanning [low, high] in its own frame, grown to hold the points' cubes.
+Box frame_box(const Eigen::Matrix3d& R, const Eigen::Vector3d& low, const Eigen::Vector3d& high,
+              double cube) {
+  Box box;
+  box.center = R * (0.5 * (low + high));
+  box.half_extents = (0.5 * (high - low)).array() + kBoxFitSlack;
+  box.rotation = Eigen::Quaterniond(R).normalized();
+  grow_to_hold_cubes(box, cube);
+  return box;
+}
+
+// One way to cut a part in two across an axis of its box: the first `at` points of `order` go one way.
+struct Cut {
+  std::vector<int> order;
+  std::size_t at = 0;
+  double volume = 0;  // of the two sides' boxes
+};
+
+// The box with axes R that holds the points and their cubes.
+Box box_in_frame(const Points& points, const Eigen::Matrix3d& R, double cube) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  for (const Eigen::Vector3d& p : points) {
+    low = low.cwiseMin(R.transpose() * p);
+    high = high.cwiseMax(R.transpose() * p);
+  }
+  return frame_box(R, low, high, cube);
+}
+
+// The cut along `axis` of the points in `local` (their coordinates in the box frame R) that minimises the two
+// sides' box volumes, each side keeping at least `min` points.
+std::optional<Cut> best_cut(const Points& local, const std::vector<int>& indices, const Eigen::Matrix3d& R,
+                            int axis, std::size_t min, double cube) {
+  const std::size_t n = local.size();
+  if (n < 2 * min || min < 1) return std::nullopt;
+  std::vector<std::size_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return local[a][axis] < local[b][axis]; });
+  std::vector<Eigen::Vector3d> low(n), high(n);  // extents of the first k + 1 points
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d& p = local[order[k]];
+    low[k] = k ? low[k - 1].cwiseMin(p) : p;
+    high[k] = k ? high[k - 1].cwiseMax(p) : p;
+  }
+  Eigen::Vector3d tail_low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
+                  tail_high = -tail_low;
+  Cut best;
+  best.volume = std::numeric_limits<double>::infinity();
+  for (std::size_t at = n; at-- > min;) {  // the points from `at` on form the other side
+    tail_low = tail_low.cwiseMin(local[order[at]]);
+    tail_high = tail_high.cwiseMax(local[order[at]]);
+    if (n - at < min) continue;
+    const double volume = frame_box(R, low[at - 1], high[at - 1], cube).volume() +
+                          frame_box(R, tail_low, tail_high, cube).volume();
+    if (volume < best.volume) best.at = at, best.volume = volume;
+  }
+  for (std::size_t k : order) best.order.push_back(indices[k]);
+  return best;
+}
+
+// Per axis of `box`, and of the cloud's frame when the box is turned (scenes stand on floors and tables),
+// the cuts that minimise the two sides' box volumes: one with any side size, one with sides of at least a
+// tenth of the points (so one stray point does not hide every other cut). Smallest first.
+std::vector<Cut> best_cuts(const Cloud& cloud, const std::vector<int>& indices, const Box& box, double cube) {
+  std::vector<Eigen::Matrix3d> frames{box.rotation.toRotationMatrix()};
+  if (!box.is_axis_aligned()) frames.push_back(Eigen::Matrix3d::Identity());
+  std::vector<Cut> cuts;
+  for (const Eigen::Matrix3d& R : frames) {
+    Points local;
+    local.reserve(indices.size());
+    for (int i : indices) local.push_back(R.transpose() * cloud[i].getVector3fMap().cast<double>());
+    for (int axis = 0; axis < 3; ++axis) {
+      for (std::size_t min : {std::size_t{1}, indices.size() / 10}) {
+        if (std::optional<Cut> cut = best_cut(local, indices, R, axis, min, cube))
+          cuts.push_back(std::move(*cut));
+      }
+    }
+  }
+  std::sort(cuts.begin(), cuts.end(), [](const Cut& a, const Cut& b) { return a.volume < b.volume; });
+  return cuts;
+}
+
+// The connected groups of `indices`: points linked through neighbours within the gap.
+class Components {
+ public:
+  Components(const Neighbourhoods& nb, double gap)
+      : nb_(nb), sq_gap_(static_cast<float>(gap * gap)), slot_(static_cast<std::size_t>(nb.size()), -1) {}
+
+  std::vector<std::vector<int>> of(const std::vector<int>& indices) {
+    for (std::size_t s = 0; s < indices.size(); ++s) slot_[indices[s]] = static_cast<int>(s);
+    std::vector<int> parent(indices.size());
+    for (std::size_t s = 0; s < parent.size(); ++s) parent[s] = static_cast<int>(s);
+    const auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (std::size_t s = 0; s < indices.size(); ++s) {
+      for (int j = 0; j < nb_.k; ++j) {
+        const int other = nb_.neighbour(indices[s], j);
+        if (other < 0 || nb_.sq_distance(indices[s], j) > sq_gap_) break;
+        if (slot_[other] >= 0) parent[find(static_cast<int>(s))] = find(slot_[other]);
+      }
+    }
+    std::vector<std::vector<int>> groups;
+    std::vector<int> group_of(indices.size(), -1);
+    for (std::size_t s = 0; s < indices.size(); ++s) {
+      int& g = group_of[find(static_cast<int>(s))];
+      if (g < 0) g = static_cast<int>(groups.size()), groups.emplace_back();
+      groups[g].push_back(indices[s]);
+    }
+    for (int i : indices) slot_[i] = -1;
+    return groups;
+  }
+
+ private:
+  const Neighbourhoods& nb_;
+  float sq_gap_;
+  std::vector<int> slot_;  // position of a point in the indices being grouped, -1 = not among them
+};
+
+class Splitter {
+ public:
+  Splitter(const Cloud& cloud, const Neighbourhoods& nb, const BoxSplitParams& params, Segments& out)
+      : cloud_(cloud), params_(params), components_(nb, params.gap), out_(out) {}
+
+  // Labels `indices` as one segment, or as the segments of its pieces. Returns whether it was split.
+  bool split(const std::vector<int>& indices, const SeenFreeSpace& space, int depth) {
+    if (depth < params_.max_depth && indices.size() >= 2) {
+      const Box box = fit_box(cloud_, indices, params_.kind, params_.cube);
+      const double needed = params_.min_gain * box.volume();
+      const double free = space.free_volume(box);
+      // Pieces can at most free what the box blocks: skip the search when that is too little.
+      if (free >= needed) {
+        for (const std::vector<std::vector<int>>& pieces : candidates(indices, box)) {
+          double left = 0;
+          for (const std::vector<int>& piece : pieces) left += space.free_volume(piece_box(piece, box));
+          if (free - left < needed) continue;
+          for (const std::vector<int>& piece : pieces) split(piece, space, depth + 1);
+          return true;
+        }
+      }
+    }
+    for (int i : indices) out_.label[i] = out_.count;
+    ++out_.count;
+    return false;
+  }
+
+ private:
+  // A quick box of a piece: the smaller of its boxes along the part's axes and along the cloud's.
+  [[nodiscard]] Box piece_box(const std::vector<int>& piece, const Box& part) const {
+    const Points points = points_of(cloud_, piece);
+    const Box along_part = box_in_frame(points, part.rotation.toRotationMatrix(), params_.cube);
+    const Box along_cloud = box_in_frame(points, Eigen::Matrix3d::Identity(), params_.cube);
+    return along_cloud.volume() < along_part.volume() ? along_cloud : along_part;
+  }
+
+  // Ways to divide a part, tried in order: its connected pieces (when it has several), then each cut with
+  // the connected pieces of both sides.
+  std::vector<std::vector<std::vector<int>>> candidates(const std::vector<int>& indices, const Box& box) {
+    std::vector<std::vector<std::vector<int>>> out;
+    std::vector<std::vector<int>> whole = components_.of(indices);
+    if (whole.size() > 1) out.push_back(std::move(whole));
+    for (const Cut& cut : best_cuts(cloud_, indices, box, params_.cube)) {
+      const auto middle = cut.order.begin() + static_cast<std::ptrdiff_t>(cut.at);
+      std::vector<std::vector<int>> pieces = components_.of({cut.order.begin(), middle});
+      for (std::vector<int>& piece : components_.of({middle, cut.order.end()}))
+        pieces.push_back(std::move(piece));
+      out.push_back(std::move(pieces));
+    }
+    return out;
+  }
+
+  const Cloud& cloud_;
+  const BoxSplitParams& params_;
+  Components components_;
+  Segments& out_;
+};
+
+// The cell-frame bounds of two boxes come within `gap` of each other on every axis.
+bool near(const Box& a, const Box& b, double gap) {
+  const Eigen::Vector3d reach = a.rotation.toRotationMatrix().cwiseAbs() * a.half_extents +
+                                b.rotation.toRotationMatrix().cwiseAbs() * b.half_extents;
+  return ((a.center - b.center).cwiseAbs() - reach).maxCoeff() <= gap;
+}
+
+struct Part {
+  std::vector<int> members;
+  Points hull;  // the members' hull vertices: the box of the union of parts is the box of their hulls
+  Box box;
+  std::vector<std::shared_ptr<const SeenFreeSpace>> views;  // together: what the members hide
+  bool live = true;
+};
+
+constexpr std::size_t kMaxViews = 4;  // a part seen through more views gets one view of all its points
+
+class Joiner {
+ public:
+  Joiner(const Cloud& cloud, const Eigen::Vector3d& viewpoint, const BoxSplitParams& params)
+      : cloud_(cloud), viewpoint_(viewpoint), params_(params) {}
+
+  void add(std::vector<int> members) {
+    Part part;
+    part.hull = hull_vertices(points_of(cloud_, members));
+    part.box = fit_box(part.hull, params_.kind, params_.cube);
+    part.members = std::move(members);
+    part.views.push_back(view_of(part.members));
+    parts_.push_back(std::move(part));
+  }
+
+  // Joins the cheapest pair while one is cheap enough; returns the number of joins.
+  std::size_t run() {
+    for (std::size_t a = 0; a < parts_.size(); ++a) {
+      for (std::size_t b = a + 1; b < parts_.size(); ++b) consider(a, b);
+    }
+    std::size_t joins = 0;
+    while (!pairs_.empty()) {
+      const auto cheapest = std::min_element(pairs_.begin(), pairs_.end());
+      const auto [cost, a, b] = *cheapest;
+      join(a, b);
+      ++joins;
+      pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                  [&](const auto& p) {
+                                    return std::get<1>(p) == a || std::get<2>(p) == a ||
+                                           std::get<1>(p) == b || std::get<2>(p) == b;
+                                  }),
+                   pairs_.end());
+      for (std::size_t c = 0; c < parts_.size(); ++c) {
+        if (c != a && parts_[c].live) consider(std::min(a, c), std::max(a, c));
+      }
+    }
+    return joins;
+  }
+
+  [[nodiscard]] Segments labels(std::size_t size) const {
+    std::vector<int> label(size, -1);
+    int count = 0;
+    for (const Part& part : parts_) {
+      if (!part.live) continue;
+      for (int i : part.members) label[i] = count;
+      ++count;
+    }
+    return compact_segments(label);
+  }
+
+ private:
+  // Records the pair when joining it is cheap enough.
+  void consider(std::size_t a, std::size_t b) {
+    const Part &x = parts_[a], &y = parts_[b];
+    if (!near(x.box, y.box, params_.adjacency)) return;
+    const Box joined = quick_union(x, y);
+    std::vector<const SeenFreeSpace*> views;
+    for (const auto& v : x.views) views.push_back(v.get());
+    for (const auto& v : y.views) views.push_back(v.get());
+    const double added = free_volume(joined, views) - free_volume(x.box, views) - free_volume(y.box, views);
+    const double cost = added / joined.volume();
+    if (cost <= params_.max_growth) pairs_.emplace_back(cost, a, b);
+  }
+
+  // The smaller of the two boxes that keep one part's axes and hold both parts: a cheap stand-in for the
+  // union's own fit (never smaller than it), used to judge a join.
+  [[nodiscard]] Box quick_union(const Part& x, const Part& y) const {
+    Points both = x.hull;
+    both.insert(both.end(), y.hull.begin(), y.hull.end());
+    const Box along_x = box_in_frame(both, x.box.rotation.toRotationMatrix(), params_.cube);
+    const Box along_y = box_in_frame(both, y.box.rotation.toRotationMatrix(), params_.cube);
+    return along_x.volume() < along_y.volume() ? along_x : along_y;
+  }
+
+  void join(std::size_t a, std::size_t b) {
+    Part &x = parts_[a], &y = parts_[b];
+    x.members.insert(x.members.end(), y.members.begin(), y.members.end());
+    x.hull.insert(x.hull.end(), y.hull.begin(), y.hull.end());
+    x.hull = hull_vertices(x.hull);
+    x.box = fit_box(x.hull, params_.kind, params_.cube);
+    x.views.insert(x.views.end(), y.views.begin(), y.views.end());
+    if (x.views.size() > kMaxViews) x.views = {view_of(x.members)};
+    y.live = false;
+    y.members.clear();
+    y.hull.clear();
+    y.views.clear();
+  }
+
+  [[nodiscard]] std::shared_ptr<const SeenFreeSpace> view_of(const std::vector<int>& members) const {
+    return std::make_shared<const SeenFreeSpace>(cloud_, members, viewpoint_, params_.angular_step,
+                                                 params_.margin);
+  }
+
+  const Cloud& cloud_;
+  Eigen::Vector3d viewpoint_;
+  const BoxSplitParams& params_;
+  std::vector<Part> parts_;
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs_;
+};
+
+}  // namespace
+
+void BoxSplitParams::validate() const {
+  if (!(min_gain > 0 && min_gain <= 1)) throw Error("box split: min_gain must be in (0, 1]");
+  if (!(max_growth >= 0 && max_growth < 1)) throw Error("box split: max_growth must be in [0, 1)");
+  if (max_depth < 0) throw Error("box split: max_depth must be >= 0");
+  if (!(angular_step > 0) || !(gap > 0) || !(margin >= 0) || !(adjacency >= 0) || !(cube >= 0)) {
+    throw Error("box split: angular_step and gap must be > 0; margin, adjacency and cube >= 0");
+  }
+}
+
+Segments split_by_free_space(const Cloud& cloud, const Neighbourhoods& neighbourhoods,
+                             const Segments& segments, const Eigen::Vector3d& viewpoint,
+                             const BoxSplitParams& params, std::size_t* split_count) {
+  params.validate();
+  if (segments.label.size() != cloud.size() ||
+      static_cast<std::size_t>(neighbourhoods.size()) != cloud.size()) {
+    throw Error("split: cloud, neighbourhoods and labels differ in size");
+  }
+  Segments out;
+  out.label.assign(cloud.size(), -1);
+  Splitter splitter(cloud, neighbourhoods, params, out);
+  std::size_t split = 0;
+  for (const std::vector<int>& members : segments.members()) {
+    if (members.empty()) continue;
+    const SeenFreeSpace space(cloud, members, viewpoint, params.angular_step, params.margin);
+    split += splitter.split(members, space, 0);
+  }
+  if (split_count) *split_count = split;
+  return out;
+}
+
+Segments join_by_free_space(const Cloud& cloud, const Segments& segments, const Eigen::Vector3d& viewpoint,
+                            const BoxSplitParams& params, std::size_t* join_count) {
+  params.validate();
+  if (segments.label.size() != cloud.size()) throw Error("join: labels and cloud differ in size");
+  Joiner joiner(cloud, viewpoint, params);
+  for (std::vector<int>& members : segments.members()) {
+    if (!members.empty()) joiner.add(std::move(members));
+  }
+  const std::size_t joins = params.max_growth > 0 ? joiner.run() : 0;
+  if (join_count) *join_count = joins;
+  return joiner.labels(cloud.size());
+}
+
+}  // namespace cellmap

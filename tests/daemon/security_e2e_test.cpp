@@ -1,0 +1,316 @@
+// DDS Security as an attacker meets it, with real processes on loopback: a participant without credentials
+// (a forging process, and our own tools without --security, as anyone on the plant network can run them)
+// on a secured cell's domain reaches nobody and receives nothing; each role can create only the writers and
+// readers its permissions grant; an identity of another CA is refused by the peers; bad credentials stop a
+// program at start with one line. Every role is a process of its own, as in a plant (and as Cyclone DDS
+// requires: one security setting per domain and process).
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <functional>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "cellmap/transport/status_reader.hpp"
+#include "daemon/service_e2e.hpp"
+
+namespace cellmap {
+namespace {
+
+using namespace std::chrono_literals;
+using security::Role;
+constexpr int kAttackDomain = 193;
+constexpr int kRolesDomain = 194;
+constexpr int kOtherCaDomain = 195;
+constexpr int kRefusalDomain = 196;
+
+// The daemon's status once `done` holds for it, or a failure after the patience.
+transport::CellStatus wait_for_status(transport::StatusReader& reader,
+                                      const std::function<bool(const transport::CellStatus&)>& done) {
+  transport::CellStatus last;
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const transport::CellStatus& status : reader.take(200ms)) {
+      last = status;
+      if (done(status)) return status;
+    }
+  }
+  ADD_FAILURE() << "the daemon's status never got there (last: version " << last.version << ", "
+                << last.sweeps << " sweeps, " << last.refused_inputs << " refused)";
+  return last;
+}
+
+// The status after `sweeps` more sweeps than `now`: a window in which anything sent before would have acted.
+transport::CellStatus after_sweeps(transport::StatusReader& reader, const transport::CellStatus& now,
+                                   std::uint64_t sweeps) {
+  return wait_for_status(reader,
+                         [&](const transport::CellStatus& s) { return s.sweeps >= now.sweeps + sweeps; });
+}
+
+// A program with stderr on stdout.
+std::unique_ptr<test::ChildProcess> start(std::vector<std::string> argv) {
+  argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
+  return std::make_unique<test::ChildProcess>(argv);
+}
+
+// Every line the program printed until it ended, and its exit code.
+std::vector<std::string> finish(test::ChildProcess& process, int* exit_code) {
+  std::vector<std::string> lines;
+  while (std::optional<std::string> line = process.read_line(test::kPatience)) lines.push_back(*line);
+  const int status = process.wait();
+  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return lines;
+}
+
+std::vector<std::string> run(const std::vector<std::string>& argv, int* exit_code) {
+  return finish(*start(argv), exit_code);
+}
+
+// A security_probe process (one participant: `role` from `credentials`, or none without them).
+std::vector<std::string> probe(int domain, const std::string& cell, std::vector<std::string> mode,
+                               const test::TestCredentials* credentials = nullptr,
+                               Role role = Role::kDaemon) {
+  std::vector<std::string> argv{SECURITY_PROBE, std::to_string(domain), cell};
+  argv.insert(argv.end(), mode.begin(), mode.end());
+  if (credentials) {
+    const std::vector<std::string> flags = credentials->flags(role);
+    argv.insert(argv.end(), flags.begin(), flags.end());
+  }
+  return argv;
+}
+
+// Stops a serving or forging probe and returns its last line as JSON.
+nlohmann::json stop(test::ChildProcess& process) {
+  process.signal(SIGTERM);
+  int code = 0;
+  const std::vector<std::string> lines = finish(process, &code);
+  EXPECT_EQ(code, 0);
+  if (lines.empty()) {
+    ADD_FAILURE() << "the probe printed nothing at the end";
+    return nlohmann::json::object();
+  }
+  return nlohmann::json::parse(lines.back());
+}
+
+std::string last_line(const std::vector<std::string>& lines) {
+  return lines.empty() ? "" : lines.back();
+}
+
+void expect_line(test::ChildProcess& process, const std::string& line) {
+  EXPECT_EQ(process.read_line(test::kPatience).value_or("(nothing)"), line);
+}
+
+TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNothing) {
+  test::use_secure_loopback();
+  const test::ServiceFixture service("secure", kAttackDomain);
+  const test::TestCredentials& credentials = *service.credentials();
+  auto daemon = service.start_daemon(kAttackDomain);
+  const dds::Participant participant = service.participant(kAttackDomain);  // this process: a planner
+  transport::EnvironmentSubscriber planner(participant, "secure");
+  transport::StatusReader status(participant);
+  // Where robot poses would go (the simulating daemon reads none): a reader with the daemon's credentials.
+  auto poses = start(probe(kAttackDomain, "secure", {"serve"}, &credentials, Role::kDaemon));
+  expect_line(*poses, "ready");
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version over DDS Security";
+  const Environment before = test::settled(planner, 3s);
+  const transport::TrackerStats stats_before = planner.stats();
+
+  // The outsider, first reading: our own tools without --security, which is what anyone on the plant
+  // network runs, and readers of the environment, its deltas and the status.
+  const std::string domain = std::to_string(kAttackDomain);
+  auto spy = start(probe(kAttackDomain, "secure", {"spy", "3"}));
+  auto echo = start({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "3"});
+  auto inject = start({CELLMAP_TOOL, "inject", "--domain", domain, "--wait", "3", "add-box", "--center",
+                       "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  auto pose = start({CELLMAP_TOOL, "robot-pose", "--domain", domain, "--cell", "secure", "--pose", "1,1,1",
+                     "--wait", "3", "--duration", "0.2"});
+  int code = 0;
+  EXPECT_EQ(finish(*spy, &code), std::vector<std::string>{R"({"received":0})"})
+      << "the outsider read something";
+  EXPECT_EQ(finish(*echo, &code),
+            std::vector<std::string>{"cellmap: echo: timed out after 3 s with 0 of 1 messages"});
+  EXPECT_EQ(code, 1);
+  EXPECT_EQ(finish(*inject, &code),
+            std::vector<std::string>{"cellmap: inject: no simulating cellmapd on domain " + domain +
+                                     " within 3 s"});
+  EXPECT_EQ(code, 1);
+  const std::vector<std::string> pose_lines = finish(*pose, &code);
+  ASSERT_EQ(pose_lines.size(), 1u);
+  EXPECT_NE(pose_lines[0].find("robot-pose: no cellmapd reading robot poses"), std::string::npos)
+      << pose_lines[0];
+  EXPECT_EQ(code, 1);
+
+  // Then writing (alone: outsiders would read each other): a fake delta removing every box from the
+  // planner's version, a fake snapshot of an empty cell, scene edits and robot poses every 100 ms.
+  std::string ids;
+  for (const Box& box : before.boxes()) ids += (ids.empty() ? "" : ",") + std::to_string(box.id);
+  auto outsider = start(probe(kAttackDomain, "secure", {"forge", std::to_string(before.version()), ids}));
+  expect_line(*outsider, "forging");
+  // Six sweeps of the daemon (over a second): plain participants on loopback match in milliseconds, so
+  // anything forged would have acted by then.
+  const transport::CellStatus start_status =
+      wait_for_status(status, [](const transport::CellStatus&) { return true; });
+  const transport::CellStatus after = after_sweeps(status, start_status, 6);
+  const nlohmann::json forged = stop(*outsider);
+  EXPECT_EQ(forged, (nlohmann::json{
+                        {"reached_environment", false}, {"reached_edits", false}, {"reached_poses", false}}))
+      << "a secured reader matched the outsider's writer";
+  EXPECT_EQ(after.version, before.version()) << "the daemon made a version";
+  EXPECT_EQ(after.refused_inputs, 0u) << "nothing of the outsider's should even arrive";
+  EXPECT_EQ(*planner.environment(), before) << "the planner's environment changed";
+  const transport::TrackerStats stats_after = planner.stats();
+  EXPECT_EQ(stats_after.deltas_applied, stats_before.deltas_applied);
+  EXPECT_EQ(stats_after.snapshots_applied, stats_before.snapshots_applied);
+  EXPECT_EQ(stats_after.rejected, stats_before.rejected);
+  EXPECT_EQ(poses->read_line(0ms), std::nullopt) << "an outsider's robot pose arrived";
+
+  // The robot's credentials do reach the pose reader.
+  EXPECT_EQ(
+      run({CELLMAP_TOOL, "robot-pose", "--domain", domain, "--cell", "secure", "--pose", "1,1,1", "--rate",
+           "50", "--duration", "0.2", "--security", credentials.directory().string(), "--role", "robot"},
+          &code)
+          .size(),
+      1u);
+  EXPECT_EQ(code, 0) << "a robot identity could not write robot state";
+  EXPECT_GT(stop(*poses).value("poses", 0), 0);
+
+  // A credentialed tool's edit with a centre of 1e300 is refused and counted, and never enters the scene: a
+  // move of that obstacle afterwards finds none.
+  const std::string far = service.inject(
+      kAttackDomain, {"add-box", "--center", "1e300,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+  ASSERT_FALSE(far.empty());
+  wait_for_status(status, [](const transport::CellStatus& s) { return s.refused_inputs == 1; });
+  service.inject(kAttackDomain, {"move", "--name", far, "--center", "2.12,0.45,0.9"});
+  const transport::CellStatus moved =
+      wait_for_status(status, [](const transport::CellStatus& s) { return s.refused_inputs == 2; });
+  const transport::CellStatus later = after_sweeps(status, moved, 6);
+  EXPECT_EQ(later.version, before.version());
+  EXPECT_EQ(later.refused_inputs, 2u);
+  EXPECT_EQ(*planner.environment(), before);
+
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+}
+
+TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant) {
+  test::use_secure_loopback();
+  const test::TestCredentials credentials("roles", kRolesDomain);
+  const auto grants_of = [&](Role role) {
+    int code = 0;
+    const std::vector<std::string> lines =
+        run(probe(kRolesDomain, "roles", {"writers"}, &credentials, role), &code);
+    EXPECT_EQ(code, 0);
+    return lines.size() == 1 ? nlohmann::json::parse(lines[0]) : nlohmann::json::object();
+  };
+  // What each role may create; the probe tries seven writers and readers, the others must be refused.
+  const std::map<Role, std::set<std::string>> created{
+      {Role::kPlanner, {"environment_subscriber", "status_reader"}},
+      {Role::kRobot, {"robot_state_writer"}},
+      {Role::kTool, {"scene_edit_writer", "environment_subscriber", "status_reader"}},
+      {Role::kDaemon, {"environment_publisher", "scene_edit_reader", "robot_state_reader"}}};
+  for (const auto& [role, allowed] : created) {
+    const nlohmann::json got = grants_of(role);
+    EXPECT_EQ(got.size(), 7u) << got.dump();
+    for (const auto& [entity, result] : got.items()) {
+      EXPECT_EQ(result, allowed.count(entity) ? "created" : "refused")
+          << security::to_string(role) << ": " << entity;
+    }
+  }
+}
+
+TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
+  test::use_secure_loopback();
+  const test::TestCredentials ours("ca", kOtherCaDomain);
+  const test::TestCredentials theirs("ca", kOtherCaDomain);  // valid in itself, but of other CAs
+  auto daemon = start(probe(kOtherCaDomain, "ca", {"serve", "--publish"}, &ours, Role::kDaemon));
+  expect_line(*daemon, "ready");
+  const dds::Participant participant(kOtherCaDomain, ours.as(Role::kPlanner));
+  transport::EnvironmentSubscriber planner(participant, "ca");
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "our own peers never matched";
+
+  const std::string domain = std::to_string(kOtherCaDomain);
+  const auto as_theirs = [&](std::vector<std::string> argv, Role role) {
+    const std::vector<std::string> flags = theirs.flags(role);
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    return start(argv);
+  };
+  auto echo =
+      as_theirs({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "3"}, Role::kTool);
+  auto inject = as_theirs(
+      {CELLMAP_TOOL, "inject", "--domain", domain, "--wait", "3", "remove", "--name", "x"}, Role::kTool);
+  auto pose = as_theirs({CELLMAP_TOOL, "robot-pose", "--domain", domain, "--cell", "ca", "--pose", "1,1,1",
+                         "--wait", "3", "--duration", "0.2"},
+                        Role::kRobot);
+  // Their programs end as without any peer (Cyclone DDS also logs each failed handshake on stderr).
+  int code = 0;
+  EXPECT_EQ(last_line(finish(*echo, &code)), "cellmap: echo: timed out after 3 s with 0 of 1 messages");
+  EXPECT_EQ(code, 1);
+  EXPECT_EQ(last_line(finish(*inject, &code)),
+            "cellmap: inject: no simulating cellmapd on domain " + domain + " within 3 s");
+  EXPECT_EQ(code, 1) << "a tool of another CA reached the daemon's scene-edit reader";
+  EXPECT_NE(last_line(finish(*pose, &code)).find("robot-pose: no cellmapd reading robot poses"),
+            std::string::npos);
+  EXPECT_EQ(code, 1) << "a robot of another CA reached the daemon's robot-state reader";
+  const nlohmann::json served = stop(*daemon);
+  EXPECT_EQ(served, (nlohmann::json{{"edits", 0}, {"poses", 0}, {"subscribers", 1}}))
+      << "only our own planner may have matched";
+}
+
+TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
+  const test::TestCredentials credentials("refusal", kRefusalDomain);
+  const test::TempDir state;
+  const security::RoleFiles daemon = security::role_files(credentials.directory(), Role::kDaemon);
+  ASSERT_EQ(::chmod(daemon.private_key.c_str(), 0640), 0);
+  int code = 0;
+  std::vector<std::string> lines =
+      run({CELLMAPD, "--domain", std::to_string(kRefusalDomain), "--state-dir", state.path().string(),
+           "--security", credentials.directory().string()},
+          &code);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find(" critical " + daemon.private_key.string() +
+                          ": group or others have access (mode 0640); chmod 600 it"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_EQ(code, 1);
+
+  lines = run({CELLMAP_TOOL, "echo", "--domain", std::to_string(kRefusalDomain + 1), "--security",
+               credentials.directory().string()},
+              &code);
+  EXPECT_EQ(lines,
+            std::vector<std::string>{"cellmap: " + (credentials.directory() / "governance.p7s").string() +
+                                     ": made for DDS domain 196, not 197"});
+  EXPECT_EQ(code, 1);
+  lines = run({CELLMAP_TOOL, "inject", "--security", "/nonexistent", "remove", "--name", "x"}, &code);
+  EXPECT_EQ(lines, std::vector<std::string>{"cellmap: /nonexistent/identity_ca.pem: missing"});
+  EXPECT_EQ(code, 1);
+}
+
+TEST(SecurityE2eTest, TheDaemonSaysOnceAtStartWhetherDdsSecurityIsOn) {
+  test::use_secure_loopback();
+  const test::TestCredentials credentials("cell-1", kRefusalDomain);
+  const auto log_of = [&](std::vector<std::string> extra) {
+    const test::TempDir state;
+    std::vector<std::string> argv{
+        CELLMAPD,   "--domain", std::to_string(kRefusalDomain), "--state-dir", state.path().string(),
+        "--sweeps", "1"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    int code = 0;
+    std::vector<std::string> lines = run(argv, &code);
+    EXPECT_EQ(code, 0);
+    return lines;
+  };
+  const auto count = [](const std::vector<std::string>& lines, const std::string& text) {
+    return std::count_if(lines.begin(), lines.end(),
+                         [&](const std::string& line) { return line.find(text) != std::string::npos; });
+  };
+  const std::vector<std::string> plain = log_of({});
+  EXPECT_EQ(count(plain, " warning DDS Security off: any participant on DDS domain 196 can publish"), 1);
+  const std::vector<std::string> secured = log_of({"--security", credentials.directory().string()});
+  EXPECT_EQ(count(secured, " info DDS Security on: CN=daemon,OU=cell-1,O=cellmap ("), 1);
+  EXPECT_EQ(count(secured, "DDS Security off"), 0);
+}
+
+}  // namespace
+}  // namespace cellmap

@@ -1,0 +1,155 @@
+// Every rule a DDS input of the daemon must pass, one by one, as the readers apply them: the wire format's
+// (from_wire: finite numbers, unit quaternions, known kinds, names) and the cell's (check_limits: inside the
+// cell, sizes that fit, stamps near now).
+#include "cellmap/transport/input_limits.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "support/test_support.hpp"
+// lib/client/transport's private wire conversion: the samples exactly as DDS delivers them.
+#include "wire.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr std::int64_t kNow = 1'700'000'000'000'000'000;
+
+InputLimits cell_limits() {
+  InputLimits limits;  // the default simulated cell's bounds
+  limits.cell = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.2), Eigen::Vector3d(3.5, 2.5, 2.6));
+  limits.max_stamp_skew = 5s;
+  return limits;
+}
+
+class SceneEditRulesTest : public ::testing::Test {
+ protected:
+  SceneEditRulesTest() {
+    msg_.cell = cell_.data();
+    msg_.name = name_.data();
+    msg_.kind = cellmap_msg_SCENE_EDIT_ADD_BOX;
+    msg_.center[0] = 2.12, msg_.center[1] = 0.45, msg_.center[2] = 0.9;
+    msg_.half_extents[0] = msg_.half_extents[1] = 0.1, msg_.half_extents[2] = 0.15;
+  }
+  // The reason the edit is refused, "" if accepted.
+  std::string refusal() {
+    return test::error_of([&] { check_limits(wire::from_wire(msg_), cell_limits()); });
+  }
+  std::string cell_ = "cell-1";
+  std::string name_ = "box-1";
+  cellmap_msg_SceneEdit msg_{};
+};
+
+TEST_F(SceneEditRulesTest, AGoodEditPasses) {
+  EXPECT_EQ(refusal(), "");
+}
+
+TEST_F(SceneEditRulesTest, NonFiniteNumbersAreRefused) {
+  msg_.center[1] = std::nan("");
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box-1': center: not a finite number");
+  msg_.center[1] = 0.45;
+  msg_.yaw = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box-1': yaw: not a finite number");
+}
+
+TEST_F(SceneEditRulesTest, CentresOutsideTheCellAreRefused) {
+  msg_.center[0] = 1e300;
+  EXPECT_EQ(refusal(),
+            "cellmap/sim/scene_edits 'box-1': center: (1e+300, 0.45, 0.9) is outside the cell [-0.5, -0.5, "
+            "-0.2] - [3.5, 2.5, 2.6]");
+  msg_.kind = cellmap_msg_SCENE_EDIT_MOVE;
+  EXPECT_NE(refusal().find("is outside the cell"), std::string::npos);
+  msg_.kind = cellmap_msg_SCENE_EDIT_REMOVE;  // a removal uses only the name
+  EXPECT_EQ(refusal(), "");
+}
+
+TEST_F(SceneEditRulesTest, SizesThatDoNotFitTheCellAreRefused) {
+  msg_.half_extents[2] = 0.0;
+  EXPECT_NE(refusal().find("half_extents: (0.1, 0.1, 0) must be positive and at most 2"), std::string::npos)
+      << refusal();
+  msg_.half_extents[2] = 2.01;  // the cell's largest side is 4 m
+  EXPECT_NE(refusal().find("half_extents"), std::string::npos);
+  msg_.half_extents[2] = -1.0;
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box-1': half_extents: must not be negative");
+}
+
+TEST_F(SceneEditRulesTest, AYawBeyondAFullTurnIsRefused) {
+  msg_.yaw = 1e300;
+  EXPECT_NE(refusal().find("yaw: "), std::string::npos);
+  msg_.yaw = -6.0;
+  EXPECT_EQ(refusal(), "");
+}
+
+TEST_F(SceneEditRulesTest, UnknownKindsAndBadNamesAreRefused) {
+  msg_.kind = static_cast<cellmap_msg_SceneEditKind>(7);
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box-1': kind: unknown value 7");
+  msg_.kind = cellmap_msg_SCENE_EDIT_ADD_BOX;
+  name_.clear();
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits '': name: must not be empty");
+  name_.assign(200, 'x');
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(),
+            "cellmap/sim/scene_edits '" + std::string(128, 'x') + "': name: longer than 128 bytes");
+}
+
+class RobotStateRulesTest : public ::testing::Test {
+ protected:
+  RobotStateRulesTest() {
+    msg_.cell = cell_.data();
+    msg_.stamp_ns = kNow;
+    msg_.position[0] = 1.0, msg_.position[1] = 0.5, msg_.position[2] = 1.5;
+    msg_.orientation[0] = 1.0;
+  }
+  std::string refusal(const InputLimits& limits = cell_limits()) {
+    return test::error_of([&] { check_limits(wire::from_wire(msg_), limits, kNow); });
+  }
+  std::string cell_ = "cell-1";
+  cellmap_msg_RobotState msg_{};
+};
+
+TEST_F(RobotStateRulesTest, AGoodPosePasses) {
+  EXPECT_EQ(refusal(), "");
+}
+
+TEST_F(RobotStateRulesTest, NonFiniteNumbersAndNonUnitQuaternionsAreRefused) {
+  msg_.position[2] = std::nan("");
+  EXPECT_NE(refusal().find("position: not a finite number"), std::string::npos) << refusal();
+  msg_.position[2] = 1.5;
+  msg_.orientation[0] = 2.0;
+  EXPECT_NE(refusal().find("orientation: must be a unit quaternion"), std::string::npos) << refusal();
+}
+
+TEST_F(RobotStateRulesTest, PositionsOutsideTheCellAreRefused) {
+  msg_.position[0] = 4.0;
+  EXPECT_NE(refusal().find("position: (4, 0.5, 1.5) is outside the cell"), std::string::npos) << refusal();
+  msg_.position[0] = 1e300;
+  EXPECT_NE(refusal(InputLimits{}).find("is outside the cell [-100, -100, -100] - [100, 100, 100]"),
+            std::string::npos)
+      << "the limit for cells without bounds";
+}
+
+TEST_F(RobotStateRulesTest, StampsFarFromNowAreRefused) {
+  msg_.stamp_ns = kNow + 4'000'000'000;
+  EXPECT_EQ(refusal(), "");
+  msg_.stamp_ns = kNow - 6'000'000'000;
+  EXPECT_NE(refusal().find("stamp_ns: -6.000000 s from now (limit ±5.000000 s)"), std::string::npos)
+      << refusal();
+  msg_.stamp_ns = std::numeric_limits<std::int64_t>::min();  // no overflow in the difference
+  EXPECT_NE(refusal().find("stamp_ns: "), std::string::npos);
+  InputLimits no_clock = cell_limits();
+  no_clock.max_stamp_skew = 0s;
+  EXPECT_EQ(refusal(no_clock), "");
+}
+
+TEST_F(RobotStateRulesTest, AnEmptyCellIsRefused) {
+  cell_.clear();
+  msg_.cell = cell_.data();
+  EXPECT_EQ(refusal(), "cellmap/robot_state: cell: must not be empty");
+}
+
+}  // namespace
+}  // namespace cellmap::transport
