@@ -10,6 +10,7 @@
 #include "cellmap/transport/environment_monitor.hpp"
 #include "cellmap/view/render.hpp"
 #include "commands.hpp"
+#include "security_options.hpp"
 
 namespace cellmap::cli {
 namespace {
@@ -21,6 +22,7 @@ struct RenderCommandOptions {
   double timeout = 10;
   std::string output;
   view::RenderOptions render;
+  SecurityOptions security;
 };
 
 // A boxes file (`cellmap segment -o`) or a version the daemon saved (environment-<v>.json: also "cell" and
@@ -40,8 +42,9 @@ Environment environment_from_file(const std::string& path) {
 
 // The current snapshot of `cell` (or of the first cell heard) on `domain`: snapshots are transient local, so
 // a reader that joins gets each cell's current one at once.
-Environment environment_from_domain(std::uint32_t domain, const std::string& cell, double timeout) {
-  const dds::Participant participant(domain);
+Environment environment_from_domain(std::uint32_t domain, const std::string& cell, double timeout,
+                                    const SecurityOptions& security) {
+  const dds::Participant participant(domain, security.setting());
   transport::EnvironmentMonitor monitor(participant);
   using Clock = std::chrono::steady_clock;
   const auto deadline =
@@ -60,9 +63,9 @@ Environment environment_from_domain(std::uint32_t domain, const std::string& cel
 void run_render(const RenderCommandOptions& options) {
   if (options.input.empty() == !options.domain)
     throw Error("render: give either ENV.json or --domain N (not both)");
-  const Environment env = options.domain
-                              ? environment_from_domain(*options.domain, options.cell, options.timeout)
-                              : environment_from_file(options.input);
+  const Environment env = options.domain ? environment_from_domain(*options.domain, options.cell,
+                                                                   options.timeout, options.security)
+                                         : environment_from_file(options.input);
   view::render(env, options.output, options.render);
   std::cout << "wrote " << options.output << ": cell " << env.cell() << ", version " << env.version() << ", "
             << env.boxes().size() << " boxes" << std::endl;
@@ -89,6 +92,7 @@ void add_render_command(CLI::App& app) {
   command->add_option("--height", options->render.height, "pixels (default 1000)")
       ->check(CLI::Range(150, 20000));
   command->add_option("--title", options->render.title, "heading (default: cell, version, boxes, stamp)");
+  add_security_options(command, options->security, security::Role::kPlanner);
   command->callback([options] { run_render(*options); });
 }
 

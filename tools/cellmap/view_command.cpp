@@ -1,5 +1,6 @@
-// `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR]`: follows the cell(s) over DDS
-// as a planner does and serves a live 3D view of them at http://ADDR:P/ until SIGINT or SIGTERM.
+// `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR] [--security DIR [--role R]]`:
+// follows the cell(s) over DDS as a planner does (with a planner's credentials under DDS Security) and serves
+// a live 3D view of them at http://ADDR:P/ until SIGINT or SIGTERM.
 #include <csignal>
 #include <iostream>
 #include <map>
@@ -11,6 +12,7 @@
 #include "cellmap/view/cell_follower.hpp"
 #include "cellmap/view/web_server.hpp"
 #include "commands.hpp"
+#include "security_options.hpp"
 
 namespace cellmap::cli {
 namespace {
@@ -25,6 +27,7 @@ struct ViewOptions {
   std::uint32_t domain = 0;
   std::string cell;
   view::WebServerOptions server;
+  SecurityOptions security;
 };
 
 using Layers = std::set<transport::Layer>;
@@ -68,7 +71,7 @@ Layers layers_shown(const nlohmann::json& message) {
 void run_view(const ViewOptions& options) {
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
-  const dds::Participant participant(options.domain);
+  const dds::Participant participant(options.domain, options.security.setting());
   view::ViewState state(options.domain, options.cell);
   PageLayers layers;
   std::mutex server_mutex;            // DDS and page callbacks may come before the server is set, or after
@@ -132,6 +135,7 @@ void add_view_command(CLI::App& app) {
   command->add_option("--port", options->server.port, "TCP port (default 8080)")->check(CLI::Range(1, 65535));
   command->add_option("--three", options->server.three_dir,
                       "folder of three.js (default: Debian's libjs-three, /usr/share/javascript/three)");
+  add_security_options(command, options->security, security::Role::kPlanner);
   command->callback([options] { run_view(*options); });
 }
 
