@@ -5,7 +5,8 @@
 #   cellmap::client   what a planner needs: subscribe to a cell (transport), environments, collision, paths
 #   cellmap::<stage>  each stage library, e.g. cellmap::transport
 # in two components: `client` (cellmap::client and the stages it links: needs Eigen, Cyclone DDS and OpenSSL
-# only) and `mapper` (every other stage; needs PCL, OctoMap, urdfdom, yaml-cpp and the camera libraries).
+# only) and `mapper` (every other stage; needs PCL, OctoMap, urdfdom, assimp, yaml-cpp and the camera
+# libraries).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 

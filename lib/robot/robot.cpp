@@ -1,5 +1,6 @@
 #include "cellmap/robot/robot.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "cellmap/common/error.hpp"
@@ -35,6 +36,38 @@ Robot Robot::gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
   robot.steps_[3].axis = X_CE_zero.linear().transpose() * Eigen::Vector3d::UnitZ();
   robot.validate();
   return robot;
+}
+
+GantryParts GantryParts::fitting(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                                 const Eigen::Isometry3d& X_CE_zero) {
+  const Eigen::Vector3d p0 = X_CE_zero.translation();
+  GantryParts parts;
+  const double carriage_bottom = p0.z() + upper.z() + 0.1;
+  parts.carriage = {{p0.x(), p0.y(), carriage_bottom + 0.15}, {0.2, 0.2, 0.15}};
+  const double carriage_top = carriage_bottom + 0.3;
+  // The ram's top at q_z = lower.z still reaches the carriage's top.
+  const double ram_top = carriage_top - std::min(lower.z(), 0.0);
+  parts.ram = {{p0.x(), p0.y(), 0.5 * (p0.z() + ram_top)}, {0.075, 0.075, 0.5 * (ram_top - p0.z())}};
+  const double y_min = p0.y() + lower.y() - 0.3, y_max = p0.y() + upper.y() + 0.3;
+  parts.bridge = {{p0.x(), 0.5 * (y_min + y_max), carriage_top + 0.15}, {0.15, 0.5 * (y_max - y_min), 0.15}};
+  return parts;
+}
+
+Robot Robot::gantry(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                    const Eigen::Isometry3d& X_CE_zero, const GantryParts& parts) {
+  const Robot robot = gantry(lower, upper, X_CE_zero);
+  // Parts are given in the cell at q = 0; their links' frames there are X_CL(0).
+  const std::vector<Eigen::Isometry3d> X_CL = robot.link_poses(Eigen::Vector3d::Zero());
+  const std::pair<const char*, const GantryParts::Part*> named[] = {
+      {"bridge", &parts.bridge}, {"carriage", &parts.carriage}, {"ram", &parts.ram}};
+  std::vector<LinkShape> shapes;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& [link, part] = named[i];
+    if (!part->center.allFinite()) throw Error(std::string("gantry ") + link + ": center must be finite");
+    const Eigen::Isometry3d X_LG = X_CL[i + 1].inverse() * Eigen::Translation3d(part->center);
+    shapes.push_back({link, X_LG, BoxShape{part->half_extents}});
+  }
+  return robot.with_shapes(std::move(shapes));
 }
 
 Robot Robot::serial(const std::string& root_link, const std::vector<ChainJoint>& joints,
@@ -111,6 +144,44 @@ std::vector<Eigen::Isometry3d> Robot::link_poses(const Eigen::VectorXd& q) const
 
 Eigen::Isometry3d Robot::tool_pose(const Eigen::VectorXd& q) const {
   return link_poses(q).back();
+}
+
+Robot Robot::with_shapes(std::vector<LinkShape> shapes) const {
+  Robot robot = *this;
+  robot.shapes_ = std::move(shapes);
+  robot.shape_links_.clear();
+  for (std::size_t i = 0; i < robot.shapes_.size(); ++i) {
+    const LinkShape& shape = robot.shapes_[i];
+    const std::string what = "robot shape " + std::to_string(i) + " (link '" + shape.link + "')";
+    const auto it = std::find(link_names_.begin(), link_names_.end(), shape.link);
+    if (it == link_names_.end()) throw Error(what + ": the robot has no such link");
+    validate_shape(shape, what);
+    robot.shape_links_.push_back(static_cast<int>(it - link_names_.begin()));
+  }
+  return robot;
+}
+
+std::vector<Eigen::Isometry3d> Robot::shape_poses(const Eigen::VectorXd& q) const {
+  const std::vector<Eigen::Isometry3d> X_CL = link_poses(q);
+  std::vector<Eigen::Isometry3d> X_CG;
+  X_CG.reserve(shapes_.size());
+  for (std::size_t i = 0; i < shapes_.size(); ++i) {
+    X_CG.push_back(X_CL[static_cast<std::size_t>(shape_links_[i])] * shapes_[i].X_LG);
+  }
+  return X_CG;
+}
+
+std::vector<LinkBox> Robot::shape_boxes() const {
+  std::vector<LinkBox> boxes;
+  boxes.reserve(shapes_.size());
+  for (const LinkShape& shape : shapes_) boxes.push_back(bounding_box(shape));
+  return boxes;
+}
+
+std::size_t Robot::triangle_count() const {
+  std::size_t count = 0;
+  for (const LinkShape& shape : shapes_) count += cellmap::triangle_count(shape.geometry);
+  return count;
 }
 
 }  // namespace cellmap

@@ -4,9 +4,12 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <cmath>
+#include <filesystem>
+#include <map>
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/urdf/mesh_file.hpp"
 
 namespace cellmap {
 namespace {
@@ -49,21 +52,60 @@ Robot::ChainJoint chain_joint(const urdf::Link& link) {
   return out;
 }
 
+// Meshes read so far, by file and scale: links sharing a file share the mesh.
+class MeshCache {
+ public:
+  std::shared_ptr<const TriangleMesh> get(const std::filesystem::path& file, const Eigen::Vector3d& scale) {
+    const std::string key = file.string() + "|" + std::to_string(scale.x()) + "," +
+                            std::to_string(scale.y()) + "," + std::to_string(scale.z());
+    auto& mesh = meshes_[key];
+    if (!mesh) mesh = std::make_shared<const TriangleMesh>(load_mesh(file, scale));
+    return mesh;
+  }
+
+ private:
+  std::map<std::string, std::shared_ptr<const TriangleMesh>> meshes_;
+};
+
+LinkGeometry link_geometry(const urdf::Geometry& geometry, const std::string& base_dir,
+                           const std::vector<std::string>& package_paths, MeshCache& meshes) {
+  switch (geometry.type) {
+    case urdf::Geometry::BOX: {
+      const auto& box = static_cast<const urdf::Box&>(geometry);
+      return BoxShape{0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z)};
+    }
+    case urdf::Geometry::CYLINDER: {
+      const auto& cylinder = static_cast<const urdf::Cylinder&>(geometry);
+      return CylinderShape{cylinder.radius, 0.5 * cylinder.length};
+    }
+    case urdf::Geometry::SPHERE:
+      return SphereShape{static_cast<const urdf::Sphere&>(geometry).radius};
+    case urdf::Geometry::MESH: {
+      const auto& mesh = static_cast<const urdf::Mesh&>(geometry);
+      const Eigen::Vector3d scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
+      return MeshShape{meshes.get(resolve_mesh_uri(mesh.filename, base_dir, package_paths), scale)};
+    }
+  }
+  throw Error("unknown geometry type");
+}
+
 }  // namespace
 
-UrdfModel::UrdfModel(std::shared_ptr<const urdf::ModelInterface> model, std::string source)
-    : model_(std::move(model)), source_(std::move(source)) {}
+UrdfModel::UrdfModel(std::shared_ptr<const urdf::ModelInterface> model, std::string source,
+                     std::string base_dir)
+    : model_(std::move(model)), source_(std::move(source)), base_dir_(std::move(base_dir)) {}
 
-UrdfModel UrdfModel::parse(const std::string& xml, const std::string& source) {
+UrdfModel UrdfModel::parse(const std::string& xml, const std::string& source, const std::string& base_dir) {
   // urdfdom reports parse problems through console_bridge on stderr; the library reports through Error only.
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(xml);
   if (!model) throw Error(source + ": not a valid URDF robot description");
-  return UrdfModel(std::move(model), source);
+  return UrdfModel(std::move(model), source, base_dir);
 }
 
 UrdfModel UrdfModel::load(const std::string& path) {
-  return parse(read_file(path), path);
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  return parse(read_file(path), path, folder.empty() ? "." : folder);
 }
 
 Robot UrdfModel::chain(const std::string& tool_link, const Eigen::Isometry3d& X_C_root) const {
@@ -79,24 +121,35 @@ Robot UrdfModel::chain(const std::string& tool_link, const Eigen::Isometry3d& X_
   }
 }
 
-std::vector<LinkBox> UrdfModel::link_boxes(const Robot& robot) const {
-  std::vector<LinkBox> boxes;
+std::vector<LinkShape> UrdfModel::link_shapes(const Robot& robot,
+                                              const std::vector<std::string>& package_paths) const {
+  std::vector<LinkShape> shapes;
+  MeshCache meshes;
   for (const std::string& name : robot.link_names()) {
     const urdf::LinkConstSharedPtr link = model_->getLink(name);
     if (!link) continue;  // a link the robot's chain names but this URDF does not: no geometry
     for (std::size_t i = 0; i < link->collision_array.size(); ++i) {
       const urdf::CollisionSharedPtr& collision = link->collision_array[i];
       if (!collision || !collision->geometry) continue;
-      if (collision->geometry->type != urdf::Geometry::BOX) {
-        throw Error(source_ + ": link '" + name + "' collision " + std::to_string(i) +
-                    ": only box geometry is supported");
+      const std::string what = source_ + ": link '" + name + "' collision " + std::to_string(i);
+      try {
+        LinkShape shape{name, to_isometry(collision->origin),
+                        link_geometry(*collision->geometry, base_dir_, package_paths, meshes)};
+        validate_shape(shape, what);
+        shapes.push_back(std::move(shape));
+      } catch (const Error& e) {
+        const std::string reason = e.what();
+        throw Error(reason.rfind(what, 0) == 0 ? reason : what + ": " + reason);
       }
-      const auto& box = static_cast<const urdf::Box&>(*collision->geometry);
-      boxes.push_back(
-          {name, to_isometry(collision->origin), 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z)});
     }
   }
-  return boxes;
+  return shapes;
+}
+
+Robot UrdfModel::robot(const std::string& tool_link, const Eigen::Isometry3d& X_C_root,
+                       const std::vector<std::string>& package_paths) const {
+  const Robot chained = chain(tool_link, X_C_root);
+  return chained.with_shapes(link_shapes(chained, package_paths));
 }
 
 }  // namespace cellmap

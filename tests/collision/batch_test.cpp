@@ -8,6 +8,7 @@
 #include "cellmap/collision/robot_boxes.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/urdf/urdf_model.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap::collision {
 namespace {
@@ -127,12 +128,10 @@ constexpr const char* kArm = R"(<?xml version="1.0"?>
   <joint name="tip" type="fixed"><parent link="upper_arm"/><child link="flange"/><origin xyz="0.6 0 0"/></joint>
 </robot>)";
 
-TEST(RobotBoxesTest, UrdfBoxGeometryFollowsTheJoints) {
-  const UrdfModel urdf = UrdfModel::parse(kArm, "arm.urdf");
-  const Robot arm = urdf.chain("flange");
-  const std::vector<LinkBox> boxes = urdf.link_boxes(arm);
-  ASSERT_EQ(boxes.size(), 2u);
-  const RobotBoxes robot(arm, boxes);
+TEST(RobotBoxesTest, UrdfGeometryFollowsTheJoints) {
+  const Robot arm = UrdfModel::parse(kArm, "arm.urdf").robot("flange");
+  ASSERT_EQ(arm.shapes().size(), 2u);
+  const RobotBoxes robot(arm);
   // Shoulder at 90 degrees: the upper arm box points along +y, centred 0.3 m out at 0.5 m height.
   const std::vector<Obb> placed = robot.place(Eigen::VectorXd::Constant(1, M_PI / 2));
   EXPECT_LT((placed[0].center - Vector3d(0, 0, 0.25)).norm(), 1e-12);
@@ -142,16 +141,20 @@ TEST(RobotBoxesTest, UrdfBoxGeometryFollowsTheJoints) {
   const Obb obstacle(Vector3d(0, 0.9, 0.5), Vector3d(0.1, 0.1, 0.1));
   EXPECT_NEAR(signed_distance(placed[1], obstacle).distance, 0.2, 1e-12);
 
-  std::string sphere_arm = kArm;
+  // A sphere or a cylinder gets its tight box; a mesh that is not there is an error naming it.
+  std::string round_arm = kArm;
   const std::string upper_box = "<box size=\"0.6 0.1 0.1\"/>";
-  sphere_arm.replace(sphere_arm.find(upper_box), upper_box.size(), "<sphere radius=\"0.1\"/>");
-  ASSERT_NO_THROW((void)UrdfModel::parse(sphere_arm).chain("flange"));  // still a valid URDF
-  try {
-    (void)UrdfModel::parse(sphere_arm, "arm.urdf").link_boxes(arm);
-    ADD_FAILURE() << "a sphere must be refused";
-  } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "arm.urdf: link 'upper_arm' collision 0: only box geometry is supported");
-  }
+  round_arm.replace(round_arm.find(upper_box), upper_box.size(), "<sphere radius=\"0.1\"/>");
+  const RobotBoxes round(UrdfModel::parse(round_arm, "arm.urdf").robot("flange"));
+  EXPECT_LT((round.boxes()[1].half_extents - Vector3d(0.1, 0.1, 0.1)).norm(), 1e-12);
+  std::string mesh_arm = kArm;
+  mesh_arm.replace(mesh_arm.find(upper_box), upper_box.size(),
+                   "<mesh filename=\"package://nowhere/arm.stl\"/>");
+  EXPECT_NE(
+      test::error_of([&] {
+        (void)UrdfModel::parse(mesh_arm, "arm.urdf").robot("flange");
+      }).find("arm.urdf: link 'upper_arm' collision 0: mesh 'package://nowhere/arm.stl': package 'nowhere'"),
+      std::string::npos);
   EXPECT_THROW((void)UrdfModel::parse("<robot", "bad.urdf"), Error);
 }
 

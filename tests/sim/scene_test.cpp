@@ -206,3 +206,36 @@ TEST(SceneTest, UrdfArmSceneLoadsWithItsPathRelativeToTheFile) {
 
 }  // namespace
 }  // namespace cellmap::sim
+
+namespace cellmap::sim {
+namespace {
+
+TEST(SceneTest, GantryPartsDefaultToAFittingGantryAndCanBeGiven) {
+  const Scene fitted = parse_scene(kScene, "s.yaml");
+  ASSERT_EQ(fitted.robot.shapes().size(), 3u);
+  const GantryParts parts =
+      GantryParts::fitting({0, 0, -0.5}, {3, 2, 0}, fitted.robot.tool_pose(Eigen::Vector3d::Zero()));
+  EXPECT_LT((fitted.robot.shape_poses(Eigen::Vector3d::Zero())[2].translation() - parts.ram.center).norm(),
+            1e-12);
+  const Scene given =
+      parse_scene(replaced("rotation: [0, 1, 0, 0]}}",
+                           "rotation: [0, 1, 0, 0]}, ram: {center: [0.5, 0.5, 3], half_extents: "
+                           "[0.05, 0.05, 0.5]}}"),
+                  "s.yaml");
+  EXPECT_LT(
+      (given.robot.shape_poses(Eigen::Vector3d(1, 1, 0))[2].translation() - Eigen::Vector3d(1.5, 1.5, 3))
+          .norm(),
+      1e-12);
+  EXPECT_EQ(std::get<BoxShape>(given.robot.shapes()[2].geometry).half_extents,
+            Eigen::Vector3d(0.05, 0.05, 0.5));
+  EXPECT_EQ(error_of([] {
+              (void)parse_scene(replaced("rotation: [0, 1, 0, 0]}}",
+                                         "rotation: [0, 1, 0, 0]}, ram: {center: [0, 0, "
+                                         "0], half_extents: [0, 1, 1]}}"),
+                                "s.yaml");
+            }),
+            "s.yaml: robot.gantry.ram.half_extents: must be positive, got [0, 1, 1]");
+}
+
+}  // namespace
+}  // namespace cellmap::sim

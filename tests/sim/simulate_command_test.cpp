@@ -119,5 +119,26 @@ TEST(SimulateCommandTest, BadInputGivesOneLineReasonsAndNonZeroExit) {
   fs::remove_all(dir);
 }
 
+TEST(SimulateCommandTest, ArmCellWritesTheFramesOfItsFixedAndWristCameras) {
+  const fs::path dir = temp_dir("arm");
+  const std::string scene = std::string(CELLMAP_SOURCE_DIR) + "/config/scenes/arm_cell.yaml";
+  for (const std::string sensor : {"post", "wrist"}) {
+    const ToolRun run = run_tool("simulate " + scene + " --sensor " + sensor + " -o " + (dir / sensor).string(), dir);
+    ASSERT_EQ(run.status, 0) << run.err;
+    const std::vector<PoseRecord> poses = read_poses(dir / sensor / "frames.csv");
+    ASSERT_EQ(poses.size(), 5u);
+    EXPECT_EQ(poses[0].q.size(), 6);
+    EXPECT_GT(pcd_points(dir / sensor / "merged.pcd"), 50000u);
+    // The fixed camera stands still while the arm moves; the wrist camera moves with the arm.
+    const double moved = (poses[4].X_CS.translation() - poses[0].X_CS.translation()).norm();
+    if (sensor == "post") {
+      EXPECT_EQ(moved, 0.0);
+    } else {
+      EXPECT_GT(moved, 1.0);
+    }
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace cellmap::sim

@@ -6,6 +6,8 @@
 
 namespace cellmap::collision {
 
+RobotBoxes::RobotBoxes(Robot robot) : RobotBoxes(robot, robot.shape_boxes()) {}
+
 RobotBoxes::RobotBoxes(Robot robot, std::vector<LinkBox> boxes)
     : robot_(std::move(robot)), boxes_(std::move(boxes)) {
   const std::vector<std::string>& links = robot_.link_names();

@@ -22,6 +22,17 @@ void require_inside(const Eigen::Vector3d& p_C, const InputLimits& limits, const
   }
 }
 
+void require_stamp_near(std::int64_t stamp_ns, const InputLimits& limits, std::int64_t now_ns,
+                        const std::string& where) {
+  if (limits.max_stamp_skew.count() <= 0) return;
+  // In double: an attacker's stamp near INT64_MIN must not overflow the difference.
+  const double skew_s = (static_cast<double>(stamp_ns) - static_cast<double>(now_ns)) * 1e-9;
+  if (std::abs(skew_s) > std::chrono::duration<double>(limits.max_stamp_skew).count()) {
+    throw Error(where + ": stamp_ns: " + std::to_string(skew_s) + " s from now (limit ±" +
+                std::to_string(std::chrono::duration<double>(limits.max_stamp_skew).count()) + " s)");
+  }
+}
+
 }  // namespace
 
 void check_limits(const SceneEdit& edit, const InputLimits& limits) {
@@ -44,12 +55,19 @@ void check_limits(const RobotState& state, const InputLimits& limits, std::int64
   const std::string where =
       std::string(kRobotStateTopic) + " '" + state.cell + "' at " + std::to_string(state.stamp_ns);
   require_inside(state.X_CE.translation(), limits, where + ": position");
-  if (limits.max_stamp_skew.count() <= 0) return;
-  // In double: an attacker's stamp near INT64_MIN must not overflow the difference.
-  const double skew_s = (static_cast<double>(state.stamp_ns) - static_cast<double>(now_ns)) * 1e-9;
-  if (std::abs(skew_s) > std::chrono::duration<double>(limits.max_stamp_skew).count()) {
-    throw Error(where + ": stamp_ns: " + std::to_string(skew_s) + " s from now (limit ±" +
-                std::to_string(std::chrono::duration<double>(limits.max_stamp_skew).count()) + " s)");
+  require_stamp_near(state.stamp_ns, limits, now_ns, where);
+}
+
+void check_limits(const RobotJoints& joints, const InputLimits& limits, std::int64_t now_ns) {
+  const std::string where =
+      std::string(kRobotJointsTopic) + " '" + joints.cell + "' at " + std::to_string(joints.stamp_ns);
+  require_stamp_near(joints.stamp_ns, limits, now_ns, where);
+  if (!joints.payload) return;
+  const double largest = limits.cell.sizes().maxCoeff();
+  if (joints.payload->X_EB.translation().norm() > largest ||
+      joints.payload->half_extents.maxCoeff() > largest / 2) {
+    throw Error(where + ": payload: centre (" + text(joints.payload->X_EB.translation()) +
+                ") or half extents (" + text(joints.payload->half_extents) + ") do not fit in the cell");
   }
 }
 

@@ -41,4 +41,8 @@ std::map<security::Role, security::TopicGrants> role_grants() {
           {Role::kTool, {{kSceneEditTopic}, environment}}};
 }
 
+dds::Qos robot_joints_qos() {
+  return robot_state_qos();
+}
+
 }  // namespace cellmap::transport

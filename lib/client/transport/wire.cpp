@@ -1,6 +1,8 @@
 #include "wire.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/topics.hpp"
@@ -73,6 +75,15 @@ std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::s
     boxes.push_back(from_msg(seq._buffer[i], where + "[" + std::to_string(i) + "]"));
   }
   return boxes;
+}
+
+// A writer may send any 32-bit value; reading one outside the enumerators through the enum type is undefined
+// behaviour, so the value is read as the integer it is on the wire.
+std::int32_t kind_on_the_wire(const cellmap_msg_SceneEdit& msg) {
+  static_assert(sizeof msg.kind == sizeof(std::int32_t), "IDL enums are 32 bits on the wire");
+  std::int32_t kind;
+  std::memcpy(&kind, &msg.kind, sizeof kind);
+  return kind;
 }
 
 }  // namespace
@@ -194,7 +205,7 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   const std::string where = std::string(kSceneEditTopic) + " '" + (msg.name ? msg.name : "") + "'";
   SceneEdit edit;
   edit.cell = msg.cell ? msg.cell : "";
-  switch (msg.kind) {
+  switch (kind_on_the_wire(msg)) {
     case cellmap_msg_SCENE_EDIT_ADD_BOX:
       edit.kind = SceneEdit::Kind::kAddBox;
       break;
@@ -205,7 +216,7 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
       edit.kind = SceneEdit::Kind::kMove;
       break;
     default:
-      throw Error(where + ": kind: unknown value " + std::to_string(static_cast<int>(msg.kind)));
+      throw Error(where + ": kind: unknown value " + std::to_string(kind_on_the_wire(msg)));
   }
   edit.name = msg.name ? msg.name : "";
   if (edit.name.empty()) throw Error(where + ": name: must not be empty");
@@ -234,6 +245,77 @@ RobotState from_wire(const cellmap_msg_RobotState& msg) {
   state.X_CE.linear() = q.normalized().toRotationMatrix();
   state.X_CE.translation() = Eigen::Vector3d(msg.position[0], msg.position[1], msg.position[2]);
   return state;
+}
+
+RobotJointsSample::RobotJointsSample(const RobotJoints& joints) : joints_(joints) {
+  for (const std::string& name : joints_.names) names_.push_back(text(name));
+  msg_.cell = text(joints_.cell);
+  msg_.stamp_ns = joints_.stamp_ns;
+  msg_.names = sequence_of<dds_sequence_string>(names_);
+  msg_.positions = sequence_of<dds_sequence_double>(joints_.positions);
+  if (joints_.payload) {
+    const Payload& payload = *joints_.payload;
+    const Eigen::Quaterniond q_EB(payload.X_EB.linear());
+    for (int i = 0; i < 3; ++i) {
+      payload_.center[i] = payload.X_EB.translation()[i];
+      payload_.half_extents[i] = payload.half_extents[i];
+    }
+    payload_.rotation[0] = q_EB.w();
+    payload_.rotation[1] = q_EB.x();
+    payload_.rotation[2] = q_EB.y();
+    payload_.rotation[3] = q_EB.z();
+    msg_.payload._maximum = msg_.payload._length = 1;
+    msg_.payload._buffer = &payload_;
+    msg_.payload._release = false;
+  }
+}
+
+void validate(const RobotJoints& joints) {
+  if (joints.cell.empty()) throw Error(std::string(kRobotJointsTopic) + ": cell: must not be empty");
+  const std::string where = std::string(kRobotJointsTopic) + " '" + joints.cell + "'";
+  if (!joints.names.empty() && joints.names.size() != joints.positions.size()) {
+    throw Error(where + ": " + std::to_string(joints.names.size()) + " names for " +
+                std::to_string(joints.positions.size()) + " positions");
+  }
+  require_finite(joints.positions.data(), static_cast<int>(joints.positions.size()), where + ": positions");
+  if (joints.payload) {
+    const Payload& payload = *joints.payload;
+    if (!payload.X_EB.matrix().allFinite() || !payload.half_extents.allFinite()) {
+      throw Error(where + ": payload: not a finite number");
+    }
+    if (payload.half_extents.minCoeff() < 0)
+      throw Error(where + ": payload.half_extents: must not be negative");
+    const Eigen::Matrix3d R = payload.X_EB.linear();
+    if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+        R.determinant() < 0) {
+      throw Error(where + ": payload.rotation: must be a rotation");
+    }
+  }
+}
+
+RobotJoints from_wire(const cellmap_msg_RobotJoints& msg) {
+  RobotJoints joints;
+  joints.cell = cell_of(msg.cell, kRobotJointsTopic);
+  joints.stamp_ns = msg.stamp_ns;
+  for (uint32_t i = 0; i < msg.names._length; ++i) {
+    joints.names.emplace_back(msg.names._buffer[i] ? msg.names._buffer[i] : "");
+  }
+  joints.positions.assign(msg.positions._buffer, msg.positions._buffer + msg.positions._length);
+  if (msg.payload._length == 1) {
+    const cellmap_msg_ToolPayload& p = msg.payload._buffer[0];
+    const std::string where = std::string(kRobotJointsTopic) + " '" + joints.cell + "': payload";
+    require_finite(p.rotation, 4, where + ".rotation");
+    const Eigen::Quaterniond q(p.rotation[0], p.rotation[1], p.rotation[2], p.rotation[3]);
+    if (std::abs(q.norm() - 1.0) > 1e-3)
+      throw Error(where + ".rotation: must be a unit quaternion [w, x, y, z]");
+    Payload payload;
+    payload.X_EB.linear() = q.normalized().toRotationMatrix();
+    payload.X_EB.translation() = Eigen::Vector3d(p.center[0], p.center[1], p.center[2]);
+    payload.half_extents = Eigen::Vector3d(p.half_extents[0], p.half_extents[1], p.half_extents[2]);
+    joints.payload = payload;
+  }
+  validate(joints);
+  return joints;
 }
 
 }  // namespace cellmap::transport::wire

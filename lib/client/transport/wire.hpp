@@ -66,6 +66,22 @@ class RobotStateSample {
   cellmap_msg_RobotState msg_{};
 };
 
+class RobotJointsSample {
+ public:
+  explicit RobotJointsSample(const RobotJoints& joints);
+  [[nodiscard]] const cellmap_msg_RobotJoints* get() const { return &msg_; }
+
+ private:
+  RobotJoints joints_;
+  std::vector<char*> names_;
+  cellmap_msg_ToolPayload payload_{};
+  cellmap_msg_RobotJoints msg_{};
+};
+
+/// @throws Error naming the topic and field if the cell is empty, names are given but not one per position, a
+/// number is not finite, a payload half extent is negative or its rotation is not orthonormal.
+void validate(const RobotJoints& joints);
+
 /// The cell of an incoming sample. @throws Error naming the topic if it is empty.
 [[nodiscard]] std::string cell_of(const char* cell, const char* topic);
 /// The bytes of `sample` (of the generated `type`) in an RTPS DATA submessage: the 4-byte encapsulation
@@ -80,5 +96,7 @@ class RobotStateSample {
 [[nodiscard]] SceneEdit from_wire(const cellmap_msg_SceneEdit& msg);
 /// @throws Error also for an empty cell, a non-finite number or a quaternion whose norm is not 1 ± 1e-3.
 [[nodiscard]] RobotState from_wire(const cellmap_msg_RobotState& msg);
+/// @throws Error as validate(), or for a payload quaternion whose norm is not 1 ± 1e-3.
+[[nodiscard]] RobotJoints from_wire(const cellmap_msg_RobotJoints& msg);
 
 }  // namespace cellmap::transport::wire

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+
+#include "mesh_bvh.hpp"
 
 namespace cellmap::sim {
 namespace {
@@ -81,12 +84,70 @@ std::optional<double> intersect(const SphereShape& sphere, const Eigen::Vector3d
   return entry(t0, t1);
 }
 
-SceneCaster::SceneCaster(const std::vector<Obstacle>& obstacles) {
-  entries_.reserve(obstacles.size());
-  for (const Obstacle& o : obstacles) {
-    entries_.push_back(
-        Entry{o, o.shape, o.X_CO.linear().transpose(), o.X_CO.translation(), o.bounding_radius()});
+RobotSolids::RobotSolids(Robot robot) : robot_(std::move(robot)) {
+  std::map<const TriangleMesh*, std::shared_ptr<const MeshBvh>> built;  // links sharing a mesh share its tree
+  for (const LinkShape& shape : robot_.shapes()) {
+    std::shared_ptr<const MeshBvh> bvh;
+    if (const auto* mesh = std::get_if<MeshShape>(&shape.geometry)) {
+      auto& tree = built[mesh->mesh.get()];
+      if (!tree) tree = std::make_shared<const MeshBvh>(*mesh->mesh);
+      bvh = tree;
+    }
+    meshes_.push_back(std::move(bvh));
   }
+}
+
+RobotSolids::~RobotSolids() = default;
+RobotSolids::RobotSolids(RobotSolids&&) noexcept = default;
+RobotSolids& RobotSolids::operator=(RobotSolids&&) noexcept = default;
+
+SceneCaster::SceneCaster(const std::vector<Obstacle>& obstacles) {
+  add_obstacles(obstacles);
+}
+
+SceneCaster::SceneCaster(const std::vector<Obstacle>& obstacles, const RobotSolids& robot,
+                         const JointState& state) {
+  add_obstacles(obstacles);
+  const std::vector<Eigen::Isometry3d> X_CL = robot.robot().link_poses(state.q);
+  const std::vector<LinkShape>& shapes = robot.robot().shapes();
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    const Eigen::Isometry3d X_CG =
+        X_CL[static_cast<std::size_t>(robot.robot().shape_links()[i])] * shapes[i].X_LG;
+    add_robot_shape(shapes[i].geometry, robot.meshes_[i].get(), X_CG);
+  }
+  if (state.payload)
+    add_robot_shape(BoxShape{state.payload->half_extents}, nullptr, X_CL.back() * state.payload->X_EB);
+}
+
+void SceneCaster::add_obstacles(const std::vector<Obstacle>& obstacles) {
+  entries_.reserve(obstacles.size());
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const Obstacle& o = obstacles[i];
+    entries_.push_back(Entry{static_cast<int>(i), o, o.shape, nullptr, o.X_CO.linear().transpose(),
+                             o.X_CO.translation(), o.X_CO.translation(), o.bounding_radius()});
+  }
+}
+
+void SceneCaster::add_robot_shape(const LinkGeometry& geometry, const MeshBvh* mesh,
+                                  const Eigen::Isometry3d& X_CG) {
+  Entry entry{RayHit::kRobot,     std::nullopt,       BoxShape{}, mesh, X_CG.linear().transpose(),
+              X_CG.translation(), X_CG.translation(), 0.0};
+  if (mesh) {
+    const Region& bounds = mesh->bounds();
+    entry.center_C = X_CG * (0.5 * (bounds.min + bounds.max));
+    entry.bounding_radius = 0.5 * (bounds.max - bounds.min).norm();
+  } else {
+    std::visit(
+        [&](const auto& shape) {
+          using T = std::decay_t<decltype(shape)>;
+          if constexpr (!std::is_same_v<T, MeshShape>) {
+            entry.shape = shape;
+            entry.bounding_radius = Obstacle{"", shape, X_CG}.bounding_radius();
+          }
+        },
+        geometry);
+  }
+  entries_.push_back(std::move(entry));
 }
 
 std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3d& apex_C,
@@ -95,7 +156,7 @@ std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3
   std::vector<Candidate> out;
   for (int i = 0; i < size(); ++i) {
     const Entry& e = entries_[static_cast<std::size_t>(i)];
-    const Eigen::Vector3d v = e.p_CO - apex_C;
+    const Eigen::Vector3d v = e.center_C - apex_C;
     const double distance = v.norm();
     bool keep = half_angle >= M_PI / 2 || distance <= e.bounding_radius;
     if (!keep) {
@@ -103,7 +164,10 @@ std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3
       const double angle = std::acos(std::clamp(v.dot(axis_C) / distance, -1.0, 1.0));
       keep = angle - std::asin(e.bounding_radius / distance) <= half_angle;
     }
-    if (keep) out.push_back(Candidate{i, std::max(0.0, e.obstacle.signed_distance(apex_C))});
+    if (!keep) continue;
+    // Obstacles: their exact distance; robot shapes: the distance to their bounding sphere (a lower bound).
+    const double min_t = e.obstacle ? e.obstacle->signed_distance(apex_C) : distance - e.bounding_radius;
+    out.push_back(Candidate{i, std::max(0.0, min_t)});
   }
   // Nearest first: once a hit is found, farther obstacles (e.g. the floor under the table) are never tested.
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
@@ -112,26 +176,27 @@ std::vector<SceneCaster::Candidate> SceneCaster::candidates(const Eigen::Vector3
   return out;
 }
 
-std::optional<double> SceneCaster::hit(const Entry& e, const Eigen::Vector3d& o_C,
-                                       const Eigen::Vector3d& d_C) const {
+std::optional<double> SceneCaster::hit(const Entry& e, const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C,
+                                       double t_max) const {
   const Eigen::Vector3d o_O = e.R_OC * (o_C - e.p_CO);
   const Eigen::Vector3d d_O = e.R_OC * d_C;
+  if (e.mesh) return e.mesh->intersect(o_O, d_O, t_max);
   return std::visit([&](const auto& shape) { return intersect(shape, o_O, d_O); }, e.shape);
 }
 
 RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C, double t_max,
                          const std::vector<Candidate>* candidates) const {
-  RayHit best{t_max, -1};
+  RayHit best{t_max, RayHit::kNothing};
   auto consider = [&](int i) {
     const Entry& e = entries_[static_cast<std::size_t>(i)];
     // Bounding-sphere rejection before the exact test: behind the ray, farther than the best hit, or missed.
-    const Eigen::Vector3d v = e.p_CO - o_C;
+    const Eigen::Vector3d v = e.center_C - o_C;
     const double along = v.dot(d_C);
     const double r = e.bounding_radius;
     if (along + r < 0 || along - r > best.t) return;
     if (v.squaredNorm() - along * along > r * r) return;
-    const std::optional<double> t = hit(e, o_C, d_C);
-    if (t && *t <= best.t) best = RayHit{*t, i};
+    const std::optional<double> t = hit(e, o_C, d_C, best.t);
+    if (t && *t <= best.t) best = RayHit{*t, e.id};
   };
   if (candidates) {
     for (const Candidate& c : *candidates) {
@@ -141,7 +206,7 @@ RayHit SceneCaster::cast(const Eigen::Vector3d& o_C, const Eigen::Vector3d& d_C,
   } else {
     for (int i = 0; i < size(); ++i) consider(i);
   }
-  if (best.obstacle < 0) best.t = 0;
+  if (best.obstacle == RayHit::kNothing) best.t = 0;
   return best;
 }
 

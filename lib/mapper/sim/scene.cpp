@@ -78,28 +78,6 @@ Obstacle read_obstacle(YamlMap map) {
   return obstacle;
 }
 
-Robot read_robot(YamlMap map, const std::string& base_dir) {
-  if (map.has("gantry") == map.has("urdf")) map.fail("gantry", "exactly one of gantry, urdf is required");
-  if (map.has("gantry")) {
-    YamlMap gantry = map.child("gantry");
-    const Eigen::Vector3d lower = gantry.vector3("lower");
-    const Eigen::Vector3d upper = gantry.vector3("upper");
-    if (!(lower.array() <= upper.array()).all()) gantry.fail("upper", "must be >= lower on every axis");
-    const Eigen::Isometry3d X_CE_zero = gantry.pose("tool_at_zero");
-    gantry.expect_all_read();
-    map.expect_all_read();
-    return Robot::gantry(lower, upper, X_CE_zero);
-  }
-  YamlMap urdf = map.child("urdf");
-  std::filesystem::path file = urdf.require<std::string>("file");
-  if (file.is_relative()) file = std::filesystem::path(base_dir) / file;
-  const std::string tool_link = urdf.require<std::string>("tool_link");
-  const Eigen::Isometry3d X_C_root = urdf.pose("base");
-  urdf.expect_all_read();
-  map.expect_all_read();
-  return UrdfModel::load(file.string()).chain(tool_link, X_C_root);
-}
-
 Eigen::VectorXd joint_vector(YamlMap& map, const std::string& key, int dof) {
   const std::vector<double> v = map.numbers(key, static_cast<std::size_t>(dof));
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -198,6 +176,22 @@ LineScanner read_scanner(YamlMap map) {
   return s;
 }
 
+// `mount: {position, rotation}` (X_ES on the tool), or `mount: tool | cell` with `pose:` (X_ES or X_CS).
+void read_mount(YamlMap& map, SensorSpec& s) {
+  const YAML::Node mount = map.node("mount");
+  if (mount && mount.IsScalar()) {
+    const std::string where = mount.as<std::string>();
+    if (where != "tool" && where != "cell")
+      map.fail("mount", "must be tool, cell or a pose, got '" + where + "'");
+    s.mount = where == "tool" ? Mount::kTool : Mount::kCell;
+    if (!map.has("pose")) map.fail("pose", "is required with mount: " + where);
+    (s.mount == Mount::kTool ? s.X_ES : s.X_CS) = map.pose("pose");
+    return;
+  }
+  if (map.has("pose")) map.fail("pose", "only with mount: tool or mount: cell");
+  s.X_ES = map.pose("mount");
+}
+
 SensorSpec read_sensor(YamlMap map, int dof) {
   SensorSpec s;
   s.name = map.require<std::string>("name");
@@ -207,7 +201,7 @@ SensorSpec read_sensor(YamlMap map, int dof) {
   } catch (const Error& e) {
     map.fail("model", e.what());
   }
-  s.X_ES = map.pose("mount");
+  read_mount(map, s);
   if (s.is_camera()) {
     s.intrinsics = read_intrinsics(map.child("intrinsics"), s.model);
     if (map.has("scanner")) map.fail("scanner", "only for a line scanner (model os32c)");
@@ -219,6 +213,34 @@ SensorSpec read_sensor(YamlMap map, int dof) {
   if (map.has("sweep")) s.sweep = read_plan(map.child("sweep"), dof);
   map.expect_all_read();
   return s;
+}
+
+Waypoint read_waypoint(YamlMap map, int dof) {
+  Waypoint w;
+  w.time = map.number("time", 0.0, 0.0, 1e6);
+  w.q = joint_vector(map, "q", dof);
+  w.pick = map.get<std::string>("pick", "");
+  w.place = map.get<bool>("place", false);
+  map.expect_all_read();
+  return w;
+}
+
+Walker read_walker(YamlMap map) {
+  Walker w;
+  w.name = map.require<std::string>("name");
+  w.radius = positive(map, "radius");
+  w.height = positive(map, "height");
+  w.floor = map.number("floor", 0.0, -1e3, 1e3);
+  const YAML::Node path = map.node("path");
+  if (!path || !path.IsSequence()) map.fail("path", "must be a list of {time, at: [x, y]}");
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    YamlMap point(path[i], map.key_path("path[" + std::to_string(i) + "]"), map.source());
+    const std::vector<double> at = point.numbers("at", 2);
+    w.path.push_back({point.number("time", 0.0, 0.0, 1e6), Eigen::Vector2d(at[0], at[1])});
+    point.expect_all_read();
+  }
+  map.expect_all_read();
+  return w;
 }
 
 template <typename Read>
@@ -241,7 +263,53 @@ void check_shape(const Shape& shape, const std::string& what) {
   if (!ok) throw Error(what + ": sizes must be positive and finite");
 }
 
+GantryParts::Part read_part(YamlMap& gantry, const std::string& key, const GantryParts::Part& fallback) {
+  if (!gantry.has(key)) return fallback;
+  YamlMap map = gantry.child(key);
+  GantryParts::Part part{map.vector3("center"), positive_vec3(map, "half_extents")};
+  map.expect_all_read();
+  return part;
+}
+
 }  // namespace
+
+Robot read_robot(YamlMap map, const std::string& base_dir) {
+  if (map.has("gantry") == map.has("urdf")) map.fail("gantry", "exactly one of gantry, urdf is required");
+  if (map.has("gantry")) {
+    YamlMap gantry = map.child("gantry");
+    const Eigen::Vector3d lower = gantry.vector3("lower");
+    const Eigen::Vector3d upper = gantry.vector3("upper");
+    if (!(lower.array() <= upper.array()).all()) gantry.fail("upper", "must be >= lower on every axis");
+    const Eigen::Isometry3d X_CE_zero = gantry.pose("tool_at_zero");
+    const GantryParts fitting = GantryParts::fitting(lower, upper, X_CE_zero);
+    GantryParts parts;
+    parts.bridge = read_part(gantry, "bridge", fitting.bridge);
+    parts.carriage = read_part(gantry, "carriage", fitting.carriage);
+    parts.ram = read_part(gantry, "ram", fitting.ram);
+    gantry.expect_all_read();
+    map.expect_all_read();
+    return Robot::gantry(lower, upper, X_CE_zero, parts);
+  }
+  YamlMap urdf = map.child("urdf");
+  std::filesystem::path file = urdf.require<std::string>("file");
+  if (file.is_relative()) file = std::filesystem::path(base_dir) / file;
+  const std::string tool_link = urdf.require<std::string>("tool_link");
+  const Eigen::Isometry3d X_C_root = urdf.pose("base");
+  std::vector<std::string> package_paths;
+  if (urdf.has("package_paths")) {
+    package_paths = urdf.require<std::vector<std::string>>("package_paths");
+    for (std::string& path : package_paths) {
+      if (std::filesystem::path(path).is_relative()) path = (std::filesystem::path(base_dir) / path).string();
+    }
+  }
+  urdf.expect_all_read();
+  map.expect_all_read();
+  try {
+    return UrdfModel::load(file.string()).robot(tool_link, X_C_root, package_paths);
+  } catch (const Error& e) {
+    map.fail("urdf", e.what());
+  }
+}
 
 double Obstacle::volume() const {
   if (const auto* box = std::get_if<BoxShape>(&shape)) return 8.0 * box->half_extents.prod();
@@ -423,7 +491,9 @@ Eigen::Isometry3d Scene::sensor_pose(int index, const Eigen::VectorXd& q) const 
   if (index < 0 || index >= static_cast<int>(sensors.size())) {
     throw Error("sensor index " + std::to_string(index) + " out of range");
   }
-  return robot.tool_pose(q) * sensors[static_cast<std::size_t>(index)].X_ES;
+  const SensorSpec& sensor = sensors[static_cast<std::size_t>(index)];
+  if (sensor.mount == Mount::kCell) return sensor.X_CS;
+  return robot.tool_pose(q) * sensor.X_ES;
 }
 
 void Scene::validate() const {
@@ -457,7 +527,7 @@ void Scene::validate() const {
     const std::string key = "sensors[" + std::to_string(i) + "]";
     if (s.name.empty()) throw Error(key + ".name: must not be empty");
     if (!names.insert(s.name).second) throw Error(key + ".name: '" + s.name + "' used twice");
-    if (!all_finite(s.X_ES)) throw Error(key + ".mount: pose must be finite");
+    if (!all_finite(s.X_ES) || !all_finite(s.X_CS)) throw Error(key + ".mount: pose must be finite");
     try {
       if (s.is_camera()) {
         s.intrinsics.validate();
@@ -480,6 +550,16 @@ void Scene::validate() const {
     }
   }
   if (sensors.empty()) throw Error("sensors: at least one sensor is required");
+  if (motion) {
+    motion->validate(robot);
+    for (const Waypoint& w : motion->waypoints) {
+      const int picked = find_obstacle(w.pick);
+      if (!w.pick.empty() && (picked < 0 || !std::holds_alternative<BoxShape>(obstacles[picked].shape))) {
+        throw Error("motion: pick '" + w.pick + "': no box obstacle of that name");
+      }
+    }
+  }
+  for (const Walker& walker : walkers) walker.validate();
 }
 
 Scene parse_scene(const std::string& yaml, const std::string& source, const std::string& base_dir) {
@@ -496,9 +576,28 @@ Scene parse_scene(const std::string& yaml, const std::string& source, const std:
   std::vector<SensorSpec> sensors =
       read_list(root, "sensors", [dof](YamlMap map) { return read_sensor(std::move(map), dof); });
   SweepPlan plan = read_plan(root.child("sweep"), dof);
+  std::optional<Motion> motion;
+  if (root.has("motion")) {
+    YamlMap map = root.child("motion");
+    motion.emplace();
+    motion->loop = map.get<bool>("loop", true);
+    motion->controller_rate = map.number("controller_rate", 250.0, 1.0, 10000.0);
+    motion->joint_stamp_delay = map.number("joint_stamp_delay", 0.0, -1.0, 1.0);
+    motion->waypoints =
+        read_list(map, "waypoints", [dof](YamlMap item) { return read_waypoint(std::move(item), dof); });
+    map.expect_all_read();
+  }
+  std::vector<Walker> walkers;
+  if (root.has("walkers")) walkers = read_list(root, "walkers", read_walker);
   root.expect_all_read();
 
-  Scene scene{cell, std::move(obstacles), std::move(robot), std::move(sensors), std::move(plan)};
+  Scene scene{cell,
+              std::move(obstacles),
+              std::move(robot),
+              std::move(sensors),
+              std::move(plan),
+              std::move(motion),
+              std::move(walkers)};
   try {
     scene.validate();
   } catch (const Error& e) {

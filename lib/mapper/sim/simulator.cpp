@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/parallel.hpp"
@@ -16,10 +17,87 @@ Scene validated(Scene scene) {
   return scene;
 }
 
+// First multiple k of `period` with k·period >= t.
+long first_tick(double t, double period) {
+  return static_cast<long>(std::ceil(t / period - 1e-9));
+}
+
 }  // namespace
 
 Simulator::Simulator(Scene scene, SimOptions options)
-    : scene_(validated(std::move(scene))), options_(options), caster_(scene_.obstacles) {}
+    : scene_(validated(std::move(scene))),
+      options_(options),
+      caster_(scene_.obstacles),
+      robot_solids_(scene_.robot) {
+  if (!scene_.motion) return;
+  const std::vector<Waypoint>& path = scene_.motion->waypoints;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (path[i].pick.empty()) continue;
+    const Obstacle& box = scene_.obstacles[static_cast<std::size_t>(scene_.find_obstacle(path[i].pick))];
+    Carry carry{box.name, path[i].time, std::numeric_limits<double>::infinity(), {}, box};
+    const Eigen::Isometry3d X_CE = scene_.robot.tool_pose(path[i].q);
+    carry.payload.X_EB = X_CE.inverse() * box.X_CO;
+    carry.payload.half_extents = std::get<BoxShape>(box.shape).half_extents;
+    for (std::size_t j = i + 1; j < path.size(); ++j) {
+      if (!path[j].place) continue;
+      carry.place_time = path[j].time;
+      carry.placed.X_CO = scene_.robot.tool_pose(path[j].q) * carry.payload.X_EB;
+      break;
+    }
+    carries_.push_back(carry);
+  }
+}
+
+CellState Simulator::state_at(double t) const {
+  CellState state;
+  state.robot.stamp = t;
+  state.robot.q = scene_.motion ? scene_.motion->q_at(t) : scene_.sweep.stops.front();
+  state.obstacles = scene_.obstacles;
+  for (const Carry& carry : carries_) {
+    if (t < carry.pick_time) continue;
+    const int index = [&] {
+      for (std::size_t i = 0; i < state.obstacles.size(); ++i) {
+        if (state.obstacles[i].name == carry.name) return static_cast<int>(i);
+      }
+      return -1;
+    }();
+    if (index >= 0) state.obstacles.erase(state.obstacles.begin() + index);
+    if (t < carry.place_time) {
+      state.robot.payload = carry.payload;
+    } else {
+      state.obstacles.push_back(carry.placed);
+    }
+  }
+  for (const Walker& walker : scene_.walkers) {
+    for (Obstacle& part : walker.at(t)) state.obstacles.push_back(std::move(part));
+  }
+  return state;
+}
+
+SimWindow Simulator::window(double t0, double t1) const {
+  if (!(t0 >= 0) || !(t1 >= t0)) throw Error("simulator: window needs 0 <= t0 <= t1");
+  SimWindow out;
+  for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor) {
+    const SensorSpec& spec = scene_.sensors[static_cast<std::size_t>(sensor)];
+    const double period = scene_.plan_for(spec).period;
+    for (long k = first_tick(t0, period); static_cast<double>(k) * period < t1; ++k) {
+      const double t = static_cast<double>(k) * period;
+      const CellState state = state_at(t);
+      out.frames.push_back(render_in(sensor, state.robot, state.obstacles,
+                                     NoiseKey{spec.seed, 0, static_cast<std::uint64_t>(k)}));
+    }
+  }
+  std::stable_sort(out.frames.begin(), out.frames.end(),
+                   [](const SimFrame& a, const SimFrame& b) { return a.frame.stamp < b.frame.stamp; });
+  const double rate = scene_.motion ? scene_.motion->controller_rate : 250.0;
+  const double delay = scene_.motion ? scene_.motion->joint_stamp_delay : 0.0;
+  for (long k = first_tick(t0, 1.0 / rate); static_cast<double>(k) / rate < t1; ++k) {
+    JointState sample = state_at(static_cast<double>(k) / rate).robot;
+    sample.stamp += delay;
+    out.joints.push_back(std::move(sample));
+  }
+  return out;
+}
 
 std::string Simulator::apply(const transport::SceneEdit& edit) {
   std::string name = sim::apply(scene_, edit);
@@ -29,16 +107,32 @@ std::string Simulator::apply(const transport::SceneEdit& edit) {
 
 SimFrame Simulator::render(int sensor, const Eigen::VectorXd& q, double stamp, std::uint64_t sweep_index,
                            std::uint64_t frame_index) const {
+  return render(sensor, JointState{stamp, q, std::nullopt}, sweep_index, frame_index);
+}
+
+SimFrame Simulator::render(int sensor, const JointState& state, std::uint64_t sweep_index,
+                           std::uint64_t frame_index) const {
   if (sensor < 0 || sensor >= static_cast<int>(scene_.sensors.size())) {
     throw Error("simulator: no sensor with index " + std::to_string(sensor));
   }
   const SensorSpec& spec = scene_.sensors[static_cast<std::size_t>(sensor)];
-  const Eigen::Isometry3d X_CS = scene_.sensor_pose(sensor, q);
-  const NoiseKey key{spec.seed, sweep_index, frame_index};
-  SimFrame out = spec.is_camera() ? render_camera(spec, X_CS, key) : render_scanner(spec, X_CS, key);
-  out.q = q;
+  return render_in(sensor, state, scene_.obstacles, NoiseKey{spec.seed, sweep_index, frame_index});
+}
+
+SimFrame Simulator::render_in(int sensor, const JointState& state, const std::vector<Obstacle>& obstacles,
+                              const NoiseKey& key) const {
+  const SensorSpec& spec = scene_.sensors[static_cast<std::size_t>(sensor)];
+  const Eigen::Isometry3d X_CS = scene_.sensor_pose(sensor, state.q);
+  const bool with_robot = options_.render_robot && (!scene_.robot.shapes().empty() || state.payload);
+  const bool same_obstacles = &obstacles == &scene_.obstacles;
+  const SceneCaster caster = with_robot       ? SceneCaster(obstacles, robot_solids_, state)
+                             : same_obstacles ? caster_
+                                              : SceneCaster(obstacles);
+  SimFrame out =
+      spec.is_camera() ? render_camera(spec, X_CS, key, caster) : render_scanner(spec, X_CS, key, caster);
+  out.q = state.q;
   out.frame.sensor = spec.name;
-  out.frame.stamp = stamp;
+  out.frame.stamp = state.stamp;
   out.frame.X_CS = X_CS;
   if (!spec.is_camera()) out.frame.field_of_view = spec.scanner.field_of_view();
   return out;
@@ -58,8 +152,8 @@ std::vector<SimFrame> Simulator::sweep(int sensor, std::uint64_t sweep_index, do
   return frames;
 }
 
-SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3d& X_CS,
-                                  const NoiseKey& key) const {
+SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3d& X_CS, const NoiseKey& key,
+                                  const SceneCaster& caster) const {
   const PinholeIntrinsics& k = spec.intrinsics;
   const int width = k.width, height = k.height;
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
@@ -70,7 +164,7 @@ SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3
 
   SimFrame out;
   out.exact.assign(pixels, 0.0);
-  out.hit.assign(pixels, -1);
+  out.hit.assign(pixels, RayHit::kNothing);
   const int tiles_u = (width + kTile - 1) / kTile, tiles_v = (height + kTile - 1) / kTile;
   parallel_for(tiles_u * tiles_v, options_.threads, [&](int tile) {
     const int u0 = (tile % tiles_u) * kTile, v0 = (tile / tiles_u) * kTile;
@@ -85,15 +179,15 @@ SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3
       half_angle = std::max(half_angle, std::acos(std::clamp(axis_S.dot(c), -1.0, 1.0)));
     }
     const std::vector<SceneCaster::Candidate> candidates =
-        caster_.candidates(p_CS, R_CS * axis_S, half_angle + 1e-9);
+        caster.candidates(p_CS, R_CS * axis_S, half_angle + 1e-9);
     for (int v = v0; v <= v1; ++v) {
       for (int u = u0; u <= u1; ++u) {
         const Eigen::Vector3d r_S = ray_S(u, v);
         const double length = r_S.norm();
         const Eigen::Vector3d d_C = R_CS * (r_S / length);
         const double t_max = std::min(exit_distance(scene_.cell, p_CS, d_C), k.max_range * length);
-        const RayHit hit = caster_.cast(p_CS, d_C, t_max, &candidates);
-        if (hit.obstacle < 0) continue;
+        const RayHit hit = caster.cast(p_CS, d_C, t_max, &candidates);
+        if (hit.obstacle == RayHit::kNothing) continue;
         const double z = hit.t / length;
         if (z < k.min_range || z > k.max_range) continue;
         const std::size_t p = static_cast<std::size_t>(v) * width + u;
@@ -128,8 +222,8 @@ SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3
   return out;
 }
 
-SimFrame Simulator::render_scanner(const SensorSpec& spec, const Eigen::Isometry3d& X_CS,
-                                   const NoiseKey& key) const {
+SimFrame Simulator::render_scanner(const SensorSpec& spec, const Eigen::Isometry3d& X_CS, const NoiseKey& key,
+                                   const SceneCaster& caster) const {
   const LineScanner& s = spec.scanner;
   const std::size_t beams = static_cast<std::size_t>(s.beams);
   const Eigen::Vector3d p_CS = X_CS.translation();
@@ -140,12 +234,12 @@ SimFrame Simulator::render_scanner(const SensorSpec& spec, const Eigen::Isometry
 
   SimFrame out;
   out.exact.assign(beams, 0.0);
-  out.hit.assign(beams, -1);
+  out.hit.assign(beams, RayHit::kNothing);
   for (std::size_t i = 0; i < beams; ++i) {
     const Eigen::Vector3d d_C = X_CS.linear() * beam_S(i);
     const double t_max = std::min(exit_distance(scene_.cell, p_CS, d_C), s.max_range);
-    const RayHit hit = caster_.cast(p_CS, d_C, t_max);
-    if (hit.obstacle < 0 || hit.t < s.min_range) continue;
+    const RayHit hit = caster.cast(p_CS, d_C, t_max);
+    if (hit.obstacle == RayHit::kNothing || hit.t < s.min_range) continue;
     out.exact[i] = hit.t;
     out.hit[i] = hit.obstacle;
   }

@@ -11,10 +11,12 @@
 
 namespace cellmap::collision {
 
-/// A Robot with boxes on its links (from its URDF: UrdfModel::link_boxes). Immutable and valid once built;
-/// safe to share between threads.
+/// A Robot with boxes on its links. Immutable and valid once built; safe to share between threads.
 class RobotBoxes final {
  public:
+  /// The tight box of each of the robot's collision shapes (Robot::shape_boxes): the geometry the map
+  /// maker's self filter and simulator use, so planner and map maker agree on where the robot is.
+  explicit RobotBoxes(Robot robot);
   /// @throws Error naming the box index if its link is not one of robot.link_names(), a half extent is
   /// negative or a value is not finite.
   RobotBoxes(Robot robot, std::vector<LinkBox> boxes);

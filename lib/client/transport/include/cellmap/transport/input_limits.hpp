@@ -1,7 +1,8 @@
 #pragma once
 // What a daemon accepts from outside over DDS besides what the wire format already enforces (every number
 // finite, unit quaternions, known enum values, names present): positions inside the cell, boxes that fit in
-// it, robot poses stamped near now. A sample outside is refused: counted by its reader, never returned.
+// it, robot poses and joint states stamped near now, payloads that fit in the cell. A sample outside is
+// refused: counted by its reader, never returned.
 
 #include <Eigen/Geometry>
 
@@ -39,5 +40,9 @@ void check_limits(const SceneEdit& edit, const InputLimits& limits);
 /// @throws Error "cellmap/robot_state '<cell>' at <stamp>: <field>: <reason>" if the tool position is outside
 /// the cell or the stamp is farther than max_stamp_skew from `now_ns` (ns since the Unix epoch).
 void check_limits(const RobotState& state, const InputLimits& limits, std::int64_t now_ns);
+/// @throws Error "cellmap/robot_joints '<cell>' at <stamp>: <field>: <reason>" if the stamp is farther than
+/// max_stamp_skew from `now_ns`, or the payload's centre is farther from the tool than the cell's largest
+/// side or a half extent is over half of it.
+void check_limits(const RobotJoints& joints, const InputLimits& limits, std::int64_t now_ns);
 
 }  // namespace cellmap::transport

@@ -1,13 +1,16 @@
 #pragma once
-// Value types for the status, scene-edit and robot-state topics (the environment ones are
+// Value types for the status, scene-edit, robot-state and robot-joints topics (the environment ones are
 // cellmap::Environment and cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside
 // lib/client/transport.
 
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "cellmap/robot/joint_state.hpp"
 
 namespace cellmap::transport {
 
@@ -71,6 +74,22 @@ struct RobotState final {
   std::string cell;                                        ///< must not be empty
   std::int64_t stamp_ns = 0;                               ///< ns since the Unix epoch (CLOCK_REALTIME)
   Eigen::Isometry3d X_CE = Eigen::Isometry3d::Identity();  ///< tool pose in the cell frame
+};
+
+/// cellmap/robot_joints: the robot's joint positions at one instant and what its tool holds.
+struct RobotJoints final {
+  std::string cell;                ///< must not be empty
+  std::int64_t stamp_ns = 0;       ///< ns since the Unix epoch (CLOCK_REALTIME), the frames' clock
+  std::vector<std::string> names;  ///< joint names; empty: positions are in the robot's joint order
+  std::vector<double> positions;   ///< metres or radians, one per joint
+  std::optional<Payload> payload;  ///< the box the tool holds, in the tool frame; none: the tool is empty
+
+  /// The sample as a JointState (stamp in seconds) with q = positions as they are ordered here.
+  [[nodiscard]] JointState state() const {
+    return {static_cast<double>(stamp_ns) * 1e-9,
+            Eigen::Map<const Eigen::VectorXd>(positions.data(), static_cast<Eigen::Index>(positions.size())),
+            payload};
+  }
 };
 
 }  // namespace cellmap::transport

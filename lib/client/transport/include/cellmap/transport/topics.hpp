@@ -18,8 +18,6 @@ inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
 inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
 inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
 inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
-/// Reserved for the robot's joint states (no type yet): already in the DDS Security grants (robot writes,
-/// daemon reads), so credentials issued now stay valid when it arrives.
 inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
@@ -36,6 +34,8 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
 /// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
 [[nodiscard]] dds::Qos robot_state_qos();
+/// cellmap/robot_joints: as cellmap/robot_state (RELIABLE, VOLATILE, KEEP_LAST 256 per cell).
+[[nodiscard]] dds::Qos robot_joints_qos();
 
 /// cellmap/layer/*: RELIABLE, VOLATILE, KEEP_LAST 1 (a layer is the daemon's current view; a reader only
 /// wants the newest, and the daemon writes it only while a reader is matched).

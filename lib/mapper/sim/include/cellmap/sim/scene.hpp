@@ -1,6 +1,6 @@
 #pragma once
-// The simulated cell: its bounds, the obstacles in it, the robot, the sensors on the robot and the sweep
-// plan.
+// The simulated cell: its bounds, the obstacles in it, the robot, the sensors (on the robot or fixed), the
+// sweep plan, and what moves while frames are taken (the robot's motion, walkers).
 // The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
 // Detection for Industrial Robotics Applications", AIRoV 2024.
 
@@ -13,24 +13,19 @@
 #include <vector>
 
 #include "cellmap/common/region.hpp"
+#include "cellmap/config/yaml_map.hpp"
 #include "cellmap/frame/frame.hpp"
 #include "cellmap/robot/robot.hpp"
+#include "cellmap/sim/motion.hpp"
 
 namespace cellmap::sim {
 
-/// A box centred on its frame O, with half extents along O's x, y and z axes (metres, > 0).
-struct BoxShape final {
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Ones();
-};
-/// A solid cylinder centred on its frame O, its axis along O's z (metres, > 0).
-struct CylinderShape final {
-  double radius = 1.0;
-  double half_length = 1.0;
-};
-/// A solid sphere centred on its frame O (metres, > 0).
-struct SphereShape final {
-  double radius = 1.0;
-};
+// The primitive shapes are the robot's (cellmap/robot/geometry.hpp), also reachable as sim::BoxShape etc.
+using cellmap::BoxShape;
+using cellmap::CylinderShape;
+using cellmap::SphereShape;
+
+/// An obstacle's solid, in the obstacle's frame O.
 using Shape = std::variant<BoxShape, CylinderShape, SphereShape>;
 
 /// One named solid obstacle of the scene. X_CO is the pose of the shape's frame O in the cell frame.
@@ -82,14 +77,19 @@ struct SweepPlan final {
   double period = 0.1;
 };
 
-/// One sensor mounted on the end-effector E with the hand-eye extrinsic X_ES.
+/// Where a sensor is mounted: on the robot's tool (posed through the robot) or fixed in the cell.
+enum class Mount { kTool, kCell };
+
+/// One sensor, on the end-effector E with the hand-eye extrinsic X_ES, or fixed in the cell at X_CS.
 struct SensorSpec final {
   std::string name;
   SensorModel model = SensorModel::kKinectV2;
-  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();
-  PinholeIntrinsics intrinsics;    ///< cameras only
-  LineScanner scanner;             ///< line scanners only
-  std::uint64_t seed = 1;          ///< noise seed; same seed → same frames
+  Mount mount = Mount::kTool;
+  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();  ///< on the tool
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< fixed in the cell
+  PinholeIntrinsics intrinsics;                            ///< cameras only
+  LineScanner scanner;                                     ///< line scanners only
+  std::uint64_t seed = 1;                                  ///< noise seed; same seed → same frames
   std::optional<SweepPlan> sweep;  ///< overrides the scene's plan (a line scanner needs dense stops)
 
   [[nodiscard]] bool is_camera() const { return model != SensorModel::kOs32c; }
@@ -108,6 +108,9 @@ struct Scene final {
   Robot robot;
   std::vector<SensorSpec> sensors;
   SweepPlan sweep;
+  std::optional<Motion>
+      motion;  ///< the robot moving all the time (Simulator::window); none: sweeps stop by stop
+  std::vector<Walker> walkers;  ///< people walking through while the robot moves
 
   /// The plan `sensor` follows: its own, or the scene's.
   [[nodiscard]] const SweepPlan& plan_for(const SensorSpec& sensor) const;
@@ -115,14 +118,23 @@ struct Scene final {
   [[nodiscard]] int find_obstacle(const std::string& name) const;
   /// Index of the sensor whose name, or else whose model name, is `name`; -1 if none.
   [[nodiscard]] int find_sensor(const std::string& name) const;
-  /// X_CS of sensor `index` at joint vector q: X_CE(q) · X_ES. @throws Error as Robot::tool_pose.
+  /// X_CS of sensor `index` at joint vector q: X_CE(q) · X_ES on the tool, X_CS when fixed.
+  /// @throws Error as Robot::tool_pose.
   [[nodiscard]] Eigen::Isometry3d sensor_pose(int index, const Eigen::VectorXd& q) const;
 
   /// Checks what parse_scene checks, for scenes built by hand or edited: bounds non-empty, obstacle names
   /// unique and non-empty, sizes positive, sensors valid, every stop within the robot's limits and every
-  /// sensor inside the cell at every stop of its plan. @throws Error naming the obstacle, sensor or stop.
+  /// sensor inside the cell at every stop of its plan, the motion and walkers valid, every picked obstacle a
+  /// box.
+  /// @throws Error naming the obstacle, sensor, stop, waypoint or walker.
   void validate() const;
 };
+
+/// Reads the `robot` section of a scene (or daemon) file: `gantry: {lower, upper, tool_at_zero, [bridge,
+/// carriage, ram: {center, half_extents}]}` (parts at q = 0 in the cell frame; default GantryParts::fitting)
+/// or `urdf: {file, tool_link, [base], [package_paths]}` (relative paths against `base_dir`; the URDF's
+/// collision geometry and meshes are loaded). @throws Error naming the key.
+[[nodiscard]] Robot read_robot(YamlMap map, const std::string& base_dir);
 
 /// Reads a scene file (format: config/cell.yaml, documented there). A URDF path is relative to the file.
 /// @throws Error "<file>: <key path>: <reason>" for unknown keys, wrong types, non-positive sizes, a stop
