@@ -49,6 +49,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
       store_(config_.state_dir, config_.cell),
       participant_(static_cast<std::uint32_t>(config_.domain), config_.security),
       publisher_(participant_, config_.cell, config_.delta_depth),
+      layers_(participant_, config_.cell),
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
       keeper_(store_, [this](const Environment& env,
                              const EnvironmentDelta& delta) { publisher_.publish(env, delta); }),
@@ -147,12 +148,12 @@ void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
     health_.sweep_processed(number, system_now_ns());
     spdlog::info(
         "sweep {}: {} frames, {} points, {} on the robot, {} hit / {} free voxels, {} flipped, {} change "
-        "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; {} "
-        "sweeps "
-        "dropped",
+        "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; "
+        "{} sweeps dropped",
         number, report.frames, report.points, report.robot_points, report.hit_voxels, report.free_voxels,
         report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_change,
         report.t_segment, mailbox_.dropped());
+    layers_.after_sweep(number, sweep, pipeline_.map(), report.changes);
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
     spdlog::error("sweep {}: {}; keeping version {}", number, e.what(), keeper_.published().version());

@@ -17,6 +17,7 @@
 #include "health.hpp"
 #include "input_refusals.hpp"
 #include "latest_mailbox.hpp"
+#include "layer_publisher.hpp"
 #include "signals.hpp"
 #include "versions.hpp"
 
@@ -52,6 +53,7 @@ class Daemon final {
   VersionStore store_;
   dds::Participant participant_;
   transport::EnvironmentPublisher publisher_;
+  LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
   CellPipeline pipeline_;
   VersionKeeper keeper_;
   LatestMailbox<FrameSweep> mailbox_;

@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
   cellmap::cli::add_echo_command(app);
   cellmap::cli::add_inject_command(app);
   cellmap::cli::add_robot_pose_command(app);
+  cellmap::cli::add_view_command(app);
+  cellmap::cli::add_render_command(app);
   cellmap::cli::add_security_command(app);
   cellmap::cli::add_distance_command(app);
   cellmap::cli::add_sensor_comparison_command(app);

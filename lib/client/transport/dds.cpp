@@ -197,6 +197,12 @@ std::uint32_t Writer::matched_readers() const {
   return status.current_count;
 }
 
+std::uint32_t Writer::matched_readers_ever() const {
+  dds_publication_matched_status_t status;
+  check(dds_get_publication_matched_status(get(), &status), "cannot get the readers of " + topic_);
+  return status.total_count;
+}
+
 bool Writer::wait_for_readers(std::uint32_t count, std::chrono::nanoseconds timeout) const {
   // Matching is a discovery event without a waitable condition of its own here; poll it briefly.
   const auto deadline = std::chrono::steady_clock::now() + timeout;
@@ -221,6 +227,12 @@ Reader::Reader(const Participant& participant, const Topic& topic, const Qos& qo
 
 std::size_t Reader::take_all(
     const std::function<void(const void* sample, const dds_sample_info_t& info)>& on_sample) const {
+  return take_all(on_sample, {});
+}
+
+std::size_t Reader::take_all(
+    const std::function<void(const void* sample, const dds_sample_info_t& info)>& on_sample,
+    const std::function<void(const void* key_sample)>& on_gone) const {
   constexpr std::size_t kBatch = 32;
   std::size_t with_data = 0;
   for (;;) {
@@ -237,9 +249,11 @@ std::size_t Reader::take_all(
       ~Loan() { (void)dds_return_loan(reader, samples, n); }
     } loan{get(), samples, n};
     for (dds_return_t i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      ++with_data;
-      on_sample(samples[i], infos[i]);
+      if (infos[i].valid_data) {
+        ++with_data;
+        on_sample(samples[i], infos[i]);
+      }
+      if (on_gone && infos[i].instance_state != DDS_IST_ALIVE) on_gone(samples[i]);
     }
   }
 }

@@ -1,5 +1,7 @@
 #include "cellmap/transport/status_reader.hpp"
 
+#include <algorithm>
+
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/topics.hpp"
 #include "wire.hpp"
@@ -24,13 +26,25 @@ StatusReader::~StatusReader() {
 std::vector<CellStatus> StatusReader::take(std::chrono::nanoseconds timeout) {
   if (timeout.count() > 0) waitset_.wait(timeout);
   std::vector<CellStatus> reports;
-  reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
-    try {
-      reports.push_back(wire::from_wire(*static_cast<const cellmap_msg_Status*>(sample)));
-    } catch (const Error&) {
-      // A report without a cell cannot be attributed; skip it.
-    }
-  });
+  departed_.clear();
+  const auto forget = [&](const std::string& cell) {
+    departed_.erase(std::remove(departed_.begin(), departed_.end(), cell), departed_.end());
+  };
+  reader_.take_all(
+      [&](const void* sample, const dds_sample_info_t&) {
+        try {
+          reports.push_back(wire::from_wire(*static_cast<const cellmap_msg_Status*>(sample)));
+          forget(reports.back().cell);
+        } catch (const Error&) {
+          // A report without a cell cannot be attributed; skip it.
+        }
+      },
+      [&](const void* key_sample) {
+        const char* cell = static_cast<const cellmap_msg_Status*>(key_sample)->cell;
+        if (cell == nullptr || *cell == '\0') return;
+        forget(cell);
+        departed_.emplace_back(cell);
+      });
   return reports;
 }
 

@@ -25,11 +25,18 @@ dds::Qos robot_state_qos() {
   return dds::Qos::make(false, 256);
 }
 
+dds::Qos layer_qos() {
+  return dds::Qos::make(false, 1);
+}
+
 std::map<security::Role, security::TopicGrants> role_grants() {
   using security::Role;
   const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
-  return {{Role::kDaemon, {environment, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
-          {Role::kPlanner, {{}, environment}},
+  std::vector<std::string> environment_and_layers = environment;
+  environment_and_layers.insert(environment_and_layers.end(),
+                                {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic});
+  return {{Role::kDaemon, {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
+          {Role::kPlanner, {{}, environment_and_layers}},
           {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}}},
           {Role::kTool, {{kSceneEditTopic}, environment}}};
 }

@@ -77,11 +77,6 @@ std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::s
   return boxes;
 }
 
-std::string cell_of(const char* cell, const char* topic) {
-  if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
-  return cell;
-}
-
 // A writer may send any 32-bit value; reading one outside the enumerators through the enum type is undefined
 // behaviour, so the value is read as the integer it is on the wire.
 std::int32_t kind_on_the_wire(const cellmap_msg_SceneEdit& msg) {
@@ -92,6 +87,11 @@ std::int32_t kind_on_the_wire(const cellmap_msg_SceneEdit& msg) {
 }
 
 }  // namespace
+
+std::string cell_of(const char* cell, const char* topic) {
+  if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
+  return cell;
+}
 
 EnvironmentSample::EnvironmentSample(const Environment& env)
     : cell_(env.cell()), boxes_(to_msgs(env.boxes())) {

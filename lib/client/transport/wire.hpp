@@ -82,6 +82,12 @@ class RobotJointsSample {
 /// number is not finite, a payload half extent is negative or its rotation is not orthonormal.
 void validate(const RobotJoints& joints);
 
+/// The cell of an incoming sample. @throws Error naming the topic if it is empty.
+[[nodiscard]] std::string cell_of(const char* cell, const char* topic);
+/// The bytes of `sample` (of the generated `type`) in an RTPS DATA submessage: the 4-byte encapsulation
+/// header plus the XCDR1 body, measured with Cyclone's own serializer.
+[[nodiscard]] std::size_t serialized_size(const void* sample, const dds_topic_descriptor_t& type);
+
 /// @throws Error naming the topic and field if a number is not finite, a half extent is negative, a rotation
 /// is not a unit quaternion, the cell is empty or box ids repeat.
 [[nodiscard]] Environment from_wire(const cellmap_msg_Environment& msg);

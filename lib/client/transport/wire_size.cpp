@@ -5,11 +5,9 @@
 #include "wire.hpp"
 
 namespace cellmap::transport {
-namespace {
 
-constexpr std::size_t kEncapsulationHeader = 4;
-
-std::size_t serialized(const void* sample, const dds_topic_descriptor_t& type) {
+std::size_t wire::serialized_size(const void* sample, const dds_topic_descriptor_t& type) {
+  constexpr std::size_t kEncapsulationHeader = 4;
   dds_ostream_t os;
   dds_ostream_init(&os, 0, 1);  // XCDR1, what @final types use
   dds_stream_write(&os, static_cast<const char*>(sample), type.m_ops);
@@ -18,16 +16,14 @@ std::size_t serialized(const void* sample, const dds_topic_descriptor_t& type) {
   return kEncapsulationHeader + size;
 }
 
-}  // namespace
-
 std::size_t wire_size(const Environment& env) {
   const wire::EnvironmentSample sample(env);
-  return serialized(sample.get(), cellmap_msg_Environment_desc);
+  return wire::serialized_size(sample.get(), cellmap_msg_Environment_desc);
 }
 
 std::size_t wire_size(const EnvironmentDelta& delta) {
   const wire::DeltaSample sample(delta);
-  return serialized(sample.get(), cellmap_msg_EnvironmentDelta_desc);
+  return wire::serialized_size(sample.get(), cellmap_msg_EnvironmentDelta_desc);
 }
 
 }  // namespace cellmap::transport

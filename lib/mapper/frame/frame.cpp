@@ -85,4 +85,21 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
   return cloud;
 }
 
+FieldOfView frustum(const PinholeIntrinsics& k) {
+  k.validate();
+  const auto ray = [&](double u, double v) {
+    return Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0).normalized();
+  };
+  // Pixel (u, v) covers [u - 0.5, u + 0.5]: the image's outer edges lie half a pixel beyond the corner
+  // pixels.
+  const double left = -0.5, right = k.width - 0.5, top = -0.5, bottom = k.height - 0.5;
+  return {{ray(left, top), ray(right, top), ray(right, bottom), ray(left, bottom)}, true, k.max_range};
+}
+
+std::optional<FieldOfView> field_of_view(const Frame& frame) {
+  if (frame.field_of_view) return frame.field_of_view;
+  if (frame.depth) return frustum(frame.depth->intrinsics);
+  return std::nullopt;
+}
+
 }  // namespace cellmap

@@ -449,6 +449,17 @@ Scene without_depth_filter(Scene scene) {
   return scene;
 }
 
+FieldOfView LineScanner::field_of_view() const {
+  constexpr double kMaxStep = kPi / 6;
+  const int steps = std::max(1, static_cast<int>(std::ceil(fov / kMaxStep)));
+  FieldOfView out{{}, false, max_range};
+  for (int i = 0; i <= steps; ++i) {
+    const double angle = -fov / 2 + fov * i / steps;  // as the beams: about +z from +x
+    out.outline_S.emplace_back(std::cos(angle), std::sin(angle), 0.0);
+  }
+  return out;
+}
+
 PinholeIntrinsics default_intrinsics(SensorModel model) {
   PinholeIntrinsics k;
   k.depth_scale = 0.001;

@@ -140,6 +140,7 @@ SimFrame Simulator::render_in(int sensor, const JointState& state, const std::ve
   out.frame.sensor = spec.name;
   out.frame.stamp = state.stamp;
   out.frame.X_CS = X_CS;
+  if (!spec.is_camera()) out.frame.field_of_view = spec.scanner.field_of_view();
   return out;
 }
 

@@ -127,6 +127,8 @@ class Writer final : public Entity {
   void write(const void* sample) const;
   /// How many readers are matched right now.
   [[nodiscard]] std::uint32_t matched_readers() const;
+  /// How many readers ever matched (grows by one per reader that joins, never shrinks).
+  [[nodiscard]] std::uint32_t matched_readers_ever() const;
   /// Blocks until at least `count` readers matched or the timeout passed; true when they did.
   bool wait_for_readers(std::uint32_t count, std::chrono::nanoseconds timeout) const;
   /// Blocks until every matched reader acknowledged everything written; true when they did in time.
@@ -144,6 +146,12 @@ class Reader final : public Entity {
   /// disposed, writer gone) are taken and skipped. Returns how many samples carried data.
   std::size_t take_all(
       const std::function<void(const void* sample, const dds_sample_info_t& info)>& on_sample) const;
+  /// Like take_all(on_sample), and calls `on_gone` (after on_sample, if the sample carries data) for each
+  /// sample telling that its instance lost its last writer (deleted, or its lease expired) or was disposed;
+  /// only the key fields of a sample without data are set.
+  std::size_t take_all(
+      const std::function<void(const void* sample, const dds_sample_info_t& info)>& on_sample,
+      const std::function<void(const void* key_sample)>& on_gone) const;
   /// How many writers are matched right now.
   [[nodiscard]] std::uint32_t matched_writers() const;
 

@@ -2,6 +2,7 @@
 // Reads cellmap/status: the health reports of every cell daemon on a domain.
 
 #include <chrono>
+#include <string>
 #include <vector>
 
 #include "cellmap/transport/dds.hpp"
@@ -21,11 +22,16 @@ class StatusReader final {
   /// Waits up to `timeout` (zero: just looks) and returns the reports received, oldest first. Malformed
   /// reports are skipped.
   std::vector<CellStatus> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
+  /// The cells whose daemon is gone as of the last take(): its status writer left (a clean stop) or its
+  /// lease expired (a crash: after the lease duration, Cyclone's default 10 s) after its last report, in the
+  /// order seen. A cell that reported again later in the same take() is not listed.
+  [[nodiscard]] const std::vector<std::string>& departed() const { return departed_; }
 
  private:
   dds::Topic topic_;
   dds::Reader reader_;
   dds::WaitSet waitset_;
+  std::vector<std::string> departed_;
 };
 
 }  // namespace cellmap::transport

@@ -15,6 +15,9 @@ inline constexpr const char* kEnvironmentDeltaTopic = "cellmap/environment_delta
 inline constexpr const char* kStatusTopic = "cellmap/status";
 inline constexpr const char* kSceneEditTopic = "cellmap/sim/scene_edits";
 inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
+inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
+inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
+inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
 inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
@@ -34,11 +37,15 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// cellmap/robot_joints: as cellmap/robot_state (RELIABLE, VOLATILE, KEEP_LAST 256 per cell).
 [[nodiscard]] dds::Qos robot_joints_qos();
 
+/// cellmap/layer/*: RELIABLE, VOLATILE, KEEP_LAST 1 (a layer is the daemon's current view; a reader only
+/// wants the newest, and the daemon writes it only while a reader is matched).
+[[nodiscard]] dds::Qos layer_qos();
+
 /// What each DDS Security role may write and read (`cellmap security init` signs these into the permissions):
-///   daemon   writes environment, delta, status;  reads robot state and joints, scene edits (simulator)
-///   planner  writes nothing;                     reads environment, delta, status
-///   robot    writes robot state and joints;      reads nothing
-///   tool     writes scene edits (`inject`);      reads environment, delta, status (`echo`)
+///   daemon   writes environment, delta, status, layers;  reads robot state and joints, scene edits (sim)
+///   planner  writes nothing;                             reads environment, delta, status, layers (`view`)
+///   robot    writes robot state and joints;              reads nothing
+///   tool     writes scene edits (`inject`);              reads environment, delta, status (`echo`)
 [[nodiscard]] std::map<security::Role, security::TopicGrants> role_grants();
 
 }  // namespace cellmap::transport

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cellmap/common/field_of_view.hpp"
 #include "cellmap/frame/cloud.hpp"
 
 namespace cellmap {
@@ -62,6 +63,15 @@ struct Frame final {
   Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< sensor pose in the cell frame at `stamp`
   std::optional<DepthImage> depth;                         ///< cameras only
   Cloud points_S;  ///< valid points in the sensor frame (from `depth`, or a scanner's scan)
+  /// What the sensor could see, set by sources that know it without a depth image (line scanners).
+  std::optional<FieldOfView> field_of_view;
 };
+
+/// A pinhole camera's frustum: the rays through the outer corners of the image (pixel edges, not
+/// centres), closed, out to max_range. @throws Error if the intrinsics are invalid.
+[[nodiscard]] FieldOfView frustum(const PinholeIntrinsics& intrinsics);
+
+/// What the sensor of `frame` could see: its field_of_view, else the frustum of its depth image, else none.
+[[nodiscard]] std::optional<FieldOfView> field_of_view(const Frame& frame);
 
 }  // namespace cellmap

@@ -67,6 +67,8 @@ struct LineScanner final {
 
   /// @throws Error if a value is out of its range.
   void validate() const;
+  /// The fan: beams from the first to the last at most 30° apart (open), out to max_range.
+  [[nodiscard]] FieldOfView field_of_view() const;
 };
 
 /// The stops of one sweep: robot joint vectors visited in order, one frame per stop, `period` seconds apart.

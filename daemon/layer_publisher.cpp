@@ -1,0 +1,114 @@
+#include "layer_publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <array>
+
+#include "cellmap/common/error.hpp"
+#include "versions.hpp"
+
+namespace cellmap::daemon {
+namespace {
+
+using transport::Layer;
+
+// OctoMap's leaf keys at depth 16: key 2^15 is the voxel whose lower corner lies at 0 on that axis.
+constexpr int kKeyOfZero = 1 << 15;
+
+std::vector<transport::VoxelRun> occupied_runs(const OccupancyMap& map) {
+  std::vector<std::array<int, 3>> indices;
+  const std::vector<octomap::OcTreeKey> keys = map.occupied_keys();  // sorted (z, y, x)
+  indices.reserve(keys.size());
+  for (const octomap::OcTreeKey& key : keys)
+    indices.push_back({key[0] - kKeyOfZero, key[1] - kKeyOfZero, key[2] - kKeyOfZero});
+  return transport::voxel_runs(indices);
+}
+
+const char* name(Layer layer) {
+  switch (layer) {
+    case Layer::kVoxels:
+      return "voxels";
+    case Layer::kChangeRegions:
+      return "change regions";
+    case Layer::kSensors:
+      return "sensors";
+  }
+  return "?";
+}
+
+}  // namespace
+
+LayerPublisher::LayerPublisher(const dds::Participant& participant, std::string cell)
+    : writer_(participant, std::move(cell)) {}
+
+void LayerPublisher::after_sweep(std::uint64_t number, const FrameSweep& sweep, const OccupancyMap& map,
+                                 const ChangeSet& changes) {
+  try {
+    if (read(Layer::kVoxels, voxels_read_)) publish_voxels(number, map);
+    if (read(Layer::kChangeRegions, regions_read_)) publish_regions(number, changes);
+    if (read(Layer::kSensors, sensors_read_)) publish_sensors(number, sweep);
+  } catch (const Error& e) {
+    spdlog::warn("layers: {}; retrying after the next sweep", e.what());
+  }
+}
+
+bool LayerPublisher::read(Layer layer, bool& was_read) {
+  const bool is_read = writer_.readers(layer) > 0;
+  if (is_read != was_read) {
+    if (is_read) {
+      spdlog::info("layer {}: {} reader(s), publishing after each sweep", name(layer),
+                   writer_.readers(layer));
+    } else {
+      spdlog::info("layer {}: no reader, not published", name(layer));
+    }
+    was_read = is_read;
+  }
+  return is_read;
+}
+
+void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kVoxels);
+  std::vector<transport::VoxelRun> runs = occupied_runs(map);
+  if (runs == voxels_written_ && joined == voxel_readers_served_) return;
+  transport::VoxelLayer layer{writer_.cell(), sweep, system_now_ns(), map.config().resolution,
+                              std::move(runs)};
+  writer_.write(layer);
+  if (joined != voxel_readers_served_) {
+    spdlog::info("layer voxels: {} voxels in {} runs, {} bytes", layer.voxel_count(), layer.runs.size(),
+                 transport::wire_size(layer));
+  }
+  voxels_written_ = std::move(layer.runs);
+  voxel_readers_served_ = joined;
+}
+
+void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& changes) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kChangeRegions);
+  if (changes.empty() && joined == region_readers_served_) return;
+  transport::ChangeRegionLayer layer{writer_.cell(), sweep, system_now_ns(), {}};
+  for (const ChangeRegion& region : changes.regions) {
+    layer.regions.push_back({region.bounds, static_cast<std::uint32_t>(region.appeared.size()),
+                             static_cast<std::uint32_t>(region.vanished.size())});
+  }
+  writer_.write(layer);
+  if (!changes.empty()) {
+    spdlog::info("layer change regions: {} regions, {} bytes", layer.regions.size(),
+                 transport::wire_size(layer));
+  }
+  region_readers_served_ = joined;
+}
+
+void LayerPublisher::publish_sensors(std::uint64_t number, const FrameSweep& sweep) {
+  const std::uint32_t joined = writer_.readers_joined(Layer::kSensors);
+  transport::SensorLayer layer{writer_.cell(), number, system_now_ns(), {}};
+  for (const SweepFrame& taken : sweep.frames) {
+    const Frame& frame = taken.frame;
+    layer.views.push_back({frame.sensor, frame.X_CS, field_of_view(frame)});
+  }
+  writer_.write(layer);
+  if (joined != sensor_readers_served_) {
+    spdlog::info("layer sensors: {} views, {} bytes", layer.views.size(), transport::wire_size(layer));
+  }
+  sensor_readers_served_ = joined;
+}
+
+}  // namespace cellmap::daemon

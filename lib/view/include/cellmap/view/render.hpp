@@ -1,0 +1,63 @@
+#pragma once
+// A still picture of a cell's boxes for reports and the README, without a browser: three panels (top, side
+// and perspective views) drawn with cairo into a PNG or an SVG.
+//
+// cairo draws in 2D only, so the 3D part is ours, and small: each box's faces that face the camera are
+// projected (orthographic for top and side, a pinhole for the perspective) and painted back to front by the
+// depth of their centres (the painter's algorithm). That order is exact for boxes that neither intersect
+// nor interleave; where boxes intersect (the daemon's boxes may overlap), a face can be painted over where it
+// should show: acceptable in a picture, never used for anything else.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cellmap/environment/environment.hpp"
+
+namespace cellmap::view {
+
+enum class View { kTop, kSide, kPerspective };
+
+/// A rectangle of the picture, pixels (x right, y down).
+struct Panel final {
+  double x = 0, y = 0, width = 0, height = 0;
+};
+
+/// A face of a box as drawn in a panel: its corners in pixels, its depth (larger = farther from the camera)
+/// and its brightness (0–1, Lambert shading from a light over the camera's shoulder).
+struct Face final {
+  std::uint64_t box_id = 0;
+  std::array<Eigen::Vector2d, 4> corners_px;
+  double depth = 0;
+  double shade = 0;
+};
+
+/// The faces of `boxes` that face the camera of `view`, projected into `panel` and sorted back to front.
+/// The scene (the boxes and the floor z = 0 under them) is fitted into the panel with a 6 % margin and a
+/// uniform scale, centred: top view x right, y up; side view x right, z up (seen from −y); perspective from
+/// the front left, above (−x, −y, +z of the scene's centre).
+[[nodiscard]] std::vector<Face> project(const std::vector<Box>& boxes, View view, const Panel& panel);
+
+/// The colour of a box on the page and in pictures (RGB, 0–1): a hue from the id, so a box keeps its colour
+/// from version to version.
+[[nodiscard]] std::array<double, 3> box_colour(std::uint64_t id);
+
+struct RenderOptions final {
+  int width = 1600;  ///< pixels (SVG: points)
+  int height = 1000;
+  std::string title;  ///< the heading; default: cell, version, box count
+};
+
+/// The panels of a picture of `options`' size: top view (upper left), side view (lower left), perspective
+/// (right, larger).
+[[nodiscard]] std::array<Panel, 3> layout(const RenderOptions& options);
+
+/// Draws `env` (three panels, axes, a heading) into `out`: a PNG if its name ends in .png, an SVG if .svg.
+/// @throws Error for another extension, a picture smaller than 200 × 150, or if cairo cannot write the file.
+void render(const Environment& env, const std::filesystem::path& out, const RenderOptions& options = {});
+
+}  // namespace cellmap::view

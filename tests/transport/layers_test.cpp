@@ -1,0 +1,115 @@
+// The optional layers: voxel runs against known answers, their bytes, and a writer that can tell whether
+// anyone reads (real participants on loopback, domain 222).
+#include "cellmap/transport/layers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "cellmap/common/error.hpp"
+#include "loopback.hpp"
+#include "support/test_support.hpp"
+
+namespace cellmap::transport {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr auto kPatience = 30s;
+constexpr std::uint32_t kDomain = 222;
+
+TEST(VoxelRunsTest, NeighboursAlongXJoinOneRun) {
+  // Sorted by (z, y, x): a row of three, a gap, one more on that row, then one on the next row and level.
+  const std::vector<VoxelRun> runs =
+      voxel_runs({{-2, 0, 0}, {-1, 0, 0}, {0, 0, 0}, {5, 0, 0}, {5, 1, 0}, {-7, -3, 4}});
+  const std::vector<VoxelRun> expected{{-2, 0, 0, 3}, {5, 0, 0, 1}, {5, 1, 0, 1}, {-7, -3, 4, 1}};
+  EXPECT_EQ(runs, expected);
+  EXPECT_EQ((VoxelLayer{"c", 1, 0, 0.02, runs}.voxel_count()), 6u);
+}
+
+TEST(VoxelRunsTest, RefusesUnsortedRepeatedOrOutOfRangeIndices) {
+  EXPECT_NE(test::error_of([] {
+              (void)voxel_runs({{1, 0, 0}, {0, 0, 0}});
+            }).find("not sorted"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] {
+              (void)voxel_runs({{1, 0, 0}, {1, 0, 0}});
+            }).find("repeated"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] { (void)voxel_runs({{40000, 0, 0}}); }).find("int16"), std::string::npos);
+}
+
+TEST(LayerWireSizeTest, EightBytesPerRunAndFiftySixPerRegion) {
+  VoxelLayer voxels{"cell-1", 3, 0, 0.02, std::vector<VoxelRun>(10, VoxelRun{1, 2, 3, 4})};
+  const std::size_t ten_runs = wire_size(voxels);
+  voxels.runs.resize(110);
+  EXPECT_EQ(wire_size(voxels) - ten_runs, 800u);
+  ChangeRegionLayer regions{"cell-1", 3, 0, std::vector<ChangeRegionBounds>(10)};
+  const std::size_t ten_regions = wire_size(regions);
+  regions.regions.resize(20);
+  EXPECT_EQ(wire_size(regions) - ten_regions, 560u);  // six doubles and two uint32 each
+}
+
+TEST(LayerWireSizeTest, TwentyFourBytesPerOutlineRay) {
+  SensorView view{"kinect", Eigen::Isometry3d::Identity(), FieldOfView{{}, true, 4.5}};
+  view.field_of_view->outline_S.assign(4, Eigen::Vector3d::UnitZ());
+  SensorLayer layer{"cell-1", 3, 0, {view}};
+  const std::size_t four_rays = wire_size(layer);
+  layer.views[0].field_of_view->outline_S.resize(14, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(wire_size(layer) - four_rays, 240u);  // x, y, z as doubles
+}
+
+class LayerDdsTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { test::use_loopback(); }
+};
+
+TEST_F(LayerDdsTest, WriterSeesReadersComeAndGoAndReadersGetWhatWasWritten) {
+  dds::Participant daemon(kDomain);
+  dds::Participant viewer(kDomain);
+  LayerWriter writer(daemon, "cell-1");
+  EXPECT_EQ(writer.readers(Layer::kVoxels), 0u);
+  EXPECT_EQ(writer.readers_joined(Layer::kVoxels), 0u);
+  {
+    LayerReader reader(viewer, Layer::kVoxels);
+    const auto deadline = std::chrono::steady_clock::now() + kPatience;
+    while (writer.readers(Layer::kVoxels) == 0 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(5ms);
+    ASSERT_EQ(writer.readers(Layer::kVoxels), 1u);
+    EXPECT_EQ(writer.readers_joined(Layer::kVoxels), 1u);
+    EXPECT_EQ(writer.readers(Layer::kChangeRegions), 0u);  // each layer is asked for on its own
+
+    const VoxelLayer sent{"cell-1", 9, 1234, 0.02, {{-5, 7, 0, 12}, {3, 3, 3, 1}}};
+    writer.write(sent);
+    std::vector<LayerMessage> received;
+    while (received.empty() && std::chrono::steady_clock::now() < deadline) received = reader.take(100ms);
+    ASSERT_EQ(received.size(), 1u);
+    const auto& got = std::get<VoxelLayer>(received[0]);
+    EXPECT_EQ(got.cell, "cell-1");
+    EXPECT_EQ(got.sweep, 9u);
+    EXPECT_EQ(got.stamp_ns, 1234);
+    EXPECT_EQ(got.resolution, 0.02);
+    EXPECT_EQ(got.runs, sent.runs);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (writer.readers(Layer::kVoxels) > 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(5ms);
+  EXPECT_EQ(writer.readers(Layer::kVoxels), 0u);  // the reader left: the daemon stops writing
+  EXPECT_EQ(writer.readers_joined(Layer::kVoxels), 1u);
+}
+
+TEST_F(LayerDdsTest, WriterRefusesAnotherCellsLayer) {
+  dds::Participant daemon(kDomain);
+  LayerWriter writer(daemon, "cell-1");
+  EXPECT_NE(test::error_of([&] {
+              writer.write(VoxelLayer{"cell-2", 1, 0, 0.02, {}});
+            }).find("cell-2"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([&] {
+              writer.write(VoxelLayer{"cell-1", 1, 0, 0.0, {}});
+            }).find("resolution"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace cellmap::transport

@@ -1,0 +1,177 @@
+// Still pictures: the projection against hand-computed answers, and the PNG and SVG cairo writes from it.
+#include "cellmap/view/render.hpp"
+
+#include <cairo.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "cellmap/common/atomic_file.hpp"
+#include "support/test_support.hpp"
+#include "transport/child_process.hpp"
+
+namespace cellmap::view {
+namespace {
+
+Box aabb(std::uint64_t id, Eigen::Vector3d center, Eigen::Vector3d half_extents) {
+  Box box;
+  box.id = id;
+  box.center = center;
+  box.half_extents = half_extents;
+  box.points = 100;
+  return box;
+}
+
+// One box at (1, 2, 0.5) with half extents (0.5, 0.25, 0.5): its footprint is 1 m × 0.5 m.
+const Box kTableBox = aabb(7, {1, 2, 0.5}, {0.5, 0.25, 0.5});
+
+// The corners of a face, in any order and rotation, match `expected` to within `tolerance` pixels.
+bool same_quad(const std::array<Eigen::Vector2d, 4>& corners, const std::vector<Eigen::Vector2d>& expected,
+               double tolerance) {
+  for (const Eigen::Vector2d& e : expected) {
+    bool found = false;
+    for (const Eigen::Vector2d& c : corners) found = found || (c - e).norm() <= tolerance;
+    if (!found) return false;
+  }
+  return true;
+}
+
+TEST(RenderTest, TopViewFitsTheSceneIntoThePanelAndShowsOnlyTopFaces) {
+  // Panel 400 × 300; the scene spans 1 × 0.5 m in x, y → scale = min(400 · 0.88 / 1, 300 · 0.88 / 0.5) = 352
+  // px/m, centred at (200, 150): x 0.5..1.5 → 24..376 px, y 1.75..2.25 → 238..62 px (y points up).
+  const std::vector<Face> faces = project({kTableBox}, View::kTop, Panel{0, 0, 400, 300});
+  ASSERT_EQ(faces.size(), 1u);
+  EXPECT_EQ(faces[0].box_id, 7u);
+  EXPECT_TRUE(same_quad(faces[0].corners_px, {{24, 62}, {376, 62}, {376, 238}, {24, 238}}, 1e-9));
+}
+
+TEST(RenderTest, SideViewSeesTheFrontFaceWithZUp) {
+  // From −y: u = x (1 m), v = z (0..1 m, the floor is in the scene) → scale = min(352, 264) = 264, centre
+  // (200, 150): x → 68..332, z 0..1 → 282..18.
+  const std::vector<Face> faces = project({kTableBox}, View::kSide, Panel{0, 0, 400, 300});
+  ASSERT_EQ(faces.size(), 1u);
+  EXPECT_TRUE(same_quad(faces[0].corners_px, {{68, 18}, {332, 18}, {332, 282}, {68, 282}}, 1e-9));
+}
+
+TEST(RenderTest, PerspectiveShowsThreeFacesOfAnAxisAlignedBoxAndPaintsTheNearBoxLast) {
+  const Box near = aabb(1, {0, 0, 0.5}, {0.2, 0.2, 0.5});
+  const Box far = aabb(2, {2, 2, 0.5}, {0.2, 0.2, 0.5});
+  const std::vector<Face> faces = project({near, far}, View::kPerspective, Panel{0, 0, 800, 600});
+  ASSERT_EQ(faces.size(), 6u);  // −x, −y and +z of each: the camera is at the front left, above
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(faces[i].box_id, 2u) << i;
+  for (std::size_t i = 3; i < 6; ++i) EXPECT_EQ(faces[i].box_id, 1u) << i;
+  for (std::size_t i = 1; i < faces.size(); ++i) EXPECT_LE(faces[i].depth, faces[i - 1].depth);
+}
+
+TEST(RenderTest, TopViewPaintsTheHigherBoxOverTheLowerOne) {
+  const Box low = aabb(1, {0, 0, 0.1}, {1.0, 1.0, 0.1});
+  const Box high = aabb(2, {0, 0, 0.3}, {0.2, 0.2, 0.1});
+  const std::vector<Face> faces = project({high, low}, View::kTop, Panel{0, 0, 400, 400});
+  ASSERT_EQ(faces.size(), 2u);
+  EXPECT_EQ(faces.front().box_id, 1u);
+  EXPECT_EQ(faces.back().box_id, 2u);
+}
+
+TEST(RenderTest, ColoursDependOnTheIdOnly) {
+  EXPECT_EQ(box_colour(45), box_colour(45));
+  EXPECT_NE(box_colour(45), box_colour(46));
+  for (double c : box_colour(12345)) {
+    EXPECT_GE(c, 0.0);
+    EXPECT_LE(c, 1.0);
+  }
+}
+
+std::array<std::uint8_t, 3> pixel(cairo_surface_t* image, int x, int y) {
+  const unsigned char* row = cairo_image_surface_get_data(image) + y * cairo_image_surface_get_stride(image);
+  const std::uint32_t argb = reinterpret_cast<const std::uint32_t*>(row)[x];
+  return {static_cast<std::uint8_t>(argb >> 16), static_cast<std::uint8_t>(argb >> 8),
+          static_cast<std::uint8_t>(argb)};
+}
+
+TEST(RenderTest, PngShowsTheBoxWhereItsTopFaceProjects) {
+  test::TempDir dir;
+  const Box low = aabb(3, {2.5, 1.0, 0.2}, {0.3, 0.3, 0.2});
+  const Environment env("cell-1", 4, 0, {kTableBox, low});
+  const RenderOptions options;
+  render(env, dir.path() / "cell.png", options);
+  cairo_surface_t* image = cairo_image_surface_create_from_png((dir.path() / "cell.png").c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  EXPECT_EQ(cairo_image_surface_get_width(image), options.width);
+  EXPECT_EQ(cairo_image_surface_get_height(image), options.height);
+  const Panel top = layout(options)[0];
+  const std::vector<Face> faces = project(env.boxes(), View::kTop, top);
+  for (const Face& face : faces) {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& c : face.corners_px) centre += c / 4;
+    const auto rgb = pixel(image, static_cast<int>(centre.x()), static_cast<int>(centre.y()));
+    const std::array<double, 3> colour = box_colour(face.box_id);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(rgb[i], 255 * colour[i] * face.shade, 2.0) << "box " << face.box_id << " channel " << i;
+  }
+  // The panel's corner, away from boxes and grid, is the white background.
+  const auto background =
+      pixel(image, static_cast<int>(top.x + 3), static_cast<int>(top.y + top.height - 30));
+  EXPECT_EQ(background, (std::array<std::uint8_t, 3>{255, 255, 255}));
+  cairo_surface_destroy(image);
+}
+
+// Every path of the SVG as its list of points ("M x y L x y ... Z").
+std::vector<std::vector<Eigen::Vector2d>> svg_paths(const std::string& svg) {
+  std::vector<std::vector<Eigen::Vector2d>> paths;
+  const std::regex path_re(R"re(<path [^>]*d="([^"]*)")re");
+  const std::regex point_re(R"re([ML] (-?[0-9.]+) (-?[0-9.]+))re");
+  for (std::sregex_iterator p(svg.begin(), svg.end(), path_re), end; p != end; ++p) {
+    const std::string d = (*p)[1];
+    std::vector<Eigen::Vector2d> points;
+    for (std::sregex_iterator q(d.begin(), d.end(), point_re); q != end; ++q)
+      points.emplace_back(std::stod((*q)[1]), std::stod((*q)[2]));
+    paths.push_back(points);
+  }
+  return paths;
+}
+
+TEST(RenderTest, SvgHoldsTheTopFaceAsAPolygon) {
+  test::TempDir dir;
+  render(Environment("cell-1", 1, 0, {kTableBox}), dir.path() / "cell.svg");
+  // Default 1600 × 1000: the top panel is x 12..637.6, y 56..516 (layout()); the box's 1 × 0.5 m footprint
+  // fills it at min(625.6 · 0.88 / 1, 460 · 0.88 / 0.5) = 550.528 px/m around (324.8, 286):
+  // x 49.536..600.064, y 148.368..423.632.
+  const std::vector<Eigen::Vector2d> expected{
+      {49.536, 148.368}, {600.064, 148.368}, {600.064, 423.632}, {49.536, 423.632}};
+  int matches = 0;
+  for (const std::vector<Eigen::Vector2d>& path : svg_paths(read_file(dir.path() / "cell.svg"))) {
+    if (path.size() < 4) continue;
+    const std::array<Eigen::Vector2d, 4> quad{path[0], path[1], path[2], path[3]};
+    if (same_quad(quad, expected, 0.01)) ++matches;
+  }
+  EXPECT_GE(matches, 1);  // the fill (and its outline)
+}
+
+TEST(RenderTest, RefusesOtherFormats) {
+  test::TempDir dir;
+  EXPECT_NE(test::error_of([&] {
+              render(Environment("c", 1, 0, {}), dir.path() / "cell.jpg");
+            }).find("must be a .png or an .svg"),
+            std::string::npos);
+}
+
+TEST(RenderTest, CommandDrawsABoxesFile) {
+  test::TempDir dir;
+  const std::filesystem::path boxes = dir.path() / "boxes.json";
+  write_box_file(boxes, BoxSet{5, "cell", {kTableBox}});
+  const std::filesystem::path png = dir.path() / "out.png";
+  test::ChildProcess tool({CELLMAP_TOOL, "render", boxes.string(), "-o", png.string()});
+  const std::string line = tool.read_line(std::chrono::seconds(60)).value_or("");
+  EXPECT_EQ(tool.wait(), 0);
+  EXPECT_EQ(line, "wrote " + png.string() + ": cell boxes, version 5, 1 boxes");
+  EXPECT_EQ(read_file(png).substr(1, 3), "PNG");
+
+  test::ChildProcess bad({CELLMAP_TOOL, "render", boxes.string(), "-o", (dir.path() / "out.gif").string()});
+  const int status = bad.wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status;
+}
+
+}  // namespace
+}  // namespace cellmap::view

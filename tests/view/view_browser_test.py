@@ -1,0 +1,378 @@
+#!/usr/bin/env python3
+"""`cellmap view` in a real browser: cellmapd on the simulated cell (exact depths), `cellmap view`, `cellmap
+inject` and `cellmap render` as processes, and Debian's chromium (headless) driven by python3-selenium.
+
+Domain 220. CELLMAP_BROWSER_ROUNDS=N repeats the inject/remove/restart
+round N times (default 1, the CI run). The last screenshot is written to view_browser.png in the working
+directory (the build's tests folder under ctest).
+"""
+import argparse
+import io
+import os
+import queue
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+from PIL import Image
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+
+# Cyclone DDS on loopback only, as tests/transport/loopback.hpp (1 s lease: a killed daemon is noticed soon).
+LOOPBACK = ('<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
+            '</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>'
+            '<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>'
+            '<Peers><Peer address="127.0.0.1"/></Peers><LeaseDuration>1 s</LeaseDuration></Discovery>'
+            '</Domain></CycloneDDS>')
+PATIENCE = 90  # seconds; passing runs take a few, the machine is shared
+LIVE_DOMAIN = 220
+BACKGROUND = (0xfb, 0xfc, 0xfd)  # the scene's background colour in view.js
+TABLE_POINT = (1.0, 1.25, 0.75)  # on the default cell's table top, clear of every object (config/cell.yaml)
+NEW_BOX = ['add-box', '--center', '2.12,0.45,0.9', '--half-extents', '0.1,0.1,0.15']  # the README's example
+NEW_BOX_TOP = (2.12, 0.45, 1.05)
+
+ARGS = None
+
+
+class Process:
+    """A child process whose stdout lines are collected by a thread; stderr goes to a log file."""
+
+    def __init__(self, argv, log_path):
+        self.log_path = log_path
+        self.log = open(log_path, 'ab')
+        self.popen = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, env=os.environ)
+        self.lines = queue.Queue()
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
+
+    def _read(self):
+        for line in self.popen.stdout:
+            self.lines.put(line.decode(errors='replace').rstrip('\n'))
+
+    def line(self, timeout=PATIENCE):
+        return self.lines.get(timeout=timeout)
+
+    def stop(self, sig=signal.SIGTERM):
+        if self.popen.poll() is None:
+            self.popen.send_signal(sig)
+        code = self.popen.wait(timeout=PATIENCE)
+        self.reader.join(timeout=PATIENCE)
+        self.popen.stdout.close()
+        self.log.close()
+        return code
+
+    def log_text(self):
+        with open(self.log_path, 'rb') as f:
+            return f.read().decode(errors='replace')
+
+
+def wait_for(predicate, what, timeout=PATIENCE):
+    """Polls `predicate` (an observable state of a process or the page) until it is truthy."""
+    deadline = time.monotonic() + timeout
+    last = None
+    while time.monotonic() < deadline:
+        try:
+            last = predicate()
+            if last:
+                return last
+        except Exception as e:  # the page may be between two states (an element being replaced)
+            last = repr(e)
+        time.sleep(0.1)
+    raise AssertionError(f'timed out after {timeout} s waiting for {what} (last: {last})')
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+def run_tool(*args):
+    out = subprocess.run([ARGS.cellmap, *args], capture_output=True, text=True, timeout=PATIENCE)
+    if out.returncode != 0:
+        raise AssertionError(f'cellmap {" ".join(args)} failed: {out.stderr.strip()}')
+    return out.stdout.strip()
+
+
+def start_browser(profile):
+    options = webdriver.ChromeOptions()
+    options.binary_location = '/usr/bin/chromium'
+    for flag in ['--headless=new', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
+                 '--disable-component-update', '--disable-sync', '--no-first-run', '--window-size=1280,800',
+                 f'--user-data-dir={profile}']:
+        options.add_argument(flag)
+    return webdriver.Chrome(service=Service('/usr/bin/chromedriver'), options=options)
+
+
+class ViewTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        os.environ['CYCLONEDDS_URI'] = LOOPBACK
+        cls.dir = tempfile.mkdtemp(prefix='cellmap-view-test-')
+        cls.browser = start_browser(os.path.join(cls.dir, 'chromium'))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.browser.quit()
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def setUp(self):
+        self.processes = []
+        self.started = time.monotonic()
+
+    def log(self, text):
+        print(f'[{time.monotonic() - self.started:6.1f} s] {text}', flush=True)
+
+    def tearDown(self):
+        for p in self.processes:
+            if not p.log.closed:
+                p.stop(signal.SIGKILL)
+
+    # ---- processes ----
+    def start_daemon(self):
+        config = os.path.join(self.dir, 'cellmapd.yaml')
+        with open(config, 'w') as f:
+            # Exact depths fill the map in two sweeps: a short settling is enough.
+            f.write('cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n'
+                    'change: {settle_sweeps: 4}\n')
+        daemon = Process([ARGS.cellmapd, '--config', config, '--domain', str(LIVE_DOMAIN), '--state-dir',
+                          os.path.join(self.dir, 'state')], os.path.join(self.dir, 'cellmapd.log'))
+        self.processes.append(daemon)
+        return daemon
+
+    def start_view(self, domain, port):
+        view = Process([ARGS.cellmap, 'view', '--domain', str(domain), '--port', str(port)],
+                       os.path.join(self.dir, f'view-{domain}.log'))
+        self.processes.append(view)
+        line = view.line()
+        self.assertRegex(line, rf'^cellmap view: http://127\.0\.0\.1:{port}/ \(DDS domain {domain}, every cell; '
+                               r'read-only\)$')
+        return view
+
+    # ---- what the page shows ----
+    def js(self, expression):
+        return self.browser.execute_script(f'return {expression};')
+
+    def box_count(self):
+        return int(self.browser.find_element(By.ID, 'box-count').text)
+
+    def listed_ids(self):
+        return self.js('[...document.querySelectorAll("#boxes tbody tr")].map((row) => Number(row.dataset.id))')
+
+    def notice(self):
+        element = self.browser.find_element(By.ID, 'notice')
+        return element.text if element.is_displayed() else ''
+
+    def daemon_state(self):
+        elements = self.browser.find_elements(By.ID, 'daemon-state')
+        return elements[0].text if elements else ''
+
+    def daemon_snapshot(self):
+        """(version, boxes) of the daemon's current snapshot, read by `cellmap render --domain`."""
+        out = run_tool('render', '--domain', str(LIVE_DOMAIN), '--timeout', '60', '-o',
+                       os.path.join(self.dir, 'render.png'))
+        match = re.match(r'^wrote .*: cell cell-view, version (\d+), (\d+) boxes$', out)
+        self.assertIsNotNone(match, out)
+        return int(match.group(1)), int(match.group(2))
+
+    def wait_for_daemon_snapshot(self, what):
+        """The page comes to show the daemon's version and box count (exact depths: no version comes by
+        itself meanwhile), in the header, the list and the scene."""
+        version, boxes = self.daemon_snapshot()
+        wait_for(lambda: self.js('cellmapView.version()') == version and self.box_count() == boxes ==
+                 len(self.listed_ids()) == len(self.js('cellmapView.boxIds()')), what)
+
+    def check_screenshot(self):
+        png = self.browser.get_screenshot_as_png()
+        with open('view_browser.png', 'wb') as f:
+            f.write(png)
+        image = Image.open(io.BytesIO(png)).convert('RGB')
+        ratio = self.js('window.devicePixelRatio')
+        x, y = self.js('cellmapView.project(%f, %f, %f)' % TABLE_POINT)
+        pixel = image.getpixel((int(x * ratio), int(y * ratio)))
+        difference = sum(abs(a - b) for a, b in zip(pixel, BACKGROUND))
+        self.assertGreater(difference, 30, f'the table at ({x:.0f}, {y:.0f}) is drawn as {pixel}: background')
+
+    # ---- the tests ----
+    def test_live_view_follows_the_daemon(self):
+        port = free_port()
+        view = self.start_view(LIVE_DOMAIN, port)
+        # Boxes glow for 4 s by default; long enough here that a loaded machine cannot miss it.
+        self.browser.get(f'http://127.0.0.1:{port}/?highlight=60')
+        self.browser.execute_script('window.notReloaded = true;')
+        wait_for(lambda: self.js('cellmapView.connected()'), 'the page to connect')
+        self.assertIn(f'No cellmapd on DDS domain {LIVE_DOMAIN}', wait_for(self.notice, 'the page to say so'))
+        self.assertEqual(self.box_count(), 0)
+        self.log('the page says there is no daemon')
+
+        daemon = self.start_daemon()
+        wait_for(lambda: self.js('cellmapView.version()') >= 1, 'the first version on the page')
+        self.log('the first version is on the page')
+        self.wait_for_daemon_snapshot('the page to show the daemon\'s boxes')
+        self.log(f'the page shows version {self.js("cellmapView.version()")}, {self.box_count()} boxes')
+        self.assertEqual(self.notice(), '')
+        self.assertEqual(wait_for(self.daemon_state, 'the daemon state'), 'running')
+        self.check_screenshot()
+        rounds = int(os.environ.get('CELLMAP_BROWSER_ROUNDS', '1'))
+        for round_number in range(rounds):
+            daemon, view = self.round(daemon, view, port, round_number)
+        self.check_layers(daemon)
+        self.check_sensors(daemon)
+        self.assertTrue(self.js('window.notReloaded === true'), 'the page was reloaded')
+
+    def round(self, daemon, view, port, round_number):
+        before = self.listed_ids()
+        # Watched while the tool still runs: the box glows for a few seconds only.
+        inject = Process([ARGS.cellmap, 'inject', '--domain', str(LIVE_DOMAIN), '--wait', '60', *NEW_BOX],
+                         os.path.join(self.dir, 'inject.log'))
+        # Count, list and the rows marked as changed in one look (the glow lasts a few seconds).
+        shown = wait_for(lambda: self.js(
+            '(() => { const n = Number(document.getElementById("box-count").textContent);'
+            f' if (n !== {len(before) + 1}) return null;'
+            ' const rows = [...document.querySelectorAll("#boxes tbody tr")];'
+            ' return { listed: rows.map((r) => Number(r.dataset.id)),'
+            '          changed: rows.filter((r) => r.classList.contains("changed")).map((r) => Number(r.dataset.id)) };'
+            ' })()'), 'the new box on the page')
+        added = sorted(set(shown['listed']) - set(before))
+        self.assertEqual(len(added), 1, f'listed {shown["listed"]}, before {before}')
+        new_id = added[0]
+        self.assertIn(new_id, shown['changed'])
+        wait_for(lambda: new_id in self.js('cellmapView.highlighted()'), 'the new box to glow in the scene')
+        self.report_latency()
+        self.check_click(new_id)
+        self.check_screenshot()
+        name = inject.line()
+        self.assertEqual(inject.stop(), 0)
+
+        run_tool('inject', '--domain', str(LIVE_DOMAIN), '--wait', '60', 'remove', '--name', name)
+        wait_for(lambda: self.box_count() == len(before), 'the box to go')
+        self.log(f'box {new_id} removed')
+        self.assertNotIn(new_id, self.listed_ids())
+        self.assertNotIn(new_id, self.js('cellmapView.boxIds()'))
+
+        # The daemon restarts: the page says it is gone, then recovers by itself.
+        version = self.js('cellmapView.version()')
+        self.assertEqual(daemon.stop(), 0)
+        wait_for(lambda: 'is gone' in self.browser.find_element(By.ID, 'banner').text, 'the page to say so')
+        self.assertEqual(self.box_count(), len(before))  # the last version stays shown
+        daemon = self.start_daemon()
+        wait_for(lambda: self.daemon_state() == 'running', 'the restarted daemon on the page')
+        self.wait_for_daemon_snapshot('the page to show the restarted daemon\'s boxes')
+        self.assertGreaterEqual(self.js('cellmapView.version()'), version)
+        self.log('the page recovered from the daemon restart')
+
+        # The viewer restarts: the page reconnects by itself.
+        self.assertEqual(view.stop(), 0)
+        wait_for(lambda: not self.js('cellmapView.connected()'), 'the page to notice')
+        view = self.start_view(LIVE_DOMAIN, port)
+        wait_for(lambda: self.js('cellmapView.connected()'), 'the page to reconnect')
+        wait_for(lambda: self.box_count() == len(before) == len(self.js('cellmapView.boxIds()')),
+                 'the page to show the boxes again')
+        self.log(f'round {round_number + 1}: box {new_id} added and removed, daemon and viewer restarted')
+        return daemon, view
+
+    def check_click(self, box_id):
+        """A click on the new box's top shows its details."""
+        canvas = self.browser.find_element(By.ID, 'canvas')
+        left, top, width, height = self.js('(() => { const r = document.getElementById("canvas")'
+                                           '.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()')
+        x, y = self.js('cellmapView.project(%s, %s, %s)' % NEW_BOX_TOP)
+        ActionChains(self.browser).move_to_element_with_offset(
+            canvas, int(x - left - width / 2), int(y - top - height / 2)).click().perform()
+        text = wait_for(lambda: self.browser.find_element(By.ID, 'selection').text, 'the box details')
+        self.assertIn(f'box {box_id}\n', text)
+        self.assertIn(f'changed in version {self.js("cellmapView.version()")}', text)
+        size = re.search(r'size ([\d.]+) × ([\d.]+) × ([\d.]+) m', text)
+        self.assertIsNotNone(size, text)
+        for edge in size.groups():  # the injected box is 0.2 × 0.2 × 0.3 m; boxes grow by up to a voxel
+            self.assertTrue(0.15 < float(edge) < 0.4, text)
+
+    def report_latency(self):
+        last = self.js('cellmapView.latency[cellmapView.latency.length - 1]')
+        stamp_to_message = last['message_ms'] - last['stamp_ns'] / 1e6
+        message_to_frame = last['frame_ms'] - last['message_ms']
+        self.log(f'version {last["version"]}: daemon stamp -> page message {stamp_to_message:.1f} ms, '
+                 f'message -> drawn frame {message_to_frame:.1f} ms')
+        self.assertLess(message_to_frame, 1000)
+
+    def check_layers(self, daemon):
+        """Ticking a layer makes the daemon publish it; unticking stops it."""
+        self.browser.find_element(By.ID, 'layer-voxels').click()
+        wait_for(lambda: 'layer voxels: 1 reader(s)' in daemon.log_text(), 'the daemon to publish voxels')
+        runs = wait_for(lambda: self.js('(() => { const m = window.cellmapView; return m && '
+                                        'document.getElementById("layer-voxels").checked && '
+                                        'm.voxelRuns(); })()'), 'voxels on the page')
+        self.assertGreater(runs, 100)
+        self.check_screenshot()
+        self.browser.find_element(By.ID, 'layer-voxels').click()
+        wait_for(lambda: 'layer voxels: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+
+
+    def check_sensors(self, daemon):
+        """Ticking "sensors" makes the daemon publish its frames' poses and fields of view, and the page draws
+        each frustum: along the lines from each sensor, pixels turn the frustum colour."""
+        before = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+        self.browser.find_element(By.ID, 'layer-sensors').click()
+        logged = wait_for(lambda: re.search(r'layer sensors: (\d+) views, (\d+) bytes', daemon.log_text()),
+                          'the daemon to publish the sensor views')
+        views, size = int(logged.group(1)), int(logged.group(2))
+        self.log(f'sensor layer: {views} views, {size} bytes per sweep')
+        self.assertGreater(views, 0)
+        segments = wait_for(lambda: (lambda s: s if len(s) == views else None)(self.js('cellmapView.sensorSegments()')),
+                            'the sensor views on the page')
+        ratio = self.js('window.devicePixelRatio')
+        samples = []
+        for segment in segments:
+            self.assertIsNotNone(segment, 'a simulated camera knows its field of view')
+            origin, end = segment
+            # The upper part of each line: above every object of the default cell, so nothing hides it.
+            for t in [0.05 + 0.3 * i / 9 for i in range(10)]:
+                point = [o + t * (e - o) for o, e in zip(origin, end)]
+                x, y = self.js('cellmapView.project(%f, %f, %f)' % tuple(point))
+                samples.append((int(x * ratio), int(y * ratio)))
+
+        def drawn_fraction():
+            after = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+            hits = sum(1 for x, y in samples if frustum_pixel_near(before, after, x, y))
+            return hits / len(samples)
+        fraction = wait_for(lambda: (lambda f: f if f >= 0.8 else None)(drawn_fraction()),
+                            'the frustum lines drawn')
+        self.log(f'{fraction:.0%} of {len(samples)} points along the frustum lines drawn in its colour')
+        self.browser.find_element(By.ID, 'layer-sensors').click()
+        wait_for(lambda: 'layer sensors: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+
+
+def frustum_pixel_near(before, after, x, y, radius=2):
+    """Whether a pixel within `radius` of (x, y) turned the frustum colour (teal, 0x008c8c, antialiased over
+    the light background: green and blue well above red)."""
+    for dx in range(-radius, radius + 1):
+        for dy in range(-radius, radius + 1):
+            p = (x + dx, y + dy)
+            if not (0 <= p[0] < after.width and 0 <= p[1] < after.height):
+                continue
+            r, g, b = after.getpixel(p)
+            if g - r > 40 and b - r > 40 and abs(g - b) < 50 and after.getpixel(p) != before.getpixel(p):
+                return True
+    return False
+
+
+def main():
+    global ARGS
+    parser = argparse.ArgumentParser()
+    parser.add_argument('--cellmap', required=True)
+    parser.add_argument('--cellmapd', required=True)
+    ARGS, rest = parser.parse_known_args()
+    unittest.main(argv=[sys.argv[0], '-v', *rest])
+
+
+if __name__ == '__main__':
+    main()
