@@ -47,9 +47,10 @@ SweepFrame frame_of(const Scene& scene, double no_return_range) {
   return f;
 }
 
+// Four frames: the no-return rays of four frames use every pixel once.
 FrameSweep sweep_of(const Scene& scene, double no_return_range = 0.0) {
   FrameSweep sweep;
-  sweep.frames.push_back(frame_of(scene, no_return_range));
+  for (int i = 0; i < 4; ++i) sweep.frames.push_back(frame_of(scene, no_return_range));
   return sweep;
 }
 
@@ -82,7 +83,7 @@ std::size_t boxes_holding(const CellPipeline& pipeline, const Eigen::Vector3d& p
 
 // The panel alone (nothing behind it within range): boxed; then gone, every pixel without a return.
 // Returns the sweep after which the panel's box went (nullopt: still there after 30 sweeps).
-std::optional<int> panel_removed_after(double no_return_range, std::size_t& rays_per_frame) {
+std::optional<int> panel_removed_after(double no_return_range, std::size_t& rays_per_sweep) {
   CellPipeline pipeline(config());
   const Scene panel = [](int u, int v) { return panel_centre(u, v) ? 2.0 : 0.0; };
   for (int i = 0; i < 6; ++i) (void)pipeline.process(sweep_of(panel, no_return_range));
@@ -90,7 +91,7 @@ std::optional<int> panel_removed_after(double no_return_range, std::size_t& rays
   const Scene nothing = [](int, int) { return 0.0; };
   for (int i = 1; i <= 30; ++i) {
     const SweepReport report = pipeline.process(sweep_of(nothing, no_return_range));
-    rays_per_frame = report.no_return_rays;
+    rays_per_sweep = report.no_return_rays;
     if (boxes_holding(pipeline, kPanelCentre) == 0) return i;
   }
   return std::nullopt;
@@ -105,7 +106,7 @@ TEST(CellPipelineFramesTest, PixelsWithoutAReturnClearTheirLineOfSightOnlyWhenTh
   ASSERT_TRUE(removed.has_value()) << "the panel's box stayed with no_return_range 4";
   // Six sweeps of hits put it at the upper clamp; cleared like any removal seen through.
   EXPECT_EQ(*removed, config().occupancy.sweeps_to_clear() + config().change.persist_sweeps - 1);
-  EXPECT_EQ(rays, static_cast<std::size_t>(kWidth * kHeight));
+  EXPECT_EQ(rays, static_cast<std::size_t>(kWidth * kHeight));  // a quarter of the pixels in each frame
 }
 
 TEST(CellPipelineFramesTest, NoReturnRaysEndAtTheirRangeAndFramesWithoutAnImageAddNone) {
@@ -116,7 +117,7 @@ TEST(CellPipelineFramesTest, NoReturnRaysEndAtTheirRangeAndFramesWithoutAnImageA
   EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(0.01, 0.01, 0.95)), VoxelState::free);
   EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(0.01, 0.01, 1.05)), VoxelState::unknown);
   FrameSweep scanner = sweep_of(nothing, 1.0);
-  scanner.frames[0].frame.depth.reset();
+  for (SweepFrame& f : scanner.frames) f.frame.depth.reset();
   EXPECT_EQ(pipeline.process(scanner).no_return_rays, 0u);
 }
 
