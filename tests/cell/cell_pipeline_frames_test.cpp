@@ -37,7 +37,8 @@ SweepFrame frame_of(const Scene& scene, double no_return_range) {
   image.depth.assign(static_cast<std::size_t>(kWidth * kHeight), 0);
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u)
-      image.depth[static_cast<std::size_t>(v * kWidth + u)] = static_cast<std::uint16_t>(scene(u, v) * 1000.0);
+      image.depth[static_cast<std::size_t>(v * kWidth + u)] =
+          static_cast<std::uint16_t>(scene(u, v) * 1000.0);
   }
   SweepFrame f;
   f.frame.sensor = "camera";

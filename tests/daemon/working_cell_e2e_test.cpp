@@ -57,9 +57,10 @@ class WorkingCellE2eTest : public ::testing::Test {
     test::use_loopback();
     const std::filesystem::path config = dir_.path() / "cellmapd.yaml";
     // The box kind and the change gathering of config/arm-cell.yaml.
-    std::ofstream(config) << "cell: arm\nsweep_period: 0\nstatus_period: 0.5\nsegment: {boxes: {kind: aabb}}\n"
-                          << "change: {gather_sweeps: 2}\n"
-                          << yaml;
+    std::ofstream(config)
+        << "cell: arm\nsweep_period: 0\nstatus_period: 0.5\nsegment: {boxes: {kind: aabb}}\n"
+        << "change: {gather_sweeps: 2}\n"
+        << yaml;
     const dds::Participant participant(static_cast<std::uint32_t>(domain));
     VersionLog log;
     transport::EnvironmentSubscriber planner(participant, "arm", std::ref(log));
@@ -102,8 +103,7 @@ std::vector<std::uint64_t> boxes_on_the_robot(const Environment& env, const sim:
 TEST_F(WorkingCellE2eTest, ArmInViewOfTheFixedCameraMakesOneVersionAndNoBoxOnTheRobot) {
   const std::uint64_t sweeps = long_tests() ? 500 : 25;
   const sim::Scene scene = sim::load_scene(kArmScene);
-  const std::vector<Environment> versions =
-      run_daemon("sources: [" + kPost + "]\n", kFilteredDomain, sweeps);
+  const std::vector<Environment> versions = run_daemon("sources: [" + kPost + "]\n", kFilteredDomain, sweeps);
   ASSERT_FALSE(versions.empty()) << "no version in " << sweeps << " sweeps";
   EXPECT_EQ(versions.back().version(), 1u) << "the moving arm made versions";
   EXPECT_GT(versions.front().boxes().size(), 5u);

@@ -102,7 +102,8 @@ SweepReport CellPipeline::process(const FrameSweep& frames) {
       sweep.scans.push_back(std::move(filtered.scan));
     }
     if (f.no_return_range > 0.0)
-      no_return_rays += add_no_return_rays(f.frame, f.no_return_range, no_return_phase_++, sweep.scans.back());
+      no_return_rays +=
+          add_no_return_rays(f.frame, f.no_return_range, no_return_phase_++, sweep.scans.back());
   }
   const double t_filter = seconds_since(start);
   SweepReport report = process(sweep);

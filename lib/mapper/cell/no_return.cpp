@@ -15,7 +15,8 @@ std::size_t add_no_return_rays(const Frame& frame, double range, unsigned phase,
   for (std::size_t v = (phase / 2) % 2; v < height; v += 2) {
     for (std::size_t u = phase % 2; u < width; u += 2) {
       if (image.depth[v * width + u] != 0) continue;
-      const Eigen::Vector3f sight_S(float((double(u) - in.cx) / in.fx), float((double(v) - in.cy) / in.fy), 1.0f);
+      const Eigen::Vector3f sight_S(float((double(u) - in.cx) / in.fx), float((double(v) - in.cy) / in.fy),
+                                    1.0f);
       const Eigen::Vector3f end_C = X_CS * (sight_S.normalized() * float(range));
       scan.clear_C.push_back(pcl::PointXYZ(end_C.x(), end_C.y(), end_C.z()));
     }
