@@ -129,9 +129,8 @@ TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxes
 }
 
 // The share of the surface of every obstacle of the cell (floor, table, legs, pedestal, post, the objects on
-// the table; 2 cm samples) inside a box of `env`. Every obstacle: each camera sees parts the other does not
-// (the post the floor and legs far from the arm, the wrist the objects' sides facing the arm), while on the
-// table alone one camera's boxes already hold every object whole.
+// the table; 2 cm samples) inside a box of `env`. Every obstacle: counting only the objects on the table, each
+// camera's boxes alone already held all of them (1.0 each).
 double surface_in_boxes(const Environment& env, const sim::Scene& scene) {
   std::size_t inside = 0, total = 0;
   for (const sim::Obstacle& obstacle : scene.obstacles) {

@@ -1,6 +1,8 @@
 // The daemon's simulated arm cell and cell pipeline driven sweep by sweep (each sweep one second of the
 // motion, so sweep numbers are the motion's seconds): pick and place, people walking through, joint stamps
-// that are late. Noise on. CELLMAP_LONG_TESTS=1 is not needed: these runs are short by design.
+// that are late. Noise on. The arm cell's config (config/arm-cell.yaml) with the post camera only. CI runs
+// the late joint stamps for 20 sweeps; CELLMAP_LONG_TESTS=1 adds pick and place and the walkers (46 and 48
+// sweeps) and runs the late stamps for 60.
 #include <gtest/gtest.h>
 
 #include <algorithm>

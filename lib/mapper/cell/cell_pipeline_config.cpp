@@ -18,8 +18,8 @@ ReconcileOptions read_reconcile(YamlMap section) {
 CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   CellPipelineConfig c;
   c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
-  // settle_sweeps and gather_sweeps sit in the `change` section (where operators look for it) but is the
-  // pipeline's policy: read them here, the rest of the section by the change detector's reader.
+  // settle_sweeps and gather_sweeps sit in the `change` section (where operators look for them) but are the
+  // pipeline's policies: read them here, the rest of the section by the change detector's reader.
   YamlMap change = root.child("change");
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   c.gather_sweeps = static_cast<int>(change.integer("gather_sweeps", c.gather_sweeps, 0, 1000));
