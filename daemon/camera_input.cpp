@@ -85,8 +85,9 @@ std::vector<SweepFrame> CameraInput::step(std::chrono::milliseconds timeout) {
   const auto start = std::chrono::steady_clock::now();
   std::optional<Frame> frame = source_->next(timeout);
   if (frame) {
-    // Only the points and the intrinsics (for the self filter) travel on; a 640x480 image is 600 kB.
-    if (frame->depth) frame->depth->depth = {};
+    // Only the points and the intrinsics (for the self filter) travel on, the image only for the pixels
+    // without a return (no_return_range); a 640x480 image is 600 kB.
+    if (frame->depth && !(config_.no_return_range > 0.0)) frame->depth->depth = {};
     waiting_.push_back(Waiting{std::move(*frame), steady_seconds()});
   }
   std::vector<SweepFrame> posed;
@@ -120,7 +121,7 @@ PoseLookup CameraInput::locate(SweepFrame& f) const {
 void CameraInput::pose_waiting(double give_up_before, std::vector<SweepFrame>& posed) {
   while (!waiting_.empty()) {
     Waiting& head = waiting_.front();
-    SweepFrame f{std::move(head.frame), std::nullopt};
+    SweepFrame f{std::move(head.frame), std::nullopt, config_.no_return_range};
     const PoseLookup found = locate(f);
     if (found == PoseLookup::kPending && head.arrived > give_up_before) {
       // Frames behind the head are newer: they wait too.

@@ -78,6 +78,7 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   c.sensor = section.get<std::string>("sensor", c.sensor);
   if (c.sensor.empty()) section.fail("sensor", "must not be empty");
   c.noise = section.get<bool>("noise", c.noise);
+  c.no_return_range = section.number("no_return_range", c.no_return_range, 0.0, 100.0);
 
   c.camera.name = c.sensor;
   if (c.is_camera()) {

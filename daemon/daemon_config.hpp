@@ -34,6 +34,9 @@ struct SourceConfig final {
   /// Unique among the sources.
   std::string sensor = "kinect";
   bool noise = true;  ///< `noise` (sim, the same for every sim entry): false = exact depths (tests)
+  /// `no_return_range`: metres a pixel without a return clears along its line of sight, [0, 100]; 0 = none
+  /// (SweepFrame::no_return_range: time-of-flight cameras only).
+  double no_return_range = 0.0;
   /// Cameras: `mount: tool | cell` with `pose` (sim::read_mount; `X_ES` is read as the old spelling of a
   /// tool mount's pose): on the tool at camera.X_ES (posed through the robot), or fixed at X_CS. A simulated
   /// sensor is mounted by its scene.

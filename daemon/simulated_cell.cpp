@@ -31,10 +31,12 @@ SimulatedCell::SimulatedCell(const std::vector<SourceConfig>& sources, const std
     : simulator_(load(sources.front()), sim::SimOptions{sources.front().noise, 2}),
       joints_(model_for(simulator_.scene(), robot, scene_name(sources.front())),
               sources.front().camera.pose_tolerance, kSimSamples) {
+  no_return_ranges_.assign(simulator_.scene().sensors.size(), 0.0);
   for (const SourceConfig& source : sources) {
     const int sensor = simulator_.scene().find_sensor(source.sensor);
     if (sensor < 0) throw Error(scene_name(source) + ": no sensor '" + source.sensor + "' (source.sensor)");
     sensors_.push_back(sensor);
+    no_return_ranges_[static_cast<std::size_t>(sensor)] = source.no_return_range;
   }
 }
 
@@ -53,11 +55,12 @@ FrameSweep SimulatedCell::moving_sweep(double start, double duration) {
       ++dropped_;
       continue;
     }
-    const sim::SensorSpec& spec =
-        simulator_.scene().sensors[static_cast<std::size_t>(simulator_.scene().find_sensor(f.frame.sensor))];
+    const auto sensor = static_cast<std::size_t>(simulator_.scene().find_sensor(f.frame.sensor));
+    const sim::SensorSpec& spec = simulator_.scene().sensors[sensor];
     if (spec.mount == sim::Mount::kTool) f.frame.X_CS = robot.X_CE() * spec.X_ES;
     sweep.stamp = f.frame.stamp;
-    sweep.frames.push_back({std::move(f.frame), RobotAt{robot.X_CL, robot.state.payload}});
+    sweep.frames.push_back(
+        {std::move(f.frame), RobotAt{robot.X_CL, robot.state.payload}, no_return_ranges_[sensor]});
   }
   return sweep;
 }
@@ -68,7 +71,8 @@ FrameSweep SimulatedCell::stop_sweep(double start) {
     for (sim::SimFrame& f : simulator_.sweep(sensor, sweep_index_ - 1, start)) {
       RobotAt robot{joints_.robot().link_poses(f.q), std::nullopt};
       sweep.stamp = std::max(sweep.stamp, f.frame.stamp);
-      sweep.frames.push_back({std::move(f.frame), std::move(robot)});
+      sweep.frames.push_back(
+          {std::move(f.frame), std::move(robot), no_return_ranges_[static_cast<std::size_t>(sensor)]});
     }
   }
   return sweep;

@@ -52,6 +52,7 @@ class SimulatedCell final {
 
   sim::Simulator simulator_;
   std::vector<int> sensors_;
+  std::vector<double> no_return_ranges_;  // per scene sensor (index as the scene's), from the sources
   JointBuffer joints_;
   std::uint64_t sweep_index_ = 0;
   std::uint64_t dropped_ = 0;

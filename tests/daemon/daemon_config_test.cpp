@@ -129,7 +129,7 @@ TEST(DaemonConfigTest, SourcesListCamerasOnTheToolAndFixedEachOverTheSourceDefau
   const DaemonConfig c = DaemonConfig::parse(R"(
 sweep_period: 0.25
 sources:
-  - {kind: openni2, sensor: post, mount: cell, pose: {position: [3.3, 2.3, 2.3]}}
+  - {kind: openni2, sensor: post, mount: cell, pose: {position: [3.3, 2.3, 2.3]}, no_return_range: 4.5}
   - {kind: v4l2, sensor: wrist, mount: tool, pose: {position: [0.08, 0, 0.02]}, pose_tolerance: 0.02}
   - {kind: v4l2, sensor: side, X_ES: {position: [0, 0.1, 0]}, v4l2: {device: /dev/video4}}
 )",
@@ -143,6 +143,8 @@ sources:
   EXPECT_TRUE(c.sources[1].camera.X_ES.translation().isApprox(Eigen::Vector3d(0.08, 0, 0.02)));
   EXPECT_DOUBLE_EQ(c.sources[1].camera.pose_tolerance, 0.02);
   EXPECT_DOUBLE_EQ(c.sources[0].camera.pose_tolerance, 0.05);  // the built-in default
+  EXPECT_DOUBLE_EQ(c.sources[0].no_return_range, 4.5);
+  EXPECT_DOUBLE_EQ(c.sources[1].no_return_range, 0.0);  // the built-in default: off
   EXPECT_DOUBLE_EQ(c.sources[2].grouping.period, 0.25);
   EXPECT_EQ(c.sources[2].mount, sim::Mount::kTool);  // X_ES: the older spelling of a tool mount
   EXPECT_TRUE(c.sources[2].camera.X_ES.translation().isApprox(Eigen::Vector3d(0, 0.1, 0)));
@@ -162,6 +164,8 @@ TEST(DaemonConfigTest, SourcesErrorsNameTheEntryAndKey) {
             "my.yaml: sources: simulated sensors and cameras cannot be mixed in one cell");
   EXPECT_EQ(error_of("sources: [{sensor: post, mount: cell, pose: {}}]\n"),
             "my.yaml: sources[0].mount: a simulated sensor is mounted by its scene");
+  EXPECT_EQ(error_of("sources: [{sensor: post, no_return_range: -1}]\n"),
+            "my.yaml: sources[0].no_return_range: must be in [0, 100], got -1");
   EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a, mount: shelf}]\n"),
             "my.yaml: sources[0].mount: must be tool, cell or a pose, got 'shelf'");
   EXPECT_EQ(error_of("sources: [{kind: v4l2, sensor: a, mount: tool, pose: {}, X_ES: {}}]\n"),

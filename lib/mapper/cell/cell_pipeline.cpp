@@ -7,6 +7,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "coverage.hpp"
+#include "no_return.hpp"
 
 namespace cellmap {
 namespace {
@@ -45,6 +46,9 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
   if (config_.settle_sweeps < 0 || config_.settle_sweeps > 100000)
     throw Error("change.settle_sweeps: must be an integer in [0, 100000], got " +
                 std::to_string(config_.settle_sweeps));
+  if (config_.gather_sweeps < 0 || config_.gather_sweeps > 1000)
+    throw Error("change.gather_sweeps: must be an integer in [0, 1000], got " +
+                std::to_string(config_.gather_sweeps));
   if (map_state) restore(*map_state);
 }
 
@@ -87,21 +91,25 @@ void CellPipeline::filter_robot(const Robot& robot) {
 SweepReport CellPipeline::process(const FrameSweep& frames) {
   Sweep sweep;
   sweep.stamp = frames.stamp;
-  std::size_t robot_points = 0;
+  std::size_t robot_points = 0, no_return_rays = 0;
   const auto start = std::chrono::steady_clock::now();
   for (const SweepFrame& f : frames.frames) {
     if (!filter_ || !f.robot || !config_.self_filter.enabled) {
       sweep.scans.push_back(to_scan(f.frame));
-      continue;
+    } else {
+      SelfFilterResult filtered = filter_->filter(f.frame, *f.robot);
+      robot_points += filtered.removed;
+      sweep.scans.push_back(std::move(filtered.scan));
     }
-    SelfFilterResult filtered = filter_->filter(f.frame, *f.robot);
-    robot_points += filtered.removed;
-    sweep.scans.push_back(std::move(filtered.scan));
+    if (f.no_return_range > 0.0)
+      no_return_rays +=
+          add_no_return_rays(f.frame, f.no_return_range, no_return_phase_++, sweep.scans.back());
   }
   const double t_filter = seconds_since(start);
   SweepReport report = process(sweep);
   report.frames = frames.frames.size();
   report.robot_points = robot_points;
+  report.no_return_rays = no_return_rays;
   report.t_filter = t_filter;
   return report;
 }
@@ -143,9 +151,16 @@ void CellPipeline::update_viewpoint(const Sweep& sweep) {
   viewpoint_C_ = sum / static_cast<double>(sweep.scans.size());
 }
 
-bool CellPipeline::resegmentation_due(const ChangeSet& changes) {
+bool CellPipeline::resegmentation_due(ChangeSet& changes) {
   if (settling_) return ++settled_sweeps_ >= config_.settle_sweeps;
-  return !changes.empty();
+  if (!changes.empty()) {
+    if (gathered_.empty()) gather_wait_ = config_.gather_sweeps;
+    for (ChangeRegion& region : changes.regions) gathered_.regions.push_back(std::move(region));
+  }
+  if (gathered_.empty() || gather_wait_-- > 0) return false;
+  changes.regions = std::move(gathered_.regions);
+  gathered_.regions.clear();
+  return true;
 }
 
 void CellPipeline::apply(Resegmentation resegmentation, SweepReport& report) {
@@ -160,14 +175,15 @@ void CellPipeline::apply(Resegmentation resegmentation, SweepReport& report) {
 }
 
 Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
+  const OccupiedVoxels voxels(map_);
   Scope scope = scope_of(changes);
   add_boxes_within(scope);
+  add_emptied_boxes(voxels, scope);
   std::vector<Box> kept;
   for (const Box& box : boxes_) {
     if (!contains_id(scope.boxes, box.id)) kept.push_back(box);
   }
   Resegmentation result;
-  const OccupiedVoxels voxels(map_);
   const std::vector<Box> fitted = fit_boxes(scope.area, kept, voxels, result.evidence);
   result.reconciled = reconcile(boxes_, scope.boxes, fitted, next_box_id_, config_.reconcile);
   // Noise alone makes no version: what it added is taken up by the next version a change makes.
@@ -204,6 +220,20 @@ void CellPipeline::add_boxes_within(Scope& scope) const {
     };
     if (!contains_id(scope.boxes, box.id) && std::any_of(scope.area.begin(), scope.area.end(), holds))
       scope.boxes.push_back(box.id);
+  }
+}
+
+// Boxes that hold no obstacle voxel any more join the scope (and, with nothing to fit, go): the rest of an
+// object's old place that cleared piece by piece after its change was published (hidden by the robot then),
+// each piece beside voxels not yet cleared and so never a change region of its own.
+void CellPipeline::add_emptied_boxes(const OccupiedVoxels& voxels, Scope& scope) const {
+  for (const Box& box : boxes_) {
+    if (contains_id(scope.boxes, box.id)) continue;
+    const std::vector<Eigen::Vector3d> held = map_.occupied_centres({bounds_of(box)});
+    const bool holds_evidence = std::any_of(held.begin(), held.end(), [&](const Eigen::Vector3d& c) {
+      return box.contains(c) && voxels.in_group_of(c, config_.change.min_voxels);
+    });
+    if (!holds_evidence) scope.boxes.push_back(box.id);
   }
 }
 

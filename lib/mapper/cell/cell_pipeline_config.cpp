@@ -18,10 +18,11 @@ ReconcileOptions read_reconcile(YamlMap section) {
 CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   CellPipelineConfig c;
   c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
-  // settle_sweeps sits in the `change` section (where operators look for it) but is the pipeline's policy:
-  // read it here, the rest of the section by the change detector's reader.
+  // settle_sweeps and gather_sweeps sit in the `change` section (where operators look for them) but are the
+  // pipeline's policies: read them here, the rest of the section by the change detector's reader.
   YamlMap change = root.child("change");
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
+  c.gather_sweeps = static_cast<int>(change.integer("gather_sweeps", c.gather_sweeps, 0, 1000));
   c.change = ChangeConfig::from_yaml(change);
   c.segment = segment_config_from_yaml(root.child("segment"));
   // cover_every_version is the pipeline's policy too, read the same way.

@@ -31,6 +31,16 @@ class OccupiedVoxels;
 struct SweepFrame final {
   Frame frame;
   std::optional<RobotAt> robot;
+  /// Metres along its line of sight that a pixel without a return clears (the source's `no_return_range`;
+  /// cameras whose frame keeps its depth image; 0 = none). A time-of-flight camera returns from every
+  /// surface within its range but the darkest and the shiniest, so no return says the line of sight is free
+  /// that far: the only evidence that clears space in front of what lies beyond the camera's range (an
+  /// object taken away whose top the camera saw against the cell's far side). Such rays are not stopped at
+  /// the robot: a line of sight with no return passed it. Off for stereo cameras (no return on plain
+  /// surfaces) and where dark or mirror-like obstacles may stand. Each frame casts the rays of one pixel of
+  /// every 2 × 2 block, the next frame (of any such camera) the next pixel: a quarter of the cost, every
+  /// pixel used within four frames.
+  double no_return_range = 0.0;
 };
 
 /// The frames of every sensor in one sweep window, in the order taken. `stamp`: the last frame's, seconds.
@@ -51,6 +61,12 @@ struct CellPipelineConfig final {
   /// to collect two hits, flying pixels in unobserved space decay slowly), so the first version is one
   /// segmentation of the settled map instead of a trickle of small versions. 0 = the first sweep makes it.
   int settle_sweeps = 15;
+  /// Sweeps a confirmed change waits before it is published, gathering the changes confirmed meanwhile into
+  /// the same version (`change.gather_sweeps`, [0, 1000]; default 0). One change often is confirmed in parts
+  /// a sweep or two apart: the sides of a new object seen at grazing angles collect their hits later than
+  /// its top; the part of an object's old place that the robot hid while it carried the object away clears
+  /// once the robot moved on. Each part would otherwise be a version of its own.
+  int gather_sweeps = 0;
   /// Every version holds every obstacle voxel of the map whole (`reconcile.cover_every_version`; default
   /// true). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
   /// smaller group touching nothing else is noise and never fitted. The first version holds every obstacle
@@ -61,28 +77,29 @@ struct CellPipelineConfig final {
   /// versions change only what the change touched and may leave such voxels outside every box.
   bool cover_every_version = true;
 
-  /// Reads the sections `occupancy`, `change` (settle_sweeps included), `segment`, `reconcile`
-  /// (cover_every_version included) and `self_filter` of `root`
-  /// and marks them read; absent keys keep the defaults above.
+  /// Reads the sections `occupancy`, `change` (settle_sweeps and gather_sweeps included), `segment`,
+  /// `reconcile` (cover_every_version included) and `self_filter` of `root` and marks them read; absent keys
+  /// keep the defaults above.
   /// @throws Error naming the key ("change.settle_sweeps: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static CellPipelineConfig from_yaml(YamlMap& root);
 };
 
 /// What one sweep did, for the log line and the status topic.
 struct SweepReport final {
-  std::size_t points = 0;        ///< points fused as hits
-  std::size_t frames = 0;        ///< frames in the sweep
-  std::size_t robot_points = 0;  ///< points the self filter found on the robot (fused as clear-only rays)
-  double t_filter = 0;           ///< seconds the self filter took for all frames
-  std::size_t hit_voxels = 0;    ///< voxels that got a hit
-  std::size_t free_voxels = 0;   ///< voxels that got free-space evidence
-  std::size_t flipped = 0;       ///< voxels whose occupied/free state flipped in this sweep
-  std::size_t regions = 0;       ///< confirmed change regions
-  std::size_t evidence = 0;      ///< occupied voxels re-segmented
-  std::size_t boxes = 0;         ///< boxes after the sweep
+  std::size_t points = 0;          ///< points fused as hits
+  std::size_t frames = 0;          ///< frames in the sweep
+  std::size_t robot_points = 0;    ///< points the self filter found on the robot (fused as clear-only rays)
+  std::size_t no_return_rays = 0;  ///< clear-only rays of pixels without a return
+  double t_filter = 0;             ///< seconds the self filter took for all frames
+  std::size_t hit_voxels = 0;      ///< voxels that got a hit
+  std::size_t free_voxels = 0;     ///< voxels that got free-space evidence
+  std::size_t flipped = 0;         ///< voxels whose occupied/free state flipped in this sweep
+  std::size_t regions = 0;         ///< change regions confirmed in this sweep
+  std::size_t evidence = 0;        ///< occupied voxels re-segmented
+  std::size_t boxes = 0;           ///< boxes after the sweep
   double t_fuse = 0, t_change = 0, t_segment = 0;  ///< seconds
-  ChangeSet changes;                               ///< the change regions confirmed in this sweep
-  std::optional<Reconciled> change;                ///< set when the boxes changed (a new version is due)
+  ChangeSet changes;  ///< the change regions re-segmented in this sweep (gathered over gather_sweeps)
+  std::optional<Reconciled> change;  ///< set when the boxes changed (a new version is due)
 };
 
 /// Boxes re-fitted to the occupied evidence of an area and reconciled with the current boxes.
@@ -115,17 +132,19 @@ class CellPipeline final {
   /// The self filter in use, if any (its cost and triangle count for logs).
   [[nodiscard]] const SelfFilter* self_filter() const { return filter_.get(); }
 
-  /// Fuses `sweep`, detects confirmed changes and, if there are any, re-segments the evidence they touch
-  /// (resegment()) and applies the result. A pipeline that started from an empty map first settles: it
-  /// publishes nothing for `settle_sweeps` sweeps, then applies resegment_everything() once (the first
-  /// version), and from then on works on changes only.
+  /// Fuses `sweep`, detects confirmed changes and, `gather_sweeps` sweeps after the first of them,
+  /// re-segments the evidence the changes gathered meanwhile touch (resegment()) and applies the result. A
+  /// pipeline that started from an empty map first settles: it publishes nothing for `settle_sweeps` sweeps,
+  /// then applies resegment_everything() once (the first version), and from then on works on changes only.
   SweepReport process(const Sweep& sweep);
 
   /// What process() makes of one sweep's confirmed changes, on the current state and without applying it:
   /// the occupied evidence inside the regions of `changes`, inside every current box that lost at least a
   /// tenth of its voxels, and inside every box lying wholly within that area, leaving out what the other
-  /// boxes cover, segmented and reconciled with the current boxes. Const and repeatable, so one change can be
-  /// evaluated on a fixed state (`cellmap bench segment` times it against resegment_everything()).
+  /// boxes cover, segmented and reconciled with the current boxes; a box that holds no obstacle voxel any
+  /// more (its evidence cleared piece by piece, too little at a time to be a change) goes. Const and
+  /// repeatable, so one change can be evaluated on a fixed state (`cellmap bench segment` times it against
+  /// resegment_everything()).
   [[nodiscard]] Resegmentation resegment(const ChangeSet& changes) const;
   /// What process() applies for the first version: the whole map segmented and reconciled with every current
   /// box in scope. Also the anchor that shows what resegment() saves.
@@ -153,6 +172,8 @@ class CellPipeline final {
   [[nodiscard]] Scope scope_of(const ChangeSet& changes) const;
   // Adds to `scope` the boxes lying wholly inside its area (to a voxel).
   void add_boxes_within(Scope& scope) const;
+  // Adds to `scope` the boxes that hold no obstacle voxel any more.
+  void add_emptied_boxes(const OccupiedVoxels& voxels, Scope& scope) const;
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
                                            const OccupiedVoxels& voxels, std::size_t& evidence) const;
@@ -160,8 +181,9 @@ class CellPipeline final {
   void cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void update_viewpoint(const Sweep& sweep);
-  // Whether this sweep's changes (or the end of settling) call for re-segmentation.
-  [[nodiscard]] bool resegmentation_due(const ChangeSet& changes);
+  // Whether this sweep's changes (or the end of settling) call for re-segmentation; when they do, `changes`
+  // holds every change gathered since the first that waits.
+  [[nodiscard]] bool resegmentation_due(ChangeSet& changes);
   void apply(Resegmentation resegmentation, SweepReport& report);
 
   CellPipelineConfig config_;
@@ -171,8 +193,11 @@ class CellPipeline final {
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;
   Eigen::Vector3d viewpoint_C_ = Eigen::Vector3d::Zero();  // where normals are oriented towards
-  bool settling_ = true;    // an empty map that has not made its first version yet
-  int settled_sweeps_ = 0;  // sweeps fused while settling
+  bool settling_ = true;          // an empty map that has not made its first version yet
+  int settled_sweeps_ = 0;        // sweeps fused while settling
+  ChangeSet gathered_;            // confirmed changes waiting to be published together
+  unsigned no_return_phase_ = 0;  // which pixel of each 2 × 2 block the next frame's no-return rays use
+  int gather_wait_ = 0;           // sweeps the gathered changes still wait
 };
 
 }  // namespace cellmap

@@ -33,7 +33,8 @@ struct ChangeConfig final {
   /// @throws Error naming the field if a value is out of range.
   void validate() const;
   /// Reads the `change` section (keys persist_sweeps, margin, min_voxels; absent keys keep their defaults).
-  /// Keys the caller read from `section` before (the cell pipeline's settle_sweeps) are not unknown.
+  /// Keys the caller read from `section` before (the cell pipeline's settle_sweeps and gather_sweeps) are not
+  /// unknown.
   /// @throws Error naming the key ("change.margin: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static ChangeConfig from_yaml(YamlMap section);
 };

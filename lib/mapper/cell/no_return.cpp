@@ -1,0 +1,30 @@
+#include "no_return.hpp"
+
+#include <Eigen/Geometry>
+
+namespace cellmap {
+
+std::size_t add_no_return_rays(const Frame& frame, double range, unsigned phase, Scan& scan) {
+  if (!frame.depth || !(range > 0.0)) return 0;
+  const DepthImage& image = *frame.depth;
+  const PinholeIntrinsics& in = image.intrinsics;
+  const auto width = static_cast<std::size_t>(in.width), height = static_cast<std::size_t>(in.height);
+  if (image.depth.size() != width * height) return 0;
+  const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
+  const std::size_t before = scan.clear_C.size();
+  for (std::size_t v = (phase / 2) % 2; v < height; v += 2) {
+    for (std::size_t u = phase % 2; u < width; u += 2) {
+      if (image.depth[v * width + u] != 0) continue;
+      const Eigen::Vector3f sight_S(float((double(u) - in.cx) / in.fx), float((double(v) - in.cy) / in.fy),
+                                    1.0f);
+      const Eigen::Vector3f end_C = X_CS * (sight_S.normalized() * float(range));
+      scan.clear_C.push_back(pcl::PointXYZ(end_C.x(), end_C.y(), end_C.z()));
+    }
+  }
+  scan.clear_C.width = static_cast<std::uint32_t>(scan.clear_C.size());
+  scan.clear_C.height = 1;
+  scan.clear_C.is_dense = true;
+  return scan.clear_C.size() - before;
+}
+
+}  // namespace cellmap
