@@ -28,8 +28,8 @@ bool long_tests() {
 
 const std::string kScenes = std::string(CELLMAP_SOURCE_DIR) + "/config/scenes";
 constexpr double kSweep = 1.0;  // seconds of the motion per sweep
-// As config/arm-cell.yaml, except its settle_sweeps (34 sweeps of 0.5 s, two rounds of the arm's path, for what
-// the wrist camera sees late in each round): the post camera only here, the default 15 sweeps of 1 s.
+// As config/arm-cell.yaml, except its settle_sweeps (34 sweeps of 0.5 s, two rounds of the arm's path, for
+// what the wrist camera sees late in each round): the post camera only here, the default 15 sweeps of 1 s.
 const char* kArmCellKeys = "segment: {boxes: {kind: aabb}}\nchange: {gather_sweeps: 2}\n";
 
 // The arm cell with `tail` (motion, walkers) in place of its motion (or after it, `keep_motion`), written
