@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "cellmap/occupancy/occupancy_map.hpp"
-#include "cellmap/occupancy/tree_agreement.hpp"
+#include "tree_agreement.hpp"
 #include "occupancy/grabber_scans.hpp"
 
 namespace cellmap {

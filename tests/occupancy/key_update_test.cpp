@@ -1,4 +1,4 @@
-#include "cellmap/occupancy/key_update.hpp"
+#include "key_update.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/occupancy/tree_agreement.hpp"
+#include "tree_agreement.hpp"
 #include "occupancy/box_scene.hpp"
 
 namespace cellmap {

@@ -8,7 +8,7 @@
 #include <tuple>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/occupancy/key_update.hpp"
+#include "key_update.hpp"
 
 namespace cellmap {
 namespace {
