@@ -560,20 +560,28 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     for (std::size_t t = 1; t < sets.size(); ++t) {
       for (std::size_t w = 0; w < free.size(); ++w) free[w] |= sets[t][w];
     }
+    // The non-empty bricks, in the OcTree's depth-first order (sorted by index, not as 1 KB structs).
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton of the base, brick)
     for (std::uint64_t b = 0; b < grid_bits.bricks(); ++b) {
-      KeyBrick brick;
       std::uint64_t any = 0;
       for (int w = 0; w < kBrickWords; ++w) {
         const std::size_t i = std::size_t(b) * kBrickWords + std::size_t(w);
+        any |= occupied[i] | free[i];
+      }
+      if (any != 0) order.emplace_back(morton(grid_bits.brick_base(b)), b);
+    }
+    std::sort(order.begin(), order.end());
+    update.bricks.resize(order.size());
+    for (std::size_t n = 0; n < order.size(); ++n) {
+      KeyBrick& brick = update.bricks[n];
+      brick.base = grid_bits.brick_base(order[n].second);
+      for (int w = 0; w < kBrickWords; ++w) {
+        const std::size_t i = std::size_t(order[n].second) * kBrickWords + std::size_t(w);
         brick.occupied[std::size_t(w)] = occupied[i];
         brick.free[std::size_t(w)] = free[i] & ~occupied[i];
-        any |= occupied[i] | free[i];
         update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
         update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
       }
-      if (any == 0) continue;
-      brick.base = grid_bits.brick_base(b);
-      update.bricks.push_back(brick);
     }
   } else {
     std::vector<std::uint64_t> all;
@@ -602,8 +610,8 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
       ++update.free_count;
     }
     for (auto& entry : bricks) update.bricks.push_back(entry.second);
+    sort_depth_first(update.bricks);
   }
-  sort_depth_first(update.bricks);
   return update;
 }
 
