@@ -101,7 +101,8 @@ std::vector<Sweep> synthetic_frame() {
 
 // One sweep of the default cell's `model` camera in the native mode `intrinsics`, each frame a sweep of its
 // own.
-std::vector<Sweep> native_cell_frames(cellmap::sim::SensorModel model, const cellmap::PinholeIntrinsics& intrinsics) {
+std::vector<Sweep> native_cell_frames(cellmap::sim::SensorModel model,
+                                      const cellmap::PinholeIntrinsics& intrinsics) {
   cellmap::sim::Scene scene = cellmap::sim::default_scene();
   std::size_t sensor = 0;
   while (scene.sensors[sensor].model != model) ++sensor;

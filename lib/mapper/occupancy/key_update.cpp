@@ -100,8 +100,8 @@ Key brick_base(const Key& k) {
 // that steps out of the box sees an index past the end instead of reading or writing outside.
 struct BrickGrid {
   static constexpr std::uint32_t kOutside = std::uint32_t{1} << 30;  // > 3 × 2^28: no sum wraps
-  int lo[3];     // key of the first brick's base
-  int count[3];  // bricks per axis
+  int lo[3];                                                         // key of the first brick's base
+  int count[3];                                                      // bricks per axis
   std::vector<std::uint32_t> offset[3];
 
   explicit BrickGrid(const KeyBox& box) {

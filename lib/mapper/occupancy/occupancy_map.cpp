@@ -28,7 +28,6 @@ void sort_zyx(std::vector<octomap::OcTreeKey>& keys) {
   });
 }
 
-
 // Applies a KeyUpdate to an OcTree brick by brick, descending each subtree once instead of once per voxel.
 // Written here because OctoMap has no batch update: per voxel, updateNode() searches the key from the root
 // and descends again (≈ 0.3 µs per voxel, ~1.6 M free voxels per 640×480 frame). This walk follows
