@@ -305,20 +305,29 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
                    std::abs(int(ray.end_key[2]) - int(origin.key[2]));
-  while (steps_left-- > 0) {
+  // OctoMap steps, stops at the end voxel, then stops if the next crossing (the smallest crossing distance)
+  // lies past the end point (rounding at a corner), and else marks the voxel. The next crossing is also what
+  // chooses the next step, so each turn chooses once and tests once.
+  bool x_axis = false, y_axis = false, z_axis = false;
+  double t_next = 0.0;
+  auto choose = [&] {
     // OctoMap's tie-breaking: the later axis wins ties.
     const bool x_before_y = tx < ty;
     const double t_xy = x_before_y ? tx : ty;
-    const bool z_axis = !(t_xy < tz);
-    const bool x_axis = !z_axis && x_before_y;
-    const bool y_axis = !z_axis && !x_before_y;
+    z_axis = !(t_xy < tz);
+    x_axis = !z_axis && x_before_y;
+    y_axis = !z_axis && !x_before_y;
+    t_next = z_axis ? tz : t_xy;
+  };
+  choose();
+  while (steps_left-- > 0) {
     cursor.step(x_axis ? sx : 0, y_axis ? sy : 0, z_axis ? sz : 0);
     tx = x_axis ? tx + dx : tx;
     ty = y_axis ? ty + dy : ty;
     tz = z_axis ? tz + dz : tz;
-    // At the end voxel; or past the end point without entering its voxel (rounding at a corner): stop, as
-    // OctoMap does.
-    if (cursor.done() || std::min(std::min(tx, ty), tz) > length) return;
+    if (cursor.done()) return;
+    choose();
+    if (t_next > length) return;
     cursor.mark();
   }
 }
@@ -337,43 +346,58 @@ void run_parallel(int threads, std::size_t n, Fn&& fn) {
 constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
 // OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
-// resolution) + the tree's key offset. new_key() remembers the last voxel, because neighbouring pixels mostly
-// share one and the test for that (six comparisons) is cheaper than the conversion.
+// resolution) + the tree's key offset. new_key() remembers the last voxel as a range of coordinates per axis,
+// because neighbouring pixels mostly share one and six float comparisons are cheaper than the conversion.
 class KeyConverter {
  public:
   explicit KeyConverter(const octomap::OcTree& grid)
-      : factor_(1.0 / grid.getResolution()), max_val_(int(grid.coordToKey(0.0))) {}
+      : factor_(1.0 / grid.getResolution()),
+        resolution_(grid.getResolution()),
+        max_val_(int(grid.coordToKey(0.0))) {}
 
   // The packed key of (x, y, z), or kNoKey if a coordinate is not finite or outside the key range.
   [[nodiscard]] std::uint64_t key(float x, float y, float z) {
     const double scaled[3] = {factor_ * double(x), factor_ * double(y), factor_ * double(z)};
-    std::uint64_t packed = 0;
+    int floored[3];
     for (int i = 0; i < 3; ++i) {
       // floor(s) is in [-max_val, max_val) exactly when s is (max_val is an integer); NaN and infinity fail.
       if (!(scaled[i] >= -max_val_ && scaled[i] < max_val_)) return kNoKey;
       const int truncated = int(scaled[i]);
-      const int floored = truncated - (double(truncated) > scaled[i]);  // floor, without a libm call
-      last_[i] = floored;
-      packed |= std::uint64_t(floored + max_val_) << (16 * i);
+      floored[i] = truncated - (double(truncated) > scaled[i]);  // floor, without a libm call
+    }
+    std::uint64_t packed = 0;
+    for (int i = 0; i < 3; ++i) {
+      remember(i, floored[i]);
+      packed |= std::uint64_t(floored[i] + max_val_) << (16 * i);
     }
     return packed;
   }
   // As key(), but also kNoKey when the point lies in the voxel of the last key returned.
   [[nodiscard]] std::uint64_t new_key(float x, float y, float z) {
-    // floor(s) = f exactly when f <= s < f + 1; NaN fails every comparison.
-    const double sx = factor_ * double(x), sy = factor_ * double(y), sz = factor_ * double(z);
-    if ((sx >= last_[0]) & (sx < last_[0] + 1) & (sy >= last_[1]) & (sy < last_[1] + 1) & (sz >= last_[2]) &
-        (sz < last_[2] + 1)) {
+    // NaN fails every comparison.
+    if ((x >= lo_[0]) & (x < hi_[0]) & (y >= lo_[1]) & (y < hi_[1]) & (z >= lo_[2]) & (z < hi_[2]))
       return kNoKey;
-    }
     return key(x, y, z);
   }
 
  private:
+  // Coordinates [lo, hi) of voxel `floored` on `axis`, narrowed by 1e-6 of their size (≥ 8 float rounding
+  // steps): every float inside is certainly in that voxel; one just inside the true border goes through
+  // key().
+  void remember(int axis, int floored) {
+    const float lo = static_cast<float>(floored * resolution_);
+    const float hi = static_cast<float>((floored + 1) * resolution_);
+    lo_[axis] = lo + std::fabs(lo) * 1e-6f;
+    hi_[axis] = hi - std::fabs(hi) * 1e-6f;
+  }
+
   double factor_;
+  double resolution_;
   int max_val_;
-  double last_[3] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::quiet_NaN()};
+  float lo_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::quiet_NaN()};
+  float hi_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::quiet_NaN()};
 };
 
 // The packed endpoint keys of one scan, per thread chunk of its points (consecutive repeats dropped), and
