@@ -1,6 +1,9 @@
 // cellmap bench fusion: our sweep fusion (OccupancyMap::integrate) against OctoMap's own
-// OcTree::insertPointCloud on the same frames, in the same run. Each frame is one sweep fused into a fresh
-// map per iteration. Prints the voxel-state agreement of the resulting maps before the timings.
+// OcTree::insertPointCloud on the same frames, in the same run. Each frame is one sweep; a frame set is fused
+// into a fresh map per iteration. Prints the voxel-state agreement of the resulting maps before the timings.
+// Frame sets: the real grabber frames, a synthetic box room, and one sweep of the default simulated cell
+// (config/cell.yaml) at each camera's native resolution (Kinect v2 512 × 424, RealSense D435 848 × 480),
+// rendered at start with the cameras' noise.
 // Then the self filter's cost per frame against the fusion of that frame, at native camera resolution with
 // the ABB IRB 2400 (or, without the shared data, cellmap's own arm) in view of a fixed camera.
 
@@ -13,11 +16,13 @@
 #include <vector>
 
 #include "cellmap/occupancy/occupancy_map.hpp"
-#include "cellmap/occupancy/tree_agreement.hpp"
+#include "cellmap/sim/default_scene.hpp"
+#include "cellmap/sim/simulator.hpp"
 #include "occupancy/box_scene.hpp"
 #include "occupancy/grabber_scans.hpp"
 #include "ratio_report.hpp"
 #include "self_filter_frames.hpp"
+#include "tree_agreement.hpp"
 
 namespace {
 
@@ -94,6 +99,34 @@ std::vector<Sweep> synthetic_frame() {
   return {sweep};
 }
 
+// One sweep of the default cell's `model` camera in the native mode `intrinsics`, each frame a sweep of its
+// own.
+std::vector<Sweep> native_cell_frames(cellmap::sim::SensorModel model,
+                                      const cellmap::PinholeIntrinsics& intrinsics) {
+  cellmap::sim::Scene scene = cellmap::sim::default_scene();
+  std::size_t sensor = 0;
+  while (scene.sensors[sensor].model != model) ++sensor;
+  scene.sensors[sensor].intrinsics = intrinsics;
+  std::vector<Sweep> sweeps;
+  for (const cellmap::sim::SimFrame& frame : cellmap::sim::Simulator(scene).sweep(int(sensor))) {
+    sweeps.emplace_back();
+    sweeps.back().scans.push_back(cellmap::to_scan(frame.frame));
+  }
+  return sweeps;
+}
+
+// The RealSense D435's 848 × 480 depth mode (≈ 89° × 58° field of view; the simulator's default mode is
+// 640 × 480), with the default mode's range limits.
+cellmap::PinholeIntrinsics d435_848x480() {
+  cellmap::PinholeIntrinsics k = cellmap::sim::default_intrinsics(cellmap::sim::SensorModel::kRealsenseD435);
+  k.width = 848;
+  k.height = 480;
+  k.fx = k.fy = 430.0;
+  k.cx = 423.5;
+  k.cy = 239.5;
+  return k;
+}
+
 void print_agreement(const std::string& set) {
   const std::vector<Sweep>& sweeps = frame_sets().at(set);
   std::vector<octomap::Pointcloud> clouds;
@@ -112,9 +145,9 @@ void print_agreement(const std::string& set) {
     const cellmap::TreeAgreement a = cellmap::compare_trees(ours.tree(), reference);
     std::printf(
         "agreement fusion %s vs insertPointCloud(discretize=%s): %.4f %% of %zu voxels "
-        "(occupied: ours %zu, octomap %zu, both %zu; %zu valid points)\n",
+        "(occupied: ours %zu, octomap %zu, both %zu; %zu frames, %zu valid points)\n",
         set.c_str(), discretize ? "true" : "false", 100.0 * a.fraction(), a.voxels, a.occupied_a,
-        a.occupied_b, a.occupied_both, points);
+        a.occupied_b, a.occupied_both, sweeps.size(), points);
   }
 }
 
@@ -130,6 +163,10 @@ int main(int argc, char** argv) {
     frame_sets()["grabber_3frames"] = std::move(grabber);
   }
   frame_sets()["synthetic_1frame"] = synthetic_frame();
+  using cellmap::sim::SensorModel;
+  frame_sets()["cell_kinect_v2_512x424"] =
+      native_cell_frames(SensorModel::kKinectV2, cellmap::sim::default_intrinsics(SensorModel::kKinectV2));
+  frame_sets()["cell_d435_848x480"] = native_cell_frames(SensorModel::kRealsenseD435, d435_848x480());
 
   for (const auto& entry : frame_sets()) {
     const std::string& name = entry.first;

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "cellmap/occupancy/occupancy_map.hpp"
-#include "cellmap/occupancy/tree_agreement.hpp"
 #include "occupancy/grabber_scans.hpp"
+#include "tree_agreement.hpp"
 
 namespace cellmap {
 namespace {

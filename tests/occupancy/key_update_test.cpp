@@ -1,9 +1,10 @@
-#include "cellmap/occupancy/key_update.hpp"
+#include "key_update.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <utility>
 
@@ -221,6 +222,31 @@ TEST(KeyUpdateTest, SkipsNonFinitePointsAndRejectsBadOrigins) {
   EXPECT_THROW((void)compute_key_update(sweep, tree, 5.0, 1), Error);
   sweep.scans[0].origin_C = Eigen::Vector3d::Zero();
   EXPECT_THROW((void)compute_key_update(sweep, tree, 0.0, 1), Error);
+}
+
+// Points one float step either side of and exactly on voxel borders, in a row (so that each is compared with
+// the voxel of the one before it): every point lands in OctoMap's voxel for it, as coordToKey says.
+TEST(KeyUpdateTest, PointsAtVoxelBordersGetOctomapsKeys) {
+  octomap::OcTree tree(0.02);
+  Sweep sweep;
+  Scan& scan = sweep.scans.emplace_back();
+  scan.origin_C = Eigen::Vector3d(0.005, 0.007, 0.003);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int k = -60; k <= 60; ++k) {
+    const float border = static_cast<float>(k * 0.02);
+    const float other = static_cast<float>(-k * 0.02 + 0.04);
+    for (const float x : {std::nextafter(border, -inf), border, std::nextafter(border, inf)}) {
+      for (const float y : {std::nextafter(other, -inf), other, std::nextafter(other, inf)}) {
+        scan.points_C.push_back(pcl::PointXYZ(x, y, 0.5f));
+        scan.points_C.push_back(pcl::PointXYZ(y, 0.5f, x));
+      }
+    }
+  }
+  octomap::KeySet expected;
+  for (const auto& p : scan.points_C) expected.insert(tree.coordToKey(p.x, p.y, p.z));
+  const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 1);
+  EXPECT_EQ(ours.occupied_keys(), sorted(expected));
+  EXPECT_GT(expected.size(), 700u);
 }
 
 TEST(KeyUpdateTest, BrickIndexRoundTrips) {

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/occupancy/tree_agreement.hpp"
 #include "occupancy/box_scene.hpp"
+#include "tree_agreement.hpp"
 
 namespace cellmap {
 namespace {
@@ -127,6 +127,62 @@ TEST(OccupancyMapTest, ClearOnlyRaysMatchOctomapsUpdateNode) {
   for (const octomap::OcTreeKey& k : box_b) still_occupied += map.state(k) == VoxelState::occupied ? 1 : 0;
   EXPECT_EQ(still_occupied, box_b.size());
   EXPECT_EQ(map.state(Eigen::Vector3d(0.5, 0.6, 2.3)), VoxelState::free);
+}
+
+// Every leaf voxel known in `a` or `b` (pruned nodes expanded) with its log-odds in both; the count of those
+// that differ.
+std::size_t log_odds_differences(const octomap::OcTree& a, const octomap::OcTree& b, std::size_t& known) {
+  std::size_t differences = 0;
+  known = 0;
+  for (const octomap::OcTree* tree : {&a, &b}) {
+    const octomap::OcTree& other = tree == &a ? b : a;
+    for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it) {
+      const int span = 1 << (tree->getTreeDepth() - it.getDepth());
+      const octomap::OcTreeKey first = it.getIndexKey();
+      for (int z = 0; z < span; ++z)
+        for (int y = 0; y < span; ++y)
+          for (int x = 0; x < span; ++x) {
+            const octomap::OcTreeNode* node =
+                other.search(octomap::OcTreeKey(first[0] + x, first[1] + y, first[2] + z));
+            ++known;
+            if (node == nullptr || node->getLogOdds() != it->getLogOdds()) ++differences;
+          }
+    }
+  }
+  return differences;
+}
+
+// Whole free subtrees (new, or pruned after reaching the clamp bound) are updated as one node: every leaf
+// below ends with updateNode()'s log-odds, also where a removed box's voxels inside pruned free space and
+// the clamp bounds come into play over many sweeps.
+TEST(OccupancyMapTest, WholeSubtreesGetUpdateNodesLogOdds) {
+  OccupancyConfig config;
+  config.resolution = 0.05;
+  OccupancyMap map(config);
+  octomap::OcTree reference(config.resolution);
+  apply_sensor_model(config, reference);
+  std::vector<AlignedBox> scene = testing::box_room();
+  for (int sweep = 0; sweep < 12; ++sweep) {
+    if (sweep == 8) scene.pop_back();
+    const Scan scan = testing::render_scan(scene, camera_at({0.011, -0.2, 0.02}, -0.25 + 0.01 * (sweep % 3)),
+                                           testing::kinect_intrinsics(160, 120));
+    Sweep one;
+    one.scans.push_back(scan);
+    map.integrate(one);
+    const octomap::point3d origin(float(scan.origin_C.x()), float(scan.origin_C.y()),
+                                  float(scan.origin_C.z()));
+    octomap::KeySet free, occupied;
+    reference.computeDiscreteUpdate(to_octomap(scan), origin, free, occupied, config.max_range);
+    for (const octomap::OcTreeKey& k : free) {
+      if (occupied.count(k) == 0) reference.updateNode(k, false, false);
+    }
+    for (const octomap::OcTreeKey& k : occupied) reference.updateNode(k, true, false);
+  }
+  std::size_t known = 0;
+  EXPECT_EQ(log_odds_differences(map.tree(), reference, known), 0u);
+  EXPECT_GT(known, 20000u);
+  // Pruned: our tree holds no more nodes than OctoMap's own non-lazy updates leave.
+  EXPECT_LE(map.tree().size(), reference.size());
 }
 
 TEST(OccupancyMapTest, ReportsFlipsAndStates) {

@@ -1,4 +1,4 @@
-#include "cellmap/occupancy/key_update.hpp"
+#include "key_update.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -94,38 +94,41 @@ Key brick_base(const Key& k) {
 }
 
 // The bricks of a key box (aligned outwards to whole bricks) as one dense bit array: brick after brick in
-// (z, y, x) order, each brick's 4096 bits in KeyBrick order.
+// (z, y, x) order, each brick's 4096 bits in KeyBrick order. The index is separable, offset[0][x] +
+// offset[1][y] + offset[2][z], so that a ray walk step (one axis) costs one table lookup. Each table has one
+// guard entry more on either side of the box holding kOutside: a sum with it is at least bits(), so a walk
+// that steps out of the box sees an index past the end instead of reading or writing outside.
 struct BrickGrid {
-  int lo[3];     // key of the first brick's base
-  int count[3];  // bricks per axis
-
-  // The index is separable: offset[0][x] + offset[1][y] + offset[2][z], one table per axis, so that a ray
-  // walk step (one axis) costs one table lookup.
-  std::vector<std::uint32_t> offset[3];  // 32 bits: dense grids have at most 2^28 bits
+  static constexpr std::uint32_t kOutside = std::uint32_t{1} << 30;  // > 3 × 2^28: no sum wraps
+  int lo[3];                                                         // key of the first brick's base
+  int count[3];                                                      // bricks per axis
+  std::vector<std::uint32_t> offset[3];
 
   explicit BrickGrid(const KeyBox& box) {
     for (int i = 0; i < 3; ++i) {
       lo[i] = box.lo[i] & ~0xf;
       count[i] = ((box.hi[i] | 0xf) - lo[i] + 1) / KeyBrick::kEdge;
     }
+    if (!dense()) return;  // sparse: no tables
     const std::uint64_t stride[3] = {KeyBrick::kVoxels, std::uint64_t(count[0]) * KeyBrick::kVoxels,
                                      std::uint64_t(count[0]) * count[1] * KeyBrick::kVoxels};
     for (int i = 0; i < 3; ++i) {
-      offset[i].resize(std::size_t(count[i]) * KeyBrick::kEdge);
-      for (std::size_t v = 0; v < offset[i].size(); ++v) {
-        offset[i][v] =
+      const std::size_t size = std::size_t(count[i]) * KeyBrick::kEdge;
+      offset[i].assign(size + 2, kOutside);
+      for (std::size_t v = 0; v < size; ++v) {
+        offset[i][v + 1] =
             static_cast<std::uint32_t>((v >> 4) * stride[i] + (std::uint64_t(kSpread4[v & 0xf]) << i));
       }
     }
   }
-  static constexpr std::uint32_t kOutside = ~std::uint32_t{0};
-  // Index of key (x, y, z) (dense grids only), or kOutside outside the box.
-  [[nodiscard]] std::uint32_t index(int x, int y, int z) const {
-    const std::size_t dx = std::size_t(x - lo[0]);
-    const std::size_t dy = std::size_t(y - lo[1]);
-    const std::size_t dz = std::size_t(z - lo[2]);
-    if (dx >= offset[0].size() || dy >= offset[1].size() || dz >= offset[2].size()) return kOutside;
-    return offset[0][dx] + offset[1][dy] + offset[2][dz];
+  [[nodiscard]] bool dense() const { return bits() <= kMaxDenseVoxels; }
+  // Table position of key component `k` on `axis` (0 and size + 1 are the guards).
+  [[nodiscard]] std::size_t slot(int axis, int k) const {
+    return std::size_t(std::clamp(k - lo[axis] + 1, 0, int(offset[axis].size()) - 1));
+  }
+  // Bit index of a key (dense grids only), bits() or more outside the box.
+  [[nodiscard]] std::uint32_t index(const Key& k) const {
+    return offset[0][slot(0, k[0])] + offset[1][slot(1, k[1])] + offset[2][slot(2, k[2])];
   }
   [[nodiscard]] std::uint64_t bricks() const { return std::uint64_t(count[0]) * count[1] * count[2]; }
   [[nodiscard]] std::uint64_t bits() const { return bricks() * KeyBrick::kVoxels; }
@@ -138,42 +141,55 @@ struct BrickGrid {
   }
 };
 
-// Walk cursor over a BrickGrid's bit array (local copies of the tables, so the walk keeps them in registers).
+// Walk position in a dense BrickGrid: per axis a pointer into its offset table; the bit index is the sum of
+// the three entries. A step moves one pointer (chosen without a branch: the caller passes 0 for the others).
 class DenseCursor {
  public:
-  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : words_(words) {
-    for (int i = 0; i < 3; ++i) {
-      lo_[i] = grid.lo[i];
-      size_[i] = grid.offset[i].size();
-      table_[i] = grid.offset[i].data();
-    }
+  DenseCursor(const BrickGrid& grid, std::uint64_t* words) : grid_(grid), words_(words), bits_(grid.bits()) {}
+  // Starts at `from`, the walk ending at `to`; false if `from` is outside the grid.
+  bool start(const Key& from, const Key& to) {
+    for (int i = 0; i < 3; ++i) at_[i] = grid_.offset[i].data() + grid_.slot(i, from[i]);
+    index_ = *at_[0] + *at_[1] + *at_[2];
+    end_ = grid_.index(to);
+    return index_ < bits_;
   }
-  bool move(int x, int y, int z) {
-    const std::size_t dx = std::size_t(x - lo_[0]), dy = std::size_t(y - lo_[1]),
-                      dz = std::size_t(z - lo_[2]);
-    if ((dx >= size_[0]) | (dy >= size_[1]) | (dz >= size_[2])) return false;
-    index_ = table_[0][dx] + table_[1][dy] + table_[2][dz];
-    return true;
+  void step(int dx, int dy, int dz) {
+    at_[0] += dx;
+    at_[1] += dy;
+    at_[2] += dz;
+    index_ = *at_[0] + *at_[1] + *at_[2];
   }
+  // At the end voxel, or out of the grid (one test: a guard entry makes the index ≥ bits).
+  [[nodiscard]] bool done() const { return (index_ == end_) | (index_ >= bits_); }
   void mark() { words_[index_ >> 6] |= std::uint64_t{1} << (index_ & 63); }
 
  private:
+  const BrickGrid& grid_;
   std::uint64_t* words_;
-  int lo_[3];
-  std::size_t size_[3];
-  const std::uint32_t* table_[3];
-  std::uint32_t index_ = 0;
+  std::uint32_t bits_;
+  const std::uint32_t* at_[3] = {nullptr, nullptr, nullptr};
+  std::uint32_t index_ = 0, end_ = 0;
 };
 
-// Walk cursor that lists packed keys (for boxes too large for a dense bit array).
+// Walk position that lists packed keys (for boxes too large for a dense bit array).
 class SparseCursor {
  public:
   explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
-  bool move(int x, int y, int z) {
-    key_[0] = x;
-    key_[1] = y;
-    key_[2] = z;
-    return x >= 0 && y >= 0 && z >= 0 && x <= 0xffff && y <= 0xffff && z <= 0xffff;
+  bool start(const Key& from, const Key& to) {
+    for (int i = 0; i < 3; ++i) {
+      key_[i] = from[i];
+      end_[i] = to[i];
+    }
+    return true;
+  }
+  void step(int dx, int dy, int dz) {
+    key_[0] += dx;
+    key_[1] += dy;
+    key_[2] += dz;
+  }
+  [[nodiscard]] bool done() const {
+    return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) ||
+           ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0;
   }
   void mark() {
     out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
@@ -182,6 +198,7 @@ class SparseCursor {
  private:
   std::vector<std::uint64_t>& out_;
   int key_[3] = {0, 0, 0};
+  int end_[3] = {0, 0, 0};
 };
 
 void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
@@ -250,13 +267,10 @@ struct Ray {
 // (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
 // the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `cursor` instead
 // of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
-// nothing. The cursor follows the walk one axis step at a time (move(axis, key) returns false when the walk
-// leaves its grid; the walk then stops, as it never comes back on that axis) and marks the current voxel.
+// nothing. The walk stops where it leaves the cursor's grid (it never comes back on that axis).
 template <class Cursor>
 void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
-  if (origin.key == ray.end_key) return;
-  const int key[3] = {origin.key[0], origin.key[1], origin.key[2]};
-  if (!cursor.move(key[0], key[1], key[2])) return;
+  if (origin.key == ray.end_key || !cursor.start(origin.key, ray.end_key)) return;
   cursor.mark();
 
   float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
@@ -272,7 +286,7 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   for (int i = 0; i < 3; ++i) {
     step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
     if (step[i] != 0) {
-      double border = grid.keyToCoord(static_cast<octomap::key_type>(key[i]));
+      double border = grid.keyToCoord(origin.key[i]);
       border += static_cast<float>(step[i] * resolution * 0.5);
       t_max[i] = (border - origin.p[i]) / direction[i];
       t_delta[i] = resolution / std::fabs(direction[i]);
@@ -281,37 +295,146 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
-  // The axis whose voxel border comes next (OctoMap's tie-breaking: the later axis wins ties).
   // The loop keeps everything in scalars and chooses the axis with selects rather than branches: the choice
   // is unpredictable, and a mispredicted branch (or an array indexed by it) per voxel costs more than the
   // rest.
   double tx = t_max[0], ty = t_max[1], tz = t_max[2];
-  int kx = key[0], ky = key[1], kz = key[2];
-  const int ex = ray.end_key[0], ey = ray.end_key[1], ez = ray.end_key[2];
+  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
+  const int sx = step[0], sy = step[1], sz = step[2];
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
-  int steps_left = 3 + std::abs(ex - kx) + std::abs(ey - ky) + std::abs(ez - kz);
-  while (steps_left-- > 0) {
+  int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
+                   std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
+                   std::abs(int(ray.end_key[2]) - int(origin.key[2]));
+  // OctoMap steps, stops at the end voxel, then stops if the next crossing (the smallest crossing distance)
+  // lies past the end point (rounding at a corner), and else marks the voxel. The next crossing is also what
+  // chooses the next step, so each turn chooses once and tests once.
+  bool x_axis = false, y_axis = false, z_axis = false;
+  double t_next = 0.0;
+  auto choose = [&] {
     // OctoMap's tie-breaking: the later axis wins ties.
     const bool x_before_y = tx < ty;
     const double t_xy = x_before_y ? tx : ty;
-    const bool z_axis = !(t_xy < tz);
-    const bool x_axis = !z_axis && x_before_y;
-    const bool y_axis = !z_axis && !x_before_y;
-    kx += x_axis ? step[0] : 0;
-    ky += y_axis ? step[1] : 0;
-    kz += z_axis ? step[2] : 0;
-    tx = x_axis ? tx + t_delta[0] : tx;
-    ty = y_axis ? ty + t_delta[1] : ty;
-    tz = z_axis ? tz + t_delta[2] : tz;
-    if (kx == ex && ky == ey && kz == ez) return;
-    // Past the end point without entering its voxel (rounding at a corner): stop, as OctoMap does.
-    if (std::min(std::min(tx, ty), tz) > length) return;
-    if (!cursor.move(kx, ky, kz)) return;
+    z_axis = !(t_xy < tz);
+    x_axis = !z_axis && x_before_y;
+    y_axis = !z_axis && !x_before_y;
+    t_next = z_axis ? tz : t_xy;
+  };
+  choose();
+  while (steps_left-- > 0) {
+    cursor.step(x_axis ? sx : 0, y_axis ? sy : 0, z_axis ? sz : 0);
+    tx = x_axis ? tx + dx : tx;
+    ty = y_axis ? ty + dy : ty;
+    tz = z_axis ? tz + dz : tz;
+    if (cursor.done()) return;
+    choose();
+    if (t_next > length) return;
     cursor.mark();
   }
 }
 
+// Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
+template <class Fn>
+void run_parallel(int threads, std::size_t n, Fn&& fn) {
+  const int count = std::max(threads, 1);
+  const std::size_t chunk = (n + std::size_t(count) - 1) / std::size_t(count);
+  parallel_for(count, count, [&](int t) {
+    const std::size_t begin = std::min(n, std::size_t(t) * chunk);
+    fn(begin, std::min(n, begin + chunk), std::size_t(t));
+  });
+}
+
 constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+
+// OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
+// resolution) + the tree's key offset. new_key() remembers the last voxel as a range of coordinates per axis,
+// because neighbouring pixels mostly share one and six float comparisons are cheaper than the conversion.
+class KeyConverter {
+ public:
+  explicit KeyConverter(const octomap::OcTree& grid)
+      : factor_(1.0 / grid.getResolution()),
+        resolution_(grid.getResolution()),
+        max_val_(int(grid.coordToKey(0.0))) {}
+
+  // The packed key of (x, y, z), or kNoKey if a coordinate is not finite or outside the key range.
+  [[nodiscard]] std::uint64_t key(float x, float y, float z) {
+    const double scaled[3] = {factor_ * double(x), factor_ * double(y), factor_ * double(z)};
+    int floored[3];
+    for (int i = 0; i < 3; ++i) {
+      // floor(s) is in [-max_val, max_val) exactly when s is (max_val is an integer); NaN and infinity fail.
+      if (!(scaled[i] >= -max_val_ && scaled[i] < max_val_)) return kNoKey;
+      const int truncated = int(scaled[i]);
+      floored[i] = truncated - (double(truncated) > scaled[i]);  // floor, without a libm call
+    }
+    std::uint64_t packed = 0;
+    for (int i = 0; i < 3; ++i) {
+      remember(i, floored[i]);
+      packed |= std::uint64_t(floored[i] + max_val_) << (16 * i);
+    }
+    return packed;
+  }
+  // As key(), but also kNoKey when the point lies in the voxel of the last key returned.
+  [[nodiscard]] std::uint64_t new_key(float x, float y, float z) {
+    // NaN fails every comparison.
+    if ((x >= lo_[0]) & (x < hi_[0]) & (y >= lo_[1]) & (y < hi_[1]) & (z >= lo_[2]) & (z < hi_[2]))
+      return kNoKey;
+    return key(x, y, z);
+  }
+
+ private:
+  // Coordinates [lo, hi) of voxel `floored` on `axis`, narrowed by 1e-6 of their size (≥ 8 float rounding
+  // steps): every float inside is certainly in that voxel; one just inside the true border goes through
+  // key().
+  void remember(int axis, int floored) {
+    const float lo = static_cast<float>(floored * resolution_);
+    const float hi = static_cast<float>((floored + 1) * resolution_);
+    lo_[axis] = lo + std::fabs(lo) * 1e-6f;
+    hi_[axis] = hi - std::fabs(hi) * 1e-6f;
+  }
+
+  double factor_;
+  double resolution_;
+  int max_val_;
+  float lo_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::quiet_NaN()};
+  float hi_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::quiet_NaN()};
+};
+
+// The packed endpoint keys of one scan, per thread chunk of its points (consecutive repeats dropped), and
+// of its clear-only ray ends, with the box of all of them.
+struct ScanKeys {
+  std::vector<std::vector<std::uint64_t>> points;
+  std::vector<std::uint64_t> clear;
+  KeyBox box;
+};
+
+ScanKeys scan_keys(const Scan& scan, const octomap::OcTree& grid, int threads) {
+  const auto& points = scan.points_C.points;
+  ScanKeys out;
+  out.points.resize(static_cast<std::size_t>(threads));
+  std::vector<KeyBox> boxes(static_cast<std::size_t>(threads));
+  run_parallel(threads, points.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+    KeyConverter converter(grid);
+    std::vector<std::uint64_t>& keys = out.points[t];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint64_t packed = converter.new_key(points[i].x, points[i].y, points[i].z);
+      if (packed == kNoKey) continue;
+      keys.push_back(packed);
+      boxes[t].extend(unpack(packed));
+    }
+  });
+  KeyConverter converter(grid);
+  for (const pcl::PointXYZ& p : scan.clear_C.points) {
+    const std::uint64_t packed = converter.key(p.x, p.y, p.z);
+    if (packed == kNoKey) continue;
+    out.clear.push_back(packed);
+    out.box.extend(unpack(packed));
+  }
+  for (const KeyBox& b : boxes) {
+    if (!b.empty()) out.box.extend(b);
+  }
+  return out;
+}
 
 // The distinct voxels of one scan: those holding a point, and the ends of its clear-only rays that hold none.
 struct DistinctKeys {
@@ -319,28 +442,30 @@ struct DistinctKeys {
   std::vector<Key> clear;
 };
 
-// The distinct packed keys of `keys` (kNoKey entries skipped), in first-seen order; the first `point_count`
-// entries are the points', the rest clear-only ray ends (a bit set over their box, or sorting when the box is
+// The distinct keys of `keys`, in first-seen order (a bit set over their box, or sorting when the box is
 // huge).
-DistinctKeys distinct(const std::vector<std::uint64_t>& keys, std::size_t point_count, const KeyBox& box) {
+DistinctKeys distinct(const ScanKeys& keys) {
   DistinctKeys out;
-  if (box.volume() > kMaxDenseVoxels) {
-    std::vector<std::uint64_t> packed[2];
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      if (keys[i] != kNoKey) packed[i < point_count ? 0 : 1].push_back(keys[i]);
-    }
-    const std::vector<std::uint64_t> points = sorted_unique(std::move(packed[0]));
+  if (keys.box.volume() > kMaxDenseVoxels) {
+    std::vector<std::uint64_t> all;
+    for (const auto& list : keys.points) all.insert(all.end(), list.begin(), list.end());
+    const std::vector<std::uint64_t> points = sorted_unique(std::move(all));
     for (const std::uint64_t p : points) out.points.push_back(unpack(p));
-    for (const std::uint64_t p : sorted_unique(std::move(packed[1]))) {
+    for (const std::uint64_t p : sorted_unique(keys.clear)) {
       if (!std::binary_search(points.begin(), points.end(), p)) out.clear.push_back(unpack(p));
     }
     return out;
   }
-  BitSet seen(box.volume());
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (keys[i] == kNoKey) continue;
-    const Key k = unpack(keys[i]);
-    if (!seen.test_and_set(box.index(k))) (i < point_count ? out.points : out.clear).push_back(k);
+  BitSet seen(keys.box.volume());
+  for (const auto& list : keys.points) {
+    for (const std::uint64_t p : list) {
+      const Key k = unpack(p);
+      if (!seen.test_and_set(keys.box.index(k))) out.points.push_back(k);
+    }
+  }
+  for (const std::uint64_t p : keys.clear) {
+    const Key k = unpack(p);
+    if (!seen.test_and_set(keys.box.index(k))) out.clear.push_back(k);
   }
   return out;
 }
@@ -372,17 +497,6 @@ RayEnd ray_to(const octomap::OcTree& grid, const Origin& origin, const Key& end,
                                                                                  : RayEnd::kOutside;
 }
 
-// Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
-template <class Fn>
-void run_parallel(int threads, std::size_t n, Fn&& fn) {
-  const int count = std::max(threads, 1);
-  const std::size_t chunk = (n + std::size_t(count) - 1) / std::size_t(count);
-  parallel_for(count, count, [&](int t) {
-    const std::size_t begin = std::min(n, std::size_t(t) * chunk);
-    fn(begin, std::min(n, begin + chunk), std::size_t(t));
-  });
-}
-
 }  // namespace
 
 int KeyBrick::local_index(const octomap::OcTreeKey& key) {
@@ -409,20 +523,6 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
   if (!(max_range > 0.0)) throw Error("occupancy: max_range must be > 0, got " + std::to_string(max_range));
   threads = std::max(threads, 1);
 
-  // OctoMap's coordToKey arithmetic, inlined (it is out of line in the library and costs ~10 % here).
-  const double factor = 1.0 / grid.getResolution();
-  const int max_val = int(grid.coordToKey(0.0));  // the key of coordinate 0 is the tree's key offset
-  auto to_key = [factor, max_val](float x, float y, float z, Key& key) {
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return false;
-    const float c[3] = {x, y, z};
-    for (int i = 0; i < 3; ++i) {
-      const double scaled = std::floor(factor * double(c[i]));
-      if (!(scaled >= -max_val && scaled < max_val)) return false;
-      key[i] = static_cast<octomap::key_type>(int(scaled) + max_val);
-    }
-    return true;
-  };
-
   // 1. Per scan: distinct endpoint voxels; those within range are hits, every one gets a ray.
   std::vector<Origin> origins;
   std::vector<Ray> rays;
@@ -439,31 +539,9 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
     origins.push_back(origin);
     box.extend(origin.key);
 
-    // Points, then clear-only ray ends, to keys on all threads; one that is not finite or outside the map
-    // gets kNoKey.
-    const auto& points = scan.points_C.points;
-    const auto& clear_ends = scan.clear_C.points;
-    std::vector<std::uint64_t> keys(points.size() + clear_ends.size());
-    std::vector<KeyBox> thread_boxes(static_cast<std::size_t>(threads));
-    run_parallel(threads, keys.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const pcl::PointXYZ& p = i < points.size() ? points[i] : clear_ends[i - points.size()];
-        Key k;
-        if (to_key(p.x, p.y, p.z, k)) {
-          keys[i] = pack(k);
-          thread_boxes[t].extend(k);
-        } else {
-          keys[i] = kNoKey;
-        }
-      }
-    });
-    KeyBox scan_box;
-    for (const KeyBox& b : thread_boxes) {
-      if (!b.empty()) scan_box.extend(b);
-    }
-    if (scan_box.empty()) continue;
-
-    const DistinctKeys ends = distinct(keys, points.size(), scan_box);
+    const ScanKeys keys = scan_keys(scan, grid, threads);
+    if (keys.box.empty()) continue;
+    const DistinctKeys ends = distinct(keys);
     for (const std::vector<Key>* list : {&ends.points, &ends.clear}) {
       const bool hit = list == &ends.points;
       for (const Key& k : *list) {
@@ -483,7 +561,7 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
 
   // 2. Walk the rays on `threads` threads, each into its own set; the union does not depend on the split.
   const BrickGrid grid_bits(box);
-  const bool dense = grid_bits.bits() <= kMaxDenseVoxels;
+  const bool dense = grid_bits.dense();
   std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
   const std::uint64_t bits = grid_bits.bits();
   run_parallel(threads, rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
@@ -501,25 +579,33 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
   // 3. Union the threads' sets, remove the hits from the free voxels, and keep the non-empty bricks.
   if (dense) {
     std::vector<std::uint64_t> occupied(bits / 64, 0);
-    for (const Key& k : hits) set_bit(occupied, grid_bits.index(k[0], k[1], k[2]));
+    for (const Key& k : hits) set_bit(occupied, grid_bits.index(k));
     std::vector<std::uint64_t>& free = sets[0];
     for (std::size_t t = 1; t < sets.size(); ++t) {
       for (std::size_t w = 0; w < free.size(); ++w) free[w] |= sets[t][w];
     }
+    // The non-empty bricks, in the OcTree's depth-first order (sorted by index, not as 1 KB structs).
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton of the base, brick)
     for (std::uint64_t b = 0; b < grid_bits.bricks(); ++b) {
-      KeyBrick brick;
       std::uint64_t any = 0;
       for (int w = 0; w < kBrickWords; ++w) {
         const std::size_t i = std::size_t(b) * kBrickWords + std::size_t(w);
+        any |= occupied[i] | free[i];
+      }
+      if (any != 0) order.emplace_back(morton(grid_bits.brick_base(b)), b);
+    }
+    std::sort(order.begin(), order.end());
+    update.bricks.resize(order.size());
+    for (std::size_t n = 0; n < order.size(); ++n) {
+      KeyBrick& brick = update.bricks[n];
+      brick.base = grid_bits.brick_base(order[n].second);
+      for (int w = 0; w < kBrickWords; ++w) {
+        const std::size_t i = std::size_t(order[n].second) * kBrickWords + std::size_t(w);
         brick.occupied[std::size_t(w)] = occupied[i];
         brick.free[std::size_t(w)] = free[i] & ~occupied[i];
-        any |= occupied[i] | free[i];
         update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
         update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
       }
-      if (any == 0) continue;
-      brick.base = grid_bits.brick_base(b);
-      update.bricks.push_back(brick);
     }
   } else {
     std::vector<std::uint64_t> all;
@@ -548,8 +634,8 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
       ++update.free_count;
     }
     for (auto& entry : bricks) update.bricks.push_back(entry.second);
+    sort_depth_first(update.bricks);
   }
-  sort_depth_first(update.bricks);
   return update;
 }
 

@@ -2,19 +2,30 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <istream>
 #include <ostream>
 #include <string>
 #include <tuple>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/occupancy/key_update.hpp"
+#include "key_update.hpp"
 
 namespace cellmap {
 namespace {
 
-bool zyx_less(const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
-  return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
+// Sorts `keys` in (z, y, x) order by their values packed as z:y:x (cheaper than comparing key by key).
+void sort_zyx(std::vector<octomap::OcTreeKey>& keys) {
+  std::vector<std::uint64_t> packed(keys.size());
+  std::transform(keys.begin(), keys.end(), packed.begin(), [](const octomap::OcTreeKey& k) {
+    return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
+  });
+  std::sort(packed.begin(), packed.end());
+  std::transform(packed.begin(), packed.end(), keys.begin(), [](std::uint64_t p) {
+    return octomap::OcTreeKey(static_cast<octomap::key_type>(p & 0xffff),
+                              static_cast<octomap::key_type>((p >> 16) & 0xffff),
+                              static_cast<octomap::key_type>(p >> 32));
+  });
 }
 
 // Applies a KeyUpdate to an OcTree brick by brick, descending each subtree once instead of once per voxel.
@@ -65,6 +76,16 @@ class BatchApplier {
     const std::uint64_t mask = ((std::uint64_t{1} << count) - 1) << (begin & 63);
     return (words[std::size_t(begin >> 6)] & mask) != 0;
   }
+  static bool all(const std::array<std::uint64_t, KeyBrick::kVoxels / 64>& words, int begin, int count) {
+    if (count >= 64) {
+      for (int w = begin >> 6; w < (begin + count) >> 6; ++w) {
+        if (words[std::size_t(w)] != ~std::uint64_t{0}) return false;
+      }
+      return true;
+    }
+    const std::uint64_t mask = ((std::uint64_t{1} << count) - 1) << (begin & 63);
+    return (words[std::size_t(begin >> 6)] & mask) == mask;
+  }
   static int first_bit(const std::array<std::uint64_t, KeyBrick::kVoxels / 64>& words) {
     for (int w = 0;; ++w) {
       if (words[std::size_t(w)] != 0) return w * 64 + __builtin_ctzll(words[std::size_t(w)]);
@@ -77,31 +98,49 @@ class BatchApplier {
            (log_odds > clamp_min_ && any(brick_->free, begin, count));
   }
 
-  void update_leaf(octomap::OcTreeNode* node, bool created, int index) {
-    const bool occupied = (brick_->occupied[std::size_t(index >> 6)] >> (index & 63)) & 1;
+  // Whether every voxel of the bit range gets the same update; `occupied` says which.
+  bool uniform(int begin, int count, bool& occupied) const {
+    if (all(brick_->free, begin, count)) {
+      occupied = false;
+      return true;
+    }
+    occupied = true;
+    return all(brick_->occupied, begin, count);
+  }
+
+  // Updates `node`, a leaf or a node without children standing for every voxel of the bit range, all of
+  // which get the same update, and records the voxels that flipped.
+  void update_block(octomap::OcTreeNode* node, bool created, bool occupied, int begin, int count) {
     const bool was_occupied = !created && tree_.isNodeOccupied(node);
     tree_.updateNodeLogOdds(node, occupied ? hit_ : miss_);
     const bool now_occupied = tree_.isNodeOccupied(node);
-    if (now_occupied && !was_occupied) out_.appeared.push_back(brick_->key(index));
-    if (!now_occupied && was_occupied) out_.vanished.push_back(brick_->key(index));
+    if (now_occupied == was_occupied) return;
+    auto& flipped = now_occupied ? out_.appeared : out_.vanished;
+    for (int i = begin; i < begin + count; ++i) flipped.push_back(brick_->key(i));
   }
 
   // `node` covers bit range [begin, begin + count) of the brick at tree depth `depth`; above the brick's
-  // depth the range is the whole brick and only the path towards it is followed.
+  // depth the range is the whole brick and only the path towards it is followed. `created`: the node is new
+  // (log-odds 0, no children). Where a whole subtree gets one update and holds no finer nodes (a new node or
+  // a pruned block), that one node is updated instead of creating or expanding its 8^k leaves, which would
+  // end equal and be pruned again: each leaf below gets the value updateNode() would give it.
   void visit(octomap::OcTreeNode* node, unsigned depth, bool created, int begin, int count) {
-    if (!created && !tree_.nodeHasChildren(node)) {
-      // An existing leaf or pruned block: where updateNode()'s search() stops.
-      if (!needs_update(node->getLogOdds(), begin, count)) return;
+    const unsigned brick_depth = depth_ - kBrickDepthFromLeaf;
+    if (created || !tree_.nodeHasChildren(node)) {
+      // A new node, an existing leaf or a pruned block: where updateNode()'s search() stops.
+      if (!created && !needs_update(node->getLogOdds(), begin, count)) return;
+      bool occupied = false;
       if (depth == depth_) {
-        update_leaf(node, false, begin);
+        occupied = (brick_->occupied[std::size_t(begin >> 6)] >> (begin & 63)) & 1;
+        update_block(node, created, occupied, begin, count);
         return;
       }
-      tree_.expandNode(node);
-    } else if (depth == depth_) {
-      update_leaf(node, created, begin);
-      return;
+      if (depth >= brick_depth && uniform(begin, count, occupied)) {
+        update_block(node, created, occupied, begin, count);
+        return;
+      }
+      if (!created) tree_.expandNode(node);
     }
-    const unsigned brick_depth = depth_ - kBrickDepthFromLeaf;
     if (depth < brick_depth) {
       visit_child(node, octomap::computeChildIdx(brick_->base, int(depth_ - 1 - depth)), depth, begin, count);
     } else {
@@ -156,8 +195,8 @@ OccupancyUpdate OccupancyMap::integrate(const Sweep& sweep) {
   update.free_voxels = keys.free_count;
   BatchApplier applier(*tree_, update);
   for (const KeyBrick& brick : keys.bricks) applier.apply(brick);
-  std::sort(update.appeared.begin(), update.appeared.end(), zyx_less);
-  std::sort(update.vanished.begin(), update.vanished.end(), zyx_less);
+  sort_zyx(update.appeared);
+  sort_zyx(update.vanished);
   return update;
 }
 
@@ -198,7 +237,7 @@ void append_occupied(const octomap::OcTree& tree, Iterator begin, Iterator end,
       for (int y = 0; y < span; ++y)
         for (int x = 0; x < span; ++x) keys.emplace_back(first[0] + x, first[1] + y, first[2] + z);
   }
-  std::sort(keys.begin(), keys.end(), zyx_less);
+  sort_zyx(keys);
 }
 
 }  // namespace

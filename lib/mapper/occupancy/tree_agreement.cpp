@@ -1,4 +1,4 @@
-#include "cellmap/occupancy/tree_agreement.hpp"
+#include "tree_agreement.hpp"
 
 #include <algorithm>
 #include <cstdint>
