@@ -8,13 +8,14 @@
 #include <thread>
 
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kPlannerDomain = 170;
-constexpr int kSecurePlannerDomain = 192;
+constexpr int kPlannerDomain = test::domain::kPlanner;
+constexpr int kSecurePlannerDomain = test::domain::kSecurePlanner;
 
 // The next JSON line the planner prints, or a failure.
 nlohmann::json next_state(test::ChildProcess& planner) {
@@ -51,7 +52,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kPatience)) << "the box never arrived";
-  const EnvironmentDelta added = recorder.last();
+  const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
   EXPECT_TRUE(added.removed.empty());
@@ -73,7 +74,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment with_box = test::settled(observer, 3s);
   service.inject(domain, {"remove", "--name", name});
   ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
-  EXPECT_EQ(recorder.last().removed, std::vector<std::uint64_t>{box.id});
+  EXPECT_EQ(recorder.to(with_box.version() + 1).removed, std::vector<std::uint64_t>{box.id});
   const nlohmann::json free = next_state(planner);
   EXPECT_EQ(free.value("state", ""), "free") << free.dump();
   EXPECT_EQ(free.value("removed", 0), 1) << free.dump();
