@@ -1,6 +1,7 @@
 // cellmapd on the simulated cell as a real process, a planner subscriber on loopback DDS, and `cellmap
 // inject` as a separate process: injected changes arrive as exact deltas; versions survive SIGKILL without
-// reuse. Each test runs plain and with DDS Security on every participant.
+// reuse (those run plain and with DDS Security on every participant). The daemon's status, SIGHUP, the
+// latest-wins mailbox and a truncated state directory, read from its status topic and its log (plain).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -4,8 +4,8 @@
 // and with DDS Security on every process and participant.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "daemon/service_e2e.hpp"
 #include "support/dds_domains.hpp"
@@ -38,6 +38,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const dds::Participant participant = service.participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
+  transport::StatusReader status(participant);  // tells when the stopped daemon's writers are gone
   // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");
@@ -84,7 +85,15 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment last = test::settled(observer, 3s);
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
-  std::this_thread::sleep_for(2s);  // past the 1 s lease: the writers are gone for the readers too
+  // The daemon's writers have left this participant (its status writer is seen leaving with them).
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  bool departed = false;
+  while (!departed && std::chrono::steady_clock::now() < deadline) {
+    (void)status.take(100ms);
+    departed =
+        std::find(status.departed().begin(), status.departed().end(), "planner") != status.departed().end();
+  }
+  ASSERT_TRUE(departed) << "the stopped daemon never left";
   EXPECT_EQ(*observer.environment(), last);
   daemon = service.start_daemon(domain);
   const std::string again =
