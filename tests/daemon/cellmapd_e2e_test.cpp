@@ -156,6 +156,27 @@ std::uint64_t sweep_number(const std::string& line) {
                                  : std::strtoull(line.c_str() + at + std::strlen(kSweepLine), nullptr, 10);
 }
 
+// The status of a simulated daemon after its first sweep, before any version.
+void expect_first_sweep_status(const transport::CellStatus& status) {
+  EXPECT_EQ(status.state, "running");
+  EXPECT_EQ(status.sweeps, 1u);
+  EXPECT_EQ(status.version, 0u);  // settling: no version yet
+  EXPECT_EQ(status.boxes, 0u);
+  ASSERT_FALSE(status.sensors.empty());
+  for (const transport::SensorStatus& sensor : status.sensors)
+    EXPECT_EQ(sensor.state, "streaming") << sensor.name;
+  EXPECT_GT(status.last_sweep_ns, 0);
+}
+
+// A running daemon's status agrees with `env`, the version subscribers have.
+void expect_status_of(const transport::CellStatus& status, const Environment& env) {
+  EXPECT_EQ(status.state, "running");
+  EXPECT_EQ(status.version, env.version());
+  EXPECT_EQ(status.boxes, env.boxes().size());
+  // The sweep that made the version ended just before it was stamped; later sweeps end later.
+  EXPECT_GT(status.last_sweep_ns, env.stamp_ns() - 1'000'000'000);
+}
+
 // SIGHUP re-reads log_level and sweep_period and refuses a bad file; the status of the simulated daemon
 // before and after its first version, and the final `stopped`. One daemon, plain DDS.
 TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsTheVersions) {
@@ -178,14 +199,7 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
   ASSERT_TRUE(log.wait_for(std::string(kSweepLine) + "1: ")) << "no first sweep";
   const auto first = status_where([](const transport::CellStatus& s) { return s.sweeps >= 1; });
   ASSERT_TRUE(first.has_value()) << "no status of the simulated daemon";
-  EXPECT_EQ(first->state, "running");
-  EXPECT_EQ(first->sweeps, 1u);
-  EXPECT_EQ(first->version, 0u);  // settling: no version yet
-  EXPECT_EQ(first->boxes, 0u);
-  ASSERT_FALSE(first->sensors.empty());
-  for (const transport::SensorStatus& sensor : first->sensors)
-    EXPECT_EQ(sensor.state, "streaming") << sensor.name;
-  EXPECT_GT(first->last_sweep_ns, 0);
+  expect_first_sweep_status(*first);
 
   // sweep_period 60 → 0.2 at once (the next sweep would otherwise come a minute later), log_level → warn:
   // the per-sweep info lines stop.
@@ -220,11 +234,8 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
   const auto after_version =
       status_where([&](const transport::CellStatus& s) { return s.version == env.version(); });
   ASSERT_TRUE(after_version.has_value()) << "no status with version " << env.version();
-  EXPECT_EQ(after_version->state, "running");
-  EXPECT_EQ(after_version->boxes, env.boxes().size());
   EXPECT_GT(env.boxes().size(), 0u);
-  // The sweep that made the version ended just before it was stamped; later sweeps end later.
-  EXPECT_GT(after_version->last_sweep_ns, env.stamp_ns() - 1'000'000'000);
+  expect_status_of(*after_version, env);
 
   // SIGTERM: the last report says `stopped`, with the version it stopped at.
   daemon->signal(SIGTERM);
