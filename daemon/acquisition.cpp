@@ -57,8 +57,9 @@ class SimAcquisition final : public Acquisition {
       const double duration = sweep_period_ > 0 ? sweep_period_.load() : cell_.pass_duration();
       if (deliver(stamp, duration)) stamp += duration;
       if (max_sweeps > 0 && ++sweeps >= max_sweeps) return;
-      const auto next = start + seconds(sweep_period_.load());
-      while (!stop && Clock::now() < next) std::this_thread::sleep_for(milliseconds(10));
+      // The period is read on every turn: a period changed by SIGHUP applies at once, not after the old one.
+      while (!stop && Clock::now() < start + seconds(sweep_period_.load()))
+        std::this_thread::sleep_for(milliseconds(10));
     }
   }
 

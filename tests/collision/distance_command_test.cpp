@@ -7,11 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "support/test_support.hpp"
+
 namespace {
 
 struct ToolRun {
   std::string output;
-  int status = -1;
+  int status = -1;  ///< exit code, -1 when a signal ended the tool
 };
 
 ToolRun run_tool(const std::string& arguments) {
@@ -21,7 +23,7 @@ ToolRun run_tool(const std::string& arguments) {
   if (pipe == nullptr) return run;
   std::array<char, 4096> buffer{};
   while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) run.output += buffer.data();
-  run.status = pclose(pipe);
+  run.status = cellmap::test::exit_code(pclose(pipe));
   return run;
 }
 
@@ -53,7 +55,7 @@ TEST(DistanceCommandTest, RefusesBadBoxesWithOneLineReason) {
         std::string("0,0,0,.5,.5,.5 1,1,1,.5,.5,.5,1,1,0,0")}) {
     SCOPED_TRACE(arguments);
     const ToolRun run = run_tool(arguments);
-    EXPECT_NE(run.status, 0);
+    EXPECT_EQ(run.status, 1) << run.output;  // refused, not crashed
     EXPECT_FALSE(run.output.empty());
     EXPECT_EQ(run.output.find('\n'), run.output.size() - 1) << run.output;  // exactly one line
   }

@@ -9,13 +9,14 @@
 #include <vector>
 
 #include "cellmap/transport/scene_edits.hpp"
+#include "support/dds_domains.hpp"
 #include "transport/loopback.hpp"
 
 namespace cellmap::daemon {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kSimDomain = 187;
+constexpr int kSimDomain = test::domain::kSimAcquisition;
 
 // Points of `sweep` inside the axis-aligned box at `centre` with `half_extents` grown by 5 mm, leaving out
 // the 5 cm above the table it stands on.

@@ -12,12 +12,15 @@
 #include <thread>
 
 #include "cellmap/environment/version_store.hpp"
+#include "cellmap/sensor/depth_io.hpp"
 #include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "cellmap/transport/robot_joints.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "cellmap/transport/status_reader.hpp"
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
+#include "support/shared_data.hpp"
 #include "support/test_support.hpp"
 
 namespace cellmap {
@@ -25,11 +28,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kReplayDomain = 182;
-constexpr int kNoDeviceDomain = 183;
-constexpr int kRobotPoseDomain = 184;
-constexpr int kUnpluggedDomain = 162;
-constexpr int kJointsDomain = 163;
+constexpr int kReplayDomain = test::domain::kReplay;
+constexpr int kNoDeviceDomain = test::domain::kNoDevice;
+constexpr int kRobotPoseDomain = test::domain::kRobotPose;
+constexpr int kUnpluggedDomain = test::domain::kUnplugged;
+constexpr int kJointsDomain = test::domain::kJointsCamera;
+constexpr int kEndedDomain = test::domain::kReplayEnded;
+constexpr int kErrorDomain = test::domain::kReplayError;
 
 // Debian's OpenNI2 Dummy device at 320x240 (see below).
 const char* kDummy =
@@ -64,7 +69,7 @@ class CameraE2eTest : public ::testing::Test {
 
 TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirPoints) {
   const fs::path data = fs::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
-  if (!fs::is_directory(data)) GTEST_SKIP() << data << " is absent (shared test data)";
+  CELLMAP_SKIP_WITHOUT_DATA(data);
   std::vector<fs::path> frames;
   for (const auto& entry : fs::directory_iterator(data)) {
     const std::string name = entry.path().filename().string();
@@ -90,8 +95,11 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
 
   const dds::Participant participant(kReplayDomain);
   transport::EnvironmentSubscriber planner(participant, "replay");
+  transport::StatusReader reader(participant);
   auto daemon = start_daemon(yaml, kReplayDomain, kSweeps);
   EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version published from the replay";
+  const auto stopped = test::wait_for_status(
+      reader, "replay", [](const transport::CellStatus& s) { return s.state == "stopped"; });
   const int status = daemon->wait();
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
       << "cellmapd --sweeps " << kSweeps << " did not exit cleanly";
@@ -102,6 +110,13 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
   ASSERT_GT(env.boxes().size(), 0u);
   ASSERT_TRUE(planner.environment().has_value());
   EXPECT_LE(planner.environment()->version(), env.version());
+  // The last report: stopped, every sweep processed and none dropped (`playback: fastest` waits for the
+  // processing thread), the version and boxes that went out.
+  ASSERT_TRUE(stopped.has_value()) << "no final stopped status";
+  EXPECT_EQ(stopped->sweeps, static_cast<std::uint64_t>(kSweeps));
+  EXPECT_EQ(stopped->dropped_frames, 0u);
+  EXPECT_EQ(stopped->version, env.version());
+  EXPECT_EQ(stopped->boxes, env.boxes().size());
 
   // Every box lies in front of the camera (cell +x from x = 1) and below it: the recorded tool pose was
   // applied. An ignored pose would put the scene around the cell's z axis instead.
@@ -138,6 +153,61 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
   EXPECT_GE(fraction, 0.99);
 }
 
+// A replay that ends, or whose last frame cannot be read, degrades the cell (`ended`, `error`); the version
+// made before stays published, for late joiners too. The parameter: a bad frame at the end.
+class DegradedReplayTest : public CameraE2eTest, public ::testing::WithParamInterface<bool> {};
+
+TEST_P(DegradedReplayTest, KeepsTheLastVersionPublished) {
+  const bool bad_frame = GetParam();
+  const int domain = bad_frame ? kErrorDomain : kEndedDomain;
+  // Four frames of a 160 × 120 camera (kToolPose) facing a wall 2 m ahead with a block 0.5 m in front of it.
+  const fs::path replay = dir_.path() / "replay";
+  fs::create_directories(replay);
+  RawDepth image{160, 120, std::vector<std::uint16_t>(160 * 120, 2000)};
+  for (int v = 40; v < 80; ++v)
+    for (int u = 50; u < 110; ++u) image.depth[static_cast<std::size_t>(v * 160 + u)] = 1500;
+  write_depth_png((replay / "wall.png").string(), image);
+  std::ofstream(replay / "intrinsics.yaml")
+      << "width: 160\nheight: 120\nfx: 150\nfy: 150\ncx: 79.5\ncy: 59.5\ndepth_scale: 0.001\n";
+  std::ofstream(replay / "bad.png") << "not a PNG";
+  {
+    std::ofstream poses(replay / "poses.csv");
+    poses << "file,stamp,x,y,z,qw,qx,qy,qz\n";
+    for (int i = 0; i < 4; ++i) poses << "wall.png," << 100 + i << "," << kToolPose << "\n";
+    if (bad_frame) poses << "bad.png,104," << kToolPose << "\n";
+  }
+  const std::string yaml =
+      "cell: degraded\nsweep_period: 0\nstatus_period: 0.2\nchange: {settle_sweeps: 2}\nsource:\n"
+      "  kind: replay\n  sensor: post\n  replay: {directory: replay, playback: fastest}\n";
+  const dds::Participant participant(domain);
+  transport::StatusReader reader(participant);
+  auto daemon = start_daemon(yaml, domain);
+  const std::string expected_state = bad_frame ? "error" : "ended";
+  const auto degraded = test::wait_for_status(reader, "degraded", [&](const transport::CellStatus& s) {
+    return s.state == "degraded" && s.version >= 1 && s.sensors.size() == 1 &&
+           s.sensors[0].state.rfind(expected_state, 0) == 0;
+  });
+  ASSERT_TRUE(degraded.has_value()) << "no degraded/" << expected_state << " status after a version";
+  EXPECT_NE(degraded->reason.find(bad_frame ? "bad.png" : "end of recording"), std::string::npos)
+      << degraded->reason;
+  EXPECT_GT(degraded->boxes, 0u);
+  EXPECT_EQ(degraded->dropped_frames, 0u);
+
+  // A late joiner gets that version, with the boxes the status counts.
+  transport::EnvironmentSubscriber late(participant, "degraded");
+  ASSERT_TRUE(late.wait_for_version(degraded->version, test::kPatience)) << "the last version is gone";
+  EXPECT_EQ(late.environment()->version(), degraded->version);
+  EXPECT_EQ(late.environment()->boxes().size(), degraded->boxes);
+  EXPECT_TRUE(daemon->running());
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(test::exit_code(daemon->wait()), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(, DegradedReplayTest, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "BadFrame" : "End";
+                         });
+
 TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm) {
   const std::string yaml =
       "cell: no-device\nstatus_period: 0.2\nsource:\n  kind: openni2\n  sensor: wrist\n"
@@ -154,12 +224,13 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
       << degraded->sensors[0].state;
   EXPECT_EQ(degraded->version, 0u);
   EXPECT_EQ(degraded->sweeps, 0u);
-  // Still running (and still reporting) a while later: retrying with back-off, not exiting.
-  std::this_thread::sleep_for(1500ms);
-  EXPECT_TRUE(daemon->running()) << "cellmapd exited without a device";
-  const auto later = test::wait_for_status(
-      reader, "no-device", [](const transport::CellStatus& s) { return s.state == "degraded"; });
+  // Still running and reporting, five reports later: retrying with back-off, not exiting.
+  int reports = 0;
+  const auto later = test::wait_for_status(reader, "no-device", [&](const transport::CellStatus& s) {
+    return s.state == "degraded" && ++reports >= 5;
+  });
   ASSERT_TRUE(later.has_value()) << "the daemon stopped reporting";
+  EXPECT_TRUE(daemon->running()) << "cellmapd exited without a device";
   daemon->signal(SIGTERM);
   const int status = daemon->wait();
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;

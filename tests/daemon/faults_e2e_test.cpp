@@ -12,14 +12,15 @@
 
 #include "cellmap/environment/version_store.hpp"
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap {
 namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kFirstVersionDomain = 188;
-constexpr int kLaterVersionDomain = 189;
+constexpr int kFirstVersionDomain = test::domain::kFirstVersionFault;
+constexpr int kLaterVersionDomain = test::domain::kLaterVersionFault;
 // The first version's map state is about 0.5 MB: room for three versions and a filler.
 constexpr const char* kTmpfsOptions = "size=4m";
 // A short settling (exact depths fill the map in a few sweeps): the tests are about what follows.

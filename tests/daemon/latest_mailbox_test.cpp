@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -65,6 +66,29 @@ TEST(LatestMailboxTest, CloseWakesWaitingConsumers) {
   closer.join();
 }
 
+TEST(LatestMailboxTest, BusyConsumerGetsOnlyTheNewestAndTheRestAreCountedDropped) {
+  // The consumer takes item 0, then stays busy while items 1..2000 arrive: the mailbox holds only the newest,
+  // so the consumer then gets item 2000 and the 1999 in between are counted as dropped. A queue would hand
+  // over all 2001 items and drop none.
+  LatestMailbox<std::vector<int>> box;
+  std::promise<void> took_first;
+  std::promise<void> finish_work;
+  std::vector<int> taken;
+  std::thread consumer([&] {
+    if (const auto first = box.take(milliseconds(10000))) taken.push_back(first->front());
+    took_first.set_value();
+    finish_work.get_future().wait();
+    while (const auto item = box.take(milliseconds(0))) taken.push_back(item->front());
+  });
+  box.put(std::vector<int>(100, 0));
+  took_first.get_future().wait();
+  for (int i = 1; i <= 2000; ++i) box.put(std::vector<int>(100, i));
+  finish_work.set_value();
+  consumer.join();
+  EXPECT_EQ(taken, (std::vector<int>{0, 2000}));
+  EXPECT_EQ(box.dropped(), 1999u);
+}
+
 TEST(LatestMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
   LatestMailbox<std::vector<int>> box;
   std::uint64_t taken = 0;
@@ -86,6 +110,8 @@ TEST(LatestMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
   consumer.join();
   // Every item was either taken or counted as dropped: none lost silently, none queued.
   EXPECT_EQ(taken + box.dropped(), 2000u);
+  // The consumer rests 1 ms per item while the producer puts 2000 at once: items were replaced, not queued.
+  EXPECT_GT(box.dropped(), 0u);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "cellmap/sweep/sweep.hpp"
+#include "support/dds_domains.hpp"
 #include "transport/loopback.hpp"
 
 namespace cellmap::daemon {
@@ -19,7 +20,7 @@ namespace {
 using namespace std::chrono_literals;
 using transport::Layer;
 constexpr auto kPatience = 30s;
-constexpr std::uint32_t kDomain = 223;
+constexpr std::uint32_t kDomain = test::domain::kLayerPublisher;
 
 class LayerPublisherTest : public ::testing::Test {
  protected:

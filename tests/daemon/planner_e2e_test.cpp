@@ -4,17 +4,18 @@
 // and with DDS Security on every process and participant.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kPlannerDomain = 170;
-constexpr int kSecurePlannerDomain = 192;
+constexpr int kPlannerDomain = test::domain::kPlanner;
+constexpr int kSecurePlannerDomain = test::domain::kSecurePlanner;
 
 // The next JSON line the planner prints, or a failure.
 nlohmann::json next_state(test::ChildProcess& planner) {
@@ -37,6 +38,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const dds::Participant participant = service.participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
+  transport::StatusReader status(participant);  // tells when the stopped daemon's writers are gone
   // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");
@@ -51,7 +53,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kPatience)) << "the box never arrived";
-  const EnvironmentDelta added = recorder.last();
+  const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
   EXPECT_TRUE(added.removed.empty());
@@ -73,7 +75,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment with_box = test::settled(observer, 3s);
   service.inject(domain, {"remove", "--name", name});
   ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
-  EXPECT_EQ(recorder.last().removed, std::vector<std::uint64_t>{box.id});
+  EXPECT_EQ(recorder.to(with_box.version() + 1).removed, std::vector<std::uint64_t>{box.id});
   const nlohmann::json free = next_state(planner);
   EXPECT_EQ(free.value("state", ""), "free") << free.dump();
   EXPECT_EQ(free.value("removed", 0), 1) << free.dump();
@@ -83,7 +85,15 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment last = test::settled(observer, 3s);
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
-  std::this_thread::sleep_for(2s);  // past the 1 s lease: the writers are gone for the readers too
+  // The daemon's writers have left this participant (its status writer is seen leaving with them).
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  bool departed = false;
+  while (!departed && std::chrono::steady_clock::now() < deadline) {
+    (void)status.take(100ms);
+    departed =
+        std::find(status.departed().begin(), status.departed().end(), "planner") != status.departed().end();
+  }
+  ASSERT_TRUE(departed) << "the stopped daemon never left";
   EXPECT_EQ(*observer.environment(), last);
   daemon = service.start_daemon(domain);
   const std::string again =

@@ -17,16 +17,17 @@
 
 #include "cellmap/transport/status_reader.hpp"
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
 using security::Role;
-constexpr int kAttackDomain = 193;
-constexpr int kRolesDomain = 194;
-constexpr int kOtherCaDomain = 195;
-constexpr int kRefusalDomain = 196;
+constexpr int kAttackDomain = test::domain::kAttack;
+constexpr int kRolesDomain = test::domain::kRoles;
+constexpr int kOtherCaDomain = test::domain::kOtherCa;
+constexpr int kRefusalDomain = test::domain::kRefusal;
 
 // The daemon's status once `done` holds for it, or a failure after the patience.
 transport::CellStatus wait_for_status(transport::StatusReader& reader,

@@ -55,11 +55,14 @@ class ServiceFixture {
   ServiceFixture(std::string cell, std::optional<int> secure_domain)
       : ServiceFixture(std::move(cell), "", std::nullopt, secure_domain) {}
 
-  /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess.
-  [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain, bool log_on_stdout = false) const {
+  /// Starts cellmapd on `domain`. With `log_on_stdout` its log (stderr) is read through the ChildProcess;
+  /// `sweeps` > 0 passes --sweeps (the daemon stops after that many).
+  [[nodiscard]] std::unique_ptr<ChildProcess> start_daemon(int domain, bool log_on_stdout = false,
+                                                           std::uint64_t sweeps = 0) const {
     std::vector<std::string> argv{
         CELLMAPD,      "--config",          config_.string(), "--domain", std::to_string(domain),
         "--state-dir", state_dir().string()};
+    if (sweeps > 0) argv.insert(argv.end(), {"--sweeps", std::to_string(sweeps)});
     append_flags(argv, security::Role::kDaemon);
     if (log_on_stdout) argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1"});
     return std::make_unique<ChildProcess>(argv);
@@ -93,6 +96,10 @@ class ServiceFixture {
 
   [[nodiscard]] const std::filesystem::path& state_dir() const {
     return state_dir_;
+  }
+  /// The config file start_daemon() passes; a test may rewrite it (before the start, or before a SIGHUP).
+  [[nodiscard]] const std::filesystem::path& config_file() const {
+    return config_;
   }
   [[nodiscard]] const std::string& cell() const {
     return cell_;
@@ -162,6 +169,78 @@ inline std::optional<transport::CellStatus> wait_for_status(
   return std::nullopt;
 }
 
+/// The log of a daemon started with `log_on_stdout`, read line by line as it comes. Every wait below keeps
+/// reading, so the daemon never blocks on a full pipe while the test waits for something else.
+class DaemonLog {
+ public:
+  explicit DaemonLog(ChildProcess& daemon) : daemon_(daemon) {}
+
+  /// Reads what the daemon has logged so far.
+  void drain() {
+    while (std::optional<std::string> line = daemon_.read_line(std::chrono::milliseconds(0)))
+      lines_.push_back(std::move(*line));
+  }
+  /// Reads until a line holding `text` comes (returned) or `patience` runs out or the daemon ended. Lines
+  /// an earlier wait_for() went past are not searched again.
+  std::optional<std::string> wait_for(const std::string& text,
+                                      std::chrono::milliseconds patience = kPatience) {
+    const auto deadline = std::chrono::steady_clock::now() + patience;
+    for (;;) {
+      while (searched_ < lines_.size()) {
+        const std::string& line = lines_[searched_++];
+        if (line.find(text) != std::string::npos) return line;
+      }
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return std::nullopt;
+      std::optional<std::string> line = daemon_.read_line(std::min(left, std::chrono::milliseconds(200)));
+      if (line) {
+        lines_.push_back(std::move(*line));
+      } else if (!daemon_.running()) {
+        return std::nullopt;
+      }
+    }
+  }
+  /// Lines read so far that hold `text`.
+  [[nodiscard]] std::size_t count(const std::string& text) const {
+    return static_cast<std::size_t>(std::count_if(lines_.begin(), lines_.end(), [&](const std::string& line) {
+      return line.find(text) != std::string::npos;
+    }));
+  }
+  [[nodiscard]] const std::vector<std::string>& lines() const { return lines_; }
+
+ private:
+  ChildProcess& daemon_;
+  std::vector<std::string> lines_;
+  std::size_t searched_ = 0;
+};
+
+/// wait_for_status() that reads the daemon's log meanwhile.
+inline std::optional<transport::CellStatus> wait_for_status(
+    transport::StatusReader& reader, const std::string& cell, DaemonLog& log,
+    const std::function<bool(const transport::CellStatus&)>& accept,
+    std::chrono::milliseconds patience = kPatience) {
+  const auto deadline = std::chrono::steady_clock::now() + patience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    log.drain();
+    for (const transport::CellStatus& status : reader.take(std::chrono::milliseconds(200))) {
+      if (status.cell == cell && accept(status)) return status;
+    }
+  }
+  return std::nullopt;
+}
+
+/// planner.wait_for_version() that reads the daemon's log meanwhile.
+inline bool wait_for_version(const transport::EnvironmentSubscriber& planner, std::uint64_t version,
+                             DaemonLog& log, std::chrono::milliseconds patience = kPatience) {
+  const auto deadline = std::chrono::steady_clock::now() + patience;
+  while (std::chrono::steady_clock::now() < deadline) {
+    log.drain();
+    if (planner.wait_for_version(version, std::chrono::milliseconds(200))) return true;
+  }
+  return false;
+}
+
 /// An on_change callback that records every delta the subscriber applied.
 class DeltaRecorder {
  public:
@@ -169,9 +248,14 @@ class DeltaRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     deltas_.push_back(delta);
   }
-  [[nodiscard]] EnvironmentDelta last() const {
+  /// The delta that led to `version` (picked by to_version: later versions may have come since).
+  [[nodiscard]] EnvironmentDelta to(std::uint64_t version) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return deltas_.back();
+    for (const EnvironmentDelta& delta : deltas_) {
+      if (delta.to_version == version) return delta;
+    }
+    ADD_FAILURE() << "no delta to version " << version;
+    return {};
   }
 
  private:

@@ -11,6 +11,7 @@
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
+#include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
 #include "transport/loopback.hpp"
 
@@ -19,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kKeeperDomain = 186;
+constexpr int kKeeperDomain = test::domain::kKeeper;
 constexpr auto kPatience = 30s;
 
 Box box_with_id(std::uint64_t id) {

@@ -108,24 +108,35 @@ TEST(PoseBufferTest, JointVectorsGoThroughTheRobotsKinematics) {
 TEST(PoseBufferTest, ReaderSeesConsistentPosesWhileAWriterPushes) {
   // The robot feeder and the sensor loop run on different threads: every pose a reader gets must lie on the
   // straight path being pushed (x = stamp, y = 2 stamp), never a torn or half-written sample.
+  // The writer goes on until the reader has found 1000 poses while it was pushing: the reads and the writes
+  // really overlap, however the two threads are scheduled.
   PoseBuffer buffer(0.02, 256);
   buffer.push(0.0, pose(0, 0, 0, 0));
+  constexpr int kConcurrentReads = 1000;
   std::atomic<bool> done{false};
+  std::atomic<int> newest{0};  // index of the newest pose pushed (stamp newest · 0.01 s)
+  std::atomic<int> found_while_writing{0};
   std::thread writer([&] {
-    for (int i = 1; i <= 20000; ++i) buffer.push(i * 0.01, pose(i * 0.01, i * 0.02, 0, 0));
+    for (int i = 1; i <= 20000 || (found_while_writing < kConcurrentReads && i < 50'000'000); ++i) {
+      buffer.push(i * 0.01, pose(i * 0.01, i * 0.02, 0, 0));
+      newest = i;
+    }
     done = true;
   });
   while (!done) {
-    for (double t : {0.005, 10.005, 50.0, 150.015}) {
+    const double latest = newest * 0.01;
+    for (double t : {0.005, latest - 0.005, latest - 1.0, latest - 2.0}) {
       const PoseBuffer::Result r = buffer.at(t);
       if (r.status != PoseLookup::kFound) continue;
       ASSERT_NEAR(r.X_CE.translation().x(), t, 1e-9);
       ASSERT_NEAR(r.X_CE.translation().y(), 2 * t, 1e-9);
+      ++found_while_writing;
     }
   }
   writer.join();
+  EXPECT_GE(found_while_writing, kConcurrentReads);
   EXPECT_EQ(buffer.size(), 256u);
-  EXPECT_EQ(buffer.at(199.995).status, PoseLookup::kFound);
+  EXPECT_EQ(buffer.at(newest * 0.01 - 0.005).status, PoseLookup::kFound);
   EXPECT_EQ(buffer.at(0.005).status, PoseLookup::kMissing);  // long dropped from the buffer
 }
 

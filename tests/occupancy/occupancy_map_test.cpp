@@ -58,6 +58,7 @@ TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
   EXPECT_GT(agreement.voxels, 5000u);
   EXPECT_GE(agreement.fraction(), 0.999);
   EXPECT_EQ(agreement.same, agreement.voxels);  // measured: identical, voxel for voxel
+  EXPECT_EQ(agreement.same_log_odds, agreement.voxels);
   EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
 }
 
@@ -119,6 +120,7 @@ TEST(OccupancyMapTest, ClearOnlyRaysMatchOctomapsUpdateNode) {
   const TreeAgreement agreement = compare_trees(map.tree(), reference);
   EXPECT_GT(agreement.voxels, 3000u);
   EXPECT_EQ(agreement.same, agreement.voxels);
+  EXPECT_EQ(agreement.same_log_odds, agreement.voxels);
   EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
   // Box B: hit once, then its points became clear-only rays that stop before it: its voxels stay occupied
   // (nothing cleared them), while the space in front of it got the clear-only rays' free-space evidence.

@@ -48,8 +48,11 @@ TEST(SensorComparisonTest, StereoBlocksTheMostFreeSpaceAndTheLineScannerTheLeast
   const auto coverage = [&](const std::string& m) { return rows.at(m).at(3); };
   EXPECT_GT(blocked("realsense_d435"), blocked("kinect_v2"));
   EXPECT_GT(blocked("kinect_v2"), blocked("os32c"));
+  // Measured (README): kinect_v2 0.964, realsense_d435 0.999, os32c 0.948; each floor leaves about a point.
+  const std::map<std::string, double> coverage_floor = {
+      {"kinect_v2", 0.95}, {"realsense_d435", 0.995}, {"os32c", 0.935}};
   for (const auto& [model, values] : rows) {
-    EXPECT_GT(coverage(model), 0.9) << model;
+    EXPECT_GT(coverage(model), coverage_floor.at(model)) << model;
     // The boxes file of each sensor is a valid boxes JSON with as many boxes as the table says.
     EXPECT_EQ(static_cast<double>(read_box_file(dir / (model == "kinect_v2"        ? "kinect_boxes.json"
                                                        : model == "realsense_d435" ? "realsense_boxes.json"

@@ -9,16 +9,14 @@
 #include "cellmap/preprocess/outlier_removal.hpp"
 #include "cellmap/segment/pipeline.hpp"
 #include "mosd_score.hpp"
+#include "support/shared_data.hpp"
 
 namespace cellmap {
 namespace {
 
 const std::string kDir = std::string(CELLMAP_SHARED_DATA) + "/mosd";
 
-#define SKIP_WITHOUT_DATA()                                                                    \
-  if (!std::filesystem::exists(kDir + "/learn0.pcd")) {                                        \
-    GTEST_SKIP() << kDir << " is absent: the mOSD scenes come with ../shared/data (skipping)"; \
-  }
+#define SKIP_WITHOUT_DATA() CELLMAP_SKIP_WITHOUT_DATA(kDir + "/learn0.pcd")
 
 TEST(Mosd, CoverageAndPerObjectIoUOnBoxScenes) {
   SKIP_WITHOUT_DATA();

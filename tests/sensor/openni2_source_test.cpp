@@ -35,12 +35,13 @@ TEST(OpenNI2SourceTest, NoDeviceIsACleanDisconnectedStatusWithTheReason) {
   EXPECT_NE(status.reason.find("no devices found"), std::string::npos) << status.reason;
   EXPECT_EQ(status.reason.find('\n'), std::string::npos);
   EXPECT_EQ(status.attempts, 1u);
-  // next() keeps retrying with back-off and never delivers a frame.
-  const auto until = std::chrono::steady_clock::now() + milliseconds(300);
-  while (std::chrono::steady_clock::now() < until) EXPECT_FALSE(source.next(milliseconds(20)).has_value());
+  // next() keeps retrying and never delivers a frame. (When the attempts are due, the back-off, is tested on
+  // a clock the test drives: reconnect_test.cpp.)
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (source.status().attempts < 3 && std::chrono::steady_clock::now() < deadline)
+    EXPECT_FALSE(source.next(milliseconds(20)).has_value());
   EXPECT_EQ(source.status().state, SourceState::kDisconnected);
   EXPECT_GE(source.status().attempts, 3u);
-  EXPECT_LE(source.status().attempts, 16u);  // back-off: 20, 40, 80, 100, 100 ms … not one attempt per call
   source.close();
   EXPECT_EQ(source.status().state, SourceState::kClosed);
 }
@@ -116,10 +117,11 @@ TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
     EXPECT_GT(expected_far, 300);
     EXPECT_GT(frame.points_S.size(), 320u);  // plus the disc near 1 m
   }
-  // Device stamps (33 ms apart) mapped to the host's realtime clock; the mapping's offset only shrinks, by as
-  // much as the delivery delay improves between frames (a few ms under load).
+  // Device stamps (33 ms apart) mapped to the host's realtime clock; the mapping's offset only shrinks, so
+  // mapped stamps are never farther apart than the device's (DeviceClockTest checks the mapping on given
+  // arrival times; how much it shrinks here depends on the delivery delays of a loaded machine).
   EXPECT_LE(frames[2].stamp - frames[1].stamp, 0.033 + 1e-6);
-  EXPECT_GE(frames[2].stamp - frames[1].stamp, 0.023);
+  EXPECT_GT(frames[2].stamp, frames[1].stamp);
   EXPECT_NEAR(frames[0].stamp, realtime_seconds(), 5.0);
   EXPECT_EQ(source.status().frames, 3u);
   source.close();

@@ -2,6 +2,7 @@
 // Small helpers shared by the tests.
 
 #include <stdlib.h>
+#include <sys/wait.h>
 
 #include <filesystem>
 #include <functional>
@@ -29,6 +30,13 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+/// The exit code of a child process from its wait status (waitpid, pclose, std::system), or -1 when a signal
+/// ended it: a check `exit_code(status) == 0` fails on a crash, which `WEXITSTATUS(status) == 0` alone
+/// passes.
+inline int exit_code(int wait_status) {
+  return WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+}
 
 /// The message of the cellmap::Error that `f` throws, or "" if it throws none.
 inline std::string error_of(const std::function<void()>& f) {

@@ -7,7 +7,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -45,7 +47,8 @@ class ChildProcess {
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
 
-  /// The next line of the child's stdout (without '\n'), or nullopt on timeout or end of output.
+  /// The next line of the child's stdout (without '\n'), or nullopt on timeout or end of output. A zero
+  /// timeout returns a line only if one is already there.
   std::optional<std::string> read_line(std::chrono::milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     for (;;) {
@@ -55,11 +58,15 @@ class ChildProcess {
         buffer_.erase(0, newline + 1);
         return line;
       }
+      if (out_ < 0) return std::nullopt;
       const auto left =
           std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0 || out_ < 0) return std::nullopt;
       pollfd p{out_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
+      // Polls at least once, so a zero timeout still picks up what is already there.
+      if (::poll(&p, 1, static_cast<int>(std::max<std::int64_t>(left.count(), 0))) <= 0) {
+        if (left.count() <= 0) return std::nullopt;
+        continue;
+      }
       char chunk[4096];
       const ssize_t n = ::read(out_, chunk, sizeof chunk);
       if (n <= 0) {

@@ -9,6 +9,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "loopback.hpp"
+#include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
 
 namespace cellmap::transport {
@@ -16,7 +17,7 @@ namespace {
 
 using namespace std::chrono_literals;
 constexpr auto kPatience = 30s;
-constexpr std::uint32_t kDomain = 222;
+constexpr std::uint32_t kDomain = test::domain::kLayers;
 
 TEST(VoxelRunsTest, NeighboursAlongXJoinOneRun) {
   // Sorted by (z, y, x): a row of three, a gap, one more on that row, then one on the next row and level.

@@ -11,6 +11,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "loopback.hpp"
+#include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
 
 namespace cellmap::transport {
@@ -49,8 +50,8 @@ std::vector<RobotJoints> take_until(RobotJointsReader& reader, std::size_t count
 
 TEST(RobotJointsTest, ReaderGetsItsCellsSamplesInTheRobotsJointOrder) {
   test::use_loopback();
-  dds::Participant controller(100);
-  dds::Participant daemon(100);
+  dds::Participant controller(test::domain::kJointsInOrder);
+  dds::Participant daemon(test::domain::kJointsInOrder);
   RobotJointsReader reader(daemon, "cell-a", kJoints);
   RobotJointsWriter writer(controller);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
@@ -83,8 +84,8 @@ TEST(RobotJointsTest, ReaderGetsItsCellsSamplesInTheRobotsJointOrder) {
 
 TEST(RobotJointsTest, SamplesThatDoNotFitTheRobotAreRefusedAndCounted) {
   test::use_loopback();
-  dds::Participant controller(101);
-  dds::Participant daemon(101);
+  dds::Participant controller(test::domain::kJointsRefused);
+  dds::Participant daemon(test::domain::kJointsRefused);
   InputLimits limits;
   limits.max_stamp_skew = 5s;
   std::string last_refusal;
@@ -124,17 +125,18 @@ TEST(RobotJointsTest, SamplesThatDoNotFitTheRobotAreRefusedAndCounted) {
 
 TEST(RobotJointsTest, RobotPoseCommandPublishesNamedJointsWithAPayload) {
   test::use_loopback();
-  dds::Participant daemon(102);
+  dds::Participant daemon(test::domain::kJointsCommand);
   RobotJointsReader reader(daemon, "desk", kJoints);
-  const std::string command = std::string(CELLMAP_TOOL) +
-                              " robot-pose --domain 102 --cell desk --joints j2=0.5,j1=-1,j3=2 --payload "
-                              "0,0,0.1,0.2,0.15,0.1 --rate 50 --duration 0.3 2>&1";
+  const std::string command =
+      std::string(CELLMAP_TOOL) + " robot-pose --domain " + std::to_string(test::domain::kJointsCommand) +
+      " --cell desk --joints j2=0.5,j1=-1,j3=2 --payload 0,0,0.1,0.2,0.15,0.1 --rate 50"
+      " --duration 0.3 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string output;
   char buffer[256];
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  ASSERT_EQ(::pclose(pipe), 0) << output;
+  ASSERT_EQ(test::exit_code(::pclose(pipe)), 0) << output;
   const std::vector<RobotJoints> got = take_until(reader, 10);
   ASSERT_EQ(output, "sent " + std::to_string(got.size()) + " joint states\n");
   ASSERT_GE(got.size(), 10u);  // 50 Hz for 0.3 s
@@ -150,7 +152,7 @@ TEST(RobotJointsTest, RobotPoseCommandPublishesNamedJointsWithAPayload) {
     ASSERT_NE(pipe, nullptr);
     output.clear();
     while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-    EXPECT_NE(::pclose(pipe), 0);
+    EXPECT_EQ(test::exit_code(::pclose(pipe)), 1);
     EXPECT_EQ(output.rfind("cellmap: ", 0), 0u) << output;
     EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
   }

@@ -6,9 +6,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include "cellmap/common/error.hpp"
 #include "loopback.hpp"
+#include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
 
 namespace cellmap::transport {
@@ -38,8 +41,8 @@ std::vector<RobotState> take_until(RobotStateReader& reader, std::size_t count) 
 
 TEST(RobotStateTest, ReaderGetsItsCellsPosesInOrder) {
   test::use_loopback();
-  dds::Participant controller(180);
-  dds::Participant daemon(180);
+  dds::Participant controller(test::domain::kPosesInOrder);
+  dds::Participant daemon(test::domain::kPosesInOrder);
   RobotStateReader reader(daemon, "cell-a");
   RobotStateWriter writer(controller);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
@@ -62,8 +65,8 @@ TEST(RobotStateTest, ReaderGetsItsCellsPosesInOrder) {
 
 TEST(RobotStateTest, MalformedPosesAreRejectedNotFused) {
   test::use_loopback();
-  dds::Participant controller(181);
-  dds::Participant daemon(181);
+  dds::Participant controller(test::domain::kPosesRejected);
+  dds::Participant daemon(test::domain::kPosesRejected);
   RobotStateReader reader(daemon, "cell-a");
   RobotStateWriter writer(controller);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
@@ -87,12 +90,11 @@ TEST(RobotStateTest, MalformedPosesAreRejectedNotFused) {
 
 TEST(RobotStateTest, RobotPoseCommandPublishesAStandingToolPose) {
   test::use_loopback();
-  dds::Participant daemon(185);
+  dds::Participant daemon(test::domain::kPoseCommand);
   RobotStateReader reader(daemon, "desk");
-  const std::string command =
-      std::string(CELLMAP_TOOL) +
-      " robot-pose --domain 185 --cell desk --pose 1,2,1.5,0.5,-0.5,0.5,-0.5 --rate 50"
-      " --duration 0.5 2>&1";
+  const std::string command = std::string(CELLMAP_TOOL) + " robot-pose --domain " +
+                              std::to_string(test::domain::kPoseCommand) +
+                              " --cell desk --pose 1,2,1.5,0.5,-0.5,0.5,-0.5 --rate 50 --duration 0.5 2>&1";
   const auto before_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                              std::chrono::system_clock::now().time_since_epoch())
                              .count();
@@ -101,7 +103,7 @@ TEST(RobotStateTest, RobotPoseCommandPublishesAStandingToolPose) {
   std::string output;
   char buffer[256];
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  ASSERT_EQ(::pclose(pipe), 0) << output;
+  ASSERT_EQ(test::exit_code(::pclose(pipe)), 0) << output;
   const std::vector<RobotState> got = take_until(reader, 25);
   ASSERT_EQ(output, "sent " + std::to_string(got.size()) + " poses\n");
   ASSERT_GE(got.size(), 20u);  // 50 Hz for 0.5 s
@@ -121,8 +123,32 @@ TEST(RobotStateTest, RobotPoseCommandPublishesAStandingToolPose) {
   ASSERT_NE(pipe, nullptr);
   output.clear();
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  EXPECT_NE(::pclose(pipe), 0);
+  EXPECT_EQ(test::exit_code(::pclose(pipe)), 1);
   EXPECT_EQ(output.rfind("cellmap: --pose", 0), 0u) << output;
+}
+
+// The tools that need a daemon on the other end say so and exit 1 when there is none (nobody joins the
+// domain).
+TEST(RobotStateTest, RobotPoseAndInjectWithNobodyListeningFailWithTheirMessage) {
+  test::use_loopback();
+  const auto run = [](const std::string& arguments) {
+    FILE* pipe = ::popen((std::string(CELLMAP_TOOL) + " " + arguments + " 2>&1").c_str(), "r");
+    std::string output;
+    char buffer[256];
+    while (pipe != nullptr && std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+    const int code = pipe == nullptr ? -1 : test::exit_code(::pclose(pipe));
+    return std::make_pair(code, output);
+  };
+  const std::string domain = std::to_string(test::domain::kNobodyListening);
+  const auto [pose_code, pose_output] =
+      run("robot-pose --domain " + domain + " --cell desk --pose 1,2,3 --wait 1");
+  EXPECT_EQ(pose_code, 1) << pose_output;
+  EXPECT_EQ(pose_output,
+            "cellmap: robot-pose: no cellmapd reading robot poses on domain " + domain + " within 1 s\n");
+  const auto [inject_code, inject_output] =
+      run("inject --domain " + domain + " --wait 1 add-box --center 1,1,1 --half-extents 0.1,0.1,0.1");
+  EXPECT_EQ(inject_code, 1) << inject_output;
+  EXPECT_EQ(inject_output, "cellmap: inject: no simulating cellmapd on domain " + domain + " within 1 s\n");
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "child_process.hpp"
 #include "loopback.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap::transport {
 namespace {
@@ -50,7 +51,7 @@ class TransportE2eTest : public ::testing::Test {
 };
 
 TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
-  constexpr int kDomain = 121;
+  constexpr int kDomain = test::domain::kLateJoinerProcess;
   test::TempDir dir;
   test::ChildProcess daemon(helper(kDomain, dir.path(), 10, 0));
   std::vector<std::uint64_t> published;
@@ -88,13 +89,13 @@ TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
     EXPECT_EQ(deltas[i]["added"].size() + deltas[i]["modified"].size(), 1u);
     EXPECT_TRUE(deltas[i]["removed"].empty());
   }
-  EXPECT_EQ(WEXITSTATUS(echo.wait()), 0);
+  EXPECT_EQ(test::exit_code(echo.wait()), 0);
   daemon.signal(SIGTERM);
-  EXPECT_EQ(WEXITSTATUS(daemon.wait()), 0);
+  EXPECT_EQ(test::exit_code(daemon.wait()), 0);
 }
 
 TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
-  constexpr int kDomain = 123;
+  constexpr int kDomain = test::domain::kFallsBehind;
   test::TempDir dir;
   const dds::Participant planner(kDomain);
   std::mutex gate;
@@ -127,7 +128,7 @@ TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
 }
 
 TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
-  constexpr int kDomain = 122;
+  constexpr int kDomain = test::domain::kKilledPublisher;
   test::TempDir dir;
   const dds::Participant planner(kDomain);
   std::mutex mutex;
@@ -165,7 +166,7 @@ TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
   EXPECT_GT(published.size(), 8u);
   EXPECT_EQ(unique.size(), published.size());
   daemon.signal(SIGTERM);
-  EXPECT_EQ(WEXITSTATUS(daemon.wait()), 0);
+  EXPECT_EQ(test::exit_code(daemon.wait()), 0);
 
   // The planner's copy is what the store persisted; it only ever grew, and no box was ever removed.
   const VersionStore store(dir.path(), "cell-e2e");

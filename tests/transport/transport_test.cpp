@@ -16,6 +16,7 @@
 #include "cellmap/transport/status_reader.hpp"
 #include "loopback.hpp"
 #include "scene_steps.hpp"
+#include "support/dds_domains.hpp"
 #include "support/test_credentials.hpp"
 
 namespace cellmap::transport {
@@ -52,8 +53,8 @@ Environment publish_versions(EnvironmentPublisher& publisher, Environment env, s
 }
 
 TEST_F(TransportTest, SubscriberReceivesEveryVersionWithItsDelta) {
-  dds::Participant daemon(110);
-  dds::Participant planner(110);
+  dds::Participant daemon(test::domain::kEveryVersion);
+  dds::Participant planner(test::domain::kEveryVersion);
   EnvironmentPublisher publisher(daemon, "cell-a");
   Recorded recorded;
   EnvironmentSubscriber subscriber(planner, "cell-a", recorded.callback());
@@ -82,13 +83,13 @@ TEST_F(TransportTest, SubscriberReceivesEveryVersionWithItsDelta) {
 }
 
 TEST_F(TransportTest, LateJoinerGetsTheCurrentEnvironmentAtOnce) {
-  dds::Participant daemon(111);
+  dds::Participant daemon(test::domain::kLateJoiner);
   EnvironmentPublisher publisher(daemon, "cell-a");
   Environment env = test::next_environment(Environment("cell-a"), 1, 1);
   publisher.publish(env);
   const Environment last = publish_versions(publisher, env, 10);
 
-  dds::Participant planner(111);
+  dds::Participant planner(test::domain::kLateJoiner);
   Recorded recorded;
   EnvironmentSubscriber subscriber(planner, "cell-a", recorded.callback());
   ASSERT_TRUE(subscriber.wait_for_version(10, kPatience)) << subscriber.last_error();
@@ -100,8 +101,8 @@ TEST_F(TransportTest, LateJoinerGetsTheCurrentEnvironmentAtOnce) {
 }
 
 TEST_F(TransportTest, VersionPublishedWholeIsTakenAsASnapshot) {
-  dds::Participant daemon(112);
-  dds::Participant planner(112);
+  dds::Participant daemon(test::domain::kWholeVersion);
+  dds::Participant planner(test::domain::kWholeVersion);
   EnvironmentPublisher publisher(daemon, "cell-a");
   Recorded recorded;
   EnvironmentSubscriber subscriber(planner, "cell-a", recorded.callback());
@@ -124,8 +125,8 @@ TEST_F(TransportTest, VersionPublishedWholeIsTakenAsASnapshot) {
 }
 
 TEST_F(TransportTest, SlowSubscriberLosesDeltasAndResyncs) {
-  dds::Participant daemon(113);
-  dds::Participant planner(113);
+  dds::Participant daemon(test::domain::kSlowSubscriber);
+  dds::Participant planner(test::domain::kSlowSubscriber);
   EnvironmentPublisher publisher(daemon, "cell-a");
   std::mutex gate;
   std::unique_lock<std::mutex> hold(gate);  // the first callback blocks until the burst is out
@@ -153,18 +154,18 @@ TEST_F(TransportTest, SlowSubscriberLosesDeltasAndResyncs) {
 }
 
 TEST_F(TransportTest, PublisherRestartDoesNotRemoveBoxes) {
-  dds::Participant planner(114);
+  dds::Participant planner(test::domain::kPublisherRestart);
   Recorded recorded;
   EnvironmentSubscriber subscriber(planner, "cell-a", recorded.callback());
   Environment env = test::next_environment(Environment("cell-a"), 1, 1);
   {
-    dds::Participant daemon(114);
+    dds::Participant daemon(test::domain::kPublisherRestart);
     EnvironmentPublisher publisher(daemon, "cell-a");
     publisher.publish(env);
     env = publish_versions(publisher, env, 5);
     ASSERT_TRUE(subscriber.wait_for_version(5, kPatience));
   }  // the daemon goes away: writers deleted without disposing
-  dds::Participant daemon(114);
+  dds::Participant daemon(test::domain::kPublisherRestart);
   EnvironmentPublisher publisher(daemon, "cell-a");
   // A restarted daemon republishes what it persisted, then continues.
   publisher.publish(env);
@@ -176,8 +177,8 @@ TEST_F(TransportTest, PublisherRestartDoesNotRemoveBoxes) {
 }
 
 TEST_F(TransportTest, CellsShareADomainWithoutMixing) {
-  dds::Participant daemon(115);
-  dds::Participant planner(115);
+  dds::Participant daemon(test::domain::kCellsShareADomain);
+  dds::Participant planner(test::domain::kCellsShareADomain);
   EnvironmentPublisher cell_a(daemon, "cell-a");
   EnvironmentPublisher cell_b(daemon, "cell-b");
   EnvironmentSubscriber subscriber(planner, "cell-b");
@@ -190,8 +191,8 @@ TEST_F(TransportTest, CellsShareADomainWithoutMixing) {
 }
 
 TEST_F(TransportTest, MonitorSeesSnapshotsAndDeltasInOrder) {
-  dds::Participant daemon(116);
-  dds::Participant watcher(116);
+  dds::Participant daemon(test::domain::kMonitor);
+  dds::Participant watcher(test::domain::kMonitor);
   EnvironmentPublisher publisher(daemon, "cell-a");
   EnvironmentMonitor monitor(watcher);
   ASSERT_TRUE(publisher.wait_for_subscribers(1, kPatience));
@@ -228,8 +229,8 @@ TEST_F(TransportTest, MonitorSeesSnapshotsAndDeltasInOrder) {
 }
 
 TEST_F(TransportTest, SceneEditsArriveIntact) {
-  dds::Participant simulator(117);
-  dds::Participant tool(117);
+  dds::Participant simulator(test::domain::kSceneEdits);
+  dds::Participant tool(test::domain::kSceneEdits);
   SceneEditReader reader(simulator);
   SceneEditWriter writer(tool);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
@@ -263,7 +264,7 @@ TEST_F(TransportTest, SceneEditsArriveIntact) {
 }
 
 TEST_F(TransportTest, StatusReachesALateReader) {
-  dds::Participant daemon(119);
+  dds::Participant daemon(test::domain::kStatusLateReader);
   EnvironmentPublisher publisher(daemon, "cell-a");
   CellStatus status;
   status.cell = "cell-a";
@@ -276,7 +277,7 @@ TEST_F(TransportTest, StatusReachesALateReader) {
   status.version = 9;
   publisher.publish_status(status);
   EXPECT_THROW(publisher.publish_status(CellStatus{}), Error);  // another cell
-  dds::Participant monitor(119);
+  dds::Participant monitor(test::domain::kStatusLateReader);
   StatusReader reader(monitor);
   std::vector<CellStatus> reports;
   const auto deadline = std::chrono::steady_clock::now() + kPatience;
@@ -294,7 +295,7 @@ TEST_F(TransportTest, StatusReachesALateReader) {
 }
 
 TEST_F(TransportTest, PublisherRefusesWrongVersionsAndCells) {
-  dds::Participant daemon(118);
+  dds::Participant daemon(test::domain::kPublisherRefuses);
   EnvironmentPublisher publisher(daemon, "cell-a");
   EXPECT_THROW(publisher.publish(Environment("cell-a")), Error);  // version 0
   EXPECT_THROW(publisher.publish(Environment("cell-b", 1, 0, {})), Error);
@@ -321,14 +322,17 @@ TEST_F(TransportTest, AProcessTakesOneSecuritySettingPerDomain) {
     return false;
   };
   {
-    const dds::Participant planner(124, credentials.as(security::Role::kPlanner));
-    const dds::Participant same_setting(124, credentials.as(security::Role::kPlanner));
-    EXPECT_TRUE(refused([] { dds::Participant plain(124); }));
-    EXPECT_TRUE(refused([&] { dds::Participant tool(124, credentials.as(security::Role::kTool)); }));
-    const dds::Participant other_domain(126);
+    const dds::Participant planner(test::domain::kSecuritySetting, credentials.as(security::Role::kPlanner));
+    const dds::Participant same_setting(test::domain::kSecuritySetting,
+                                        credentials.as(security::Role::kPlanner));
+    EXPECT_TRUE(refused([] { dds::Participant plain(test::domain::kSecuritySetting); }));
+    EXPECT_TRUE(refused([&] {
+      dds::Participant tool(test::domain::kSecuritySetting, credentials.as(security::Role::kTool));
+    }));
+    const dds::Participant other_domain(test::domain::kSecuritySettingOther);
   }
   // Once the secured participants are gone the domain takes any setting again.
-  const dds::Participant plain(124);
+  const dds::Participant plain(test::domain::kSecuritySetting);
   EXPECT_FALSE(plain.credentials());
 }
 

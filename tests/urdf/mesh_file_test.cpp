@@ -16,6 +16,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/urdf/urdf_model.hpp"
+#include "support/shared_data.hpp"
 #include "support/test_support.hpp"
 
 namespace cellmap {
@@ -61,9 +62,7 @@ Eigen::Isometry3d pose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R = Eige
   return X;
 }
 
-#define SKIP_WITHOUT_ABB()                                                                  \
-  if (!fs::exists(kAbbPackage)) GTEST_SKIP() << "no robot descriptions at " << kAbbPackage; \
-  static_assert(true)
+#define SKIP_WITHOUT_ABB() CELLMAP_SKIP_WITHOUT_DATA(kAbbPackage)
 
 TEST(MeshFileTest, AbbIrb2400LoadsWithItsSevenStlCollisionMeshes) {
   SKIP_WITHOUT_ABB();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "cellmap/common/error.hpp"
@@ -102,8 +103,10 @@ void publish_on(const RobotPoseOptions& options, Message message, const std::str
   const dds::Participant participant(options.domain, options.security.setting());
   const Writer writer(participant);
   if (!writer.wait_for_reader(seconds(options.wait))) {
-    throw Error("robot-pose: no cellmapd reading robot " + what + " on domain " +
-                std::to_string(options.domain) + " within " + std::to_string(options.wait) + " s");
+    std::ostringstream reason;  // the wait as given ("1 s", not "1.000000 s")
+    reason << "robot-pose: no cellmapd reading robot " << what << " on domain " << options.domain
+           << " within " << options.wait << " s";
+    throw Error(reason.str());
   }
   const std::uint64_t sent = repeat(options, [&](std::int64_t stamp_ns) {
     message.stamp_ns = stamp_ns;

@@ -31,8 +31,7 @@ void append_known(const octomap::OcTree& tree, std::vector<std::uint64_t>& out) 
 }
 
 // 0 unknown, 1 free, 2 occupied.
-int state(const octomap::OcTree& tree, const octomap::OcTreeKey& key) {
-  const octomap::OcTreeNode* node = tree.search(key);
+int state(const octomap::OcTree& tree, const octomap::OcTreeNode* node) {
   if (node == nullptr) return 0;
   return tree.isNodeOccupied(node) ? 2 : 1;
 }
@@ -54,9 +53,12 @@ TreeAgreement compare_trees(const octomap::OcTree& a, const octomap::OcTree& b) 
     const octomap::OcTreeKey key(static_cast<std::uint16_t>(p & 0xffff),
                                  static_cast<std::uint16_t>((p >> 16) & 0xffff),
                                  static_cast<std::uint16_t>(p >> 32));
-    const int sa = state(a, key);
-    const int sb = state(b, key);
+    const octomap::OcTreeNode* na = a.search(key);
+    const octomap::OcTreeNode* nb = b.search(key);
+    const int sa = state(a, na);
+    const int sb = state(b, nb);
     if (sa == sb) ++result.same;
+    if (na != nullptr && nb != nullptr && na->getLogOdds() == nb->getLogOdds()) ++result.same_log_odds;
     if (sa == 2) ++result.occupied_a;
     if (sb == 2) ++result.occupied_b;
     if (sa == 2 && sb == 2) ++result.occupied_both;

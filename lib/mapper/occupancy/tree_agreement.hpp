@@ -12,6 +12,7 @@ namespace cellmap {
 struct TreeAgreement final {
   std::size_t voxels = 0;         ///< voxels known in at least one tree
   std::size_t same = 0;           ///< of those, voxels in the same state (unknown/free/occupied) in both
+  std::size_t same_log_odds = 0;  ///< of those, voxels known in both with bit-identical log-odds
   std::size_t occupied_a = 0;     ///< occupied voxels of the first tree
   std::size_t occupied_b = 0;     ///< occupied voxels of the second tree
   std::size_t occupied_both = 0;  ///< voxels occupied in both
@@ -21,7 +22,8 @@ struct TreeAgreement final {
 };
 
 /// Compares `a` and `b` at leaf resolution (pruned nodes are expanded); each tree's state uses its own
-/// occupancy threshold. Both must have the same resolution. Cost: O(known voxels) searches in each tree.
+/// occupancy threshold. Two trees are the same voxel for voxel when same_log_odds == voxels. Both must have
+/// the same resolution. Cost: O(known voxels) searches in each tree.
 /// @throws Error if the resolutions differ.
 [[nodiscard]] TreeAgreement compare_trees(const octomap::OcTree& a, const octomap::OcTree& b);
 

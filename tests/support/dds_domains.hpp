@@ -1,0 +1,80 @@
+#pragma once
+// Every DDS domain id the tests use, in one table. ctest runs tests side by side (-j 2) and DDS tests on
+// loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
+// A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), the
+// browser test 220-221 (tests/view/view_browser_test.py), the working arm cell 160-161, 164-169 and
+// 173-179 (tests/daemon/working_cell_e2e_test.cpp and what it reserves), scripts/soak 179. Credentials tests
+// name domains 7, 197 and 233 without joining them.
+
+namespace cellmap::test::domain {
+
+// transport_test: in-process publisher and subscribers.
+inline constexpr int kEveryVersion = 110;
+inline constexpr int kLateJoiner = 111;
+inline constexpr int kWholeVersion = 112;
+inline constexpr int kSlowSubscriber = 113;
+inline constexpr int kPublisherRestart = 114;
+inline constexpr int kCellsShareADomain = 115;
+inline constexpr int kMonitor = 116;
+inline constexpr int kSceneEdits = 117;
+inline constexpr int kPublisherRefuses = 118;
+inline constexpr int kStatusLateReader = 119;
+inline constexpr int kSecuritySetting = 124;
+inline constexpr int kSecuritySettingOther = 126;
+
+// transport_e2e_test: the publisher helper and `cellmap echo` as processes.
+inline constexpr int kLateJoinerProcess = 121;
+inline constexpr int kKilledPublisher = 122;
+inline constexpr int kFallsBehind = 123;
+
+// robot_joints_test, robot_state_test (`cellmap robot-pose` and `inject` as processes).
+inline constexpr int kJointsInOrder = 100;
+inline constexpr int kJointsRefused = 101;
+inline constexpr int kJointsCommand = 102;
+inline constexpr int kPosesInOrder = 180;
+inline constexpr int kPosesRejected = 181;
+inline constexpr int kPoseCommand = 185;
+inline constexpr int kNobodyListening = 204;  // nobody joins it: the tools must say so
+
+// cellmapd_e2e_test (Secure*: the same tests with DDS Security on).
+inline constexpr int kAddRemove = 150;
+inline constexpr int kRestart = 151;
+inline constexpr int kSecureAddRemove = 190;
+inline constexpr int kSecureRestart = 191;
+inline constexpr int kReload = 200;
+inline constexpr int kResume = 203;
+inline constexpr int kMailbox = 205;
+
+// planner_e2e_test.
+inline constexpr int kPlanner = 170;
+inline constexpr int kKill = 171;
+inline constexpr int kSecurePlanner = 192;
+
+// camera_e2e_test.
+inline constexpr int kUnplugged = 162;
+inline constexpr int kJointsCamera = 163;
+inline constexpr int kReplay = 182;
+inline constexpr int kNoDevice = 183;
+inline constexpr int kRobotPose = 184;
+inline constexpr int kReplayEnded = 201;
+inline constexpr int kReplayError = 202;
+
+// daemon_test: the daemon's parts in process.
+inline constexpr int kKeeper = 186;
+inline constexpr int kSimAcquisition = 187;
+inline constexpr int kLayerPublisher = 223;
+
+// faults_e2e_test.
+inline constexpr int kFirstVersionFault = 188;
+inline constexpr int kLaterVersionFault = 189;
+
+// security_e2e_test.
+inline constexpr int kAttack = 193;
+inline constexpr int kRoles = 194;
+inline constexpr int kOtherCa = 195;
+inline constexpr int kRefusal = 196;
+
+// transport_test: the viewer's layers.
+inline constexpr int kLayers = 222;
+
+}  // namespace cellmap::test::domain
