@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "reload.hpp"
 
 namespace cellmap::daemon {
@@ -145,7 +146,7 @@ void Daemon::process() {
 void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
   try {
     const SweepReport report = pipeline_.process(sweep);
-    health_.sweep_processed(number, system_now_ns());
+    health_.sweep_processed(number, wall_clock_ns());
     spdlog::info(
         "sweep {}: {} frames, {} points, {} on the robot, {} hit / {} free voxels, {} flipped, {} change "
         "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; "

@@ -5,6 +5,7 @@
 #include <array>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "versions.hpp"
 
 namespace cellmap::daemon {
@@ -70,7 +71,7 @@ void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map
   const std::uint32_t joined = writer_.readers_joined(Layer::kVoxels);
   std::vector<transport::VoxelRun> runs = occupied_runs(map);
   if (runs == voxels_written_ && joined == voxel_readers_served_) return;
-  transport::VoxelLayer layer{writer_.cell(), sweep, system_now_ns(), map.config().resolution,
+  transport::VoxelLayer layer{writer_.cell(), sweep, wall_clock_ns(), map.config().resolution,
                               std::move(runs)};
   writer_.write(layer);
   if (joined != voxel_readers_served_) {
@@ -84,7 +85,7 @@ void LayerPublisher::publish_voxels(std::uint64_t sweep, const OccupancyMap& map
 void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& changes) {
   const std::uint32_t joined = writer_.readers_joined(Layer::kChangeRegions);
   if (changes.empty() && joined == region_readers_served_) return;
-  transport::ChangeRegionLayer layer{writer_.cell(), sweep, system_now_ns(), {}};
+  transport::ChangeRegionLayer layer{writer_.cell(), sweep, wall_clock_ns(), {}};
   for (const ChangeRegion& region : changes.regions) {
     layer.regions.push_back({region.bounds, static_cast<std::uint32_t>(region.appeared.size()),
                              static_cast<std::uint32_t>(region.vanished.size())});
@@ -99,7 +100,7 @@ void LayerPublisher::publish_regions(std::uint64_t sweep, const ChangeSet& chang
 
 void LayerPublisher::publish_sensors(std::uint64_t number, const FrameSweep& sweep) {
   const std::uint32_t joined = writer_.readers_joined(Layer::kSensors);
-  transport::SensorLayer layer{writer_.cell(), number, system_now_ns(), {}};
+  transport::SensorLayer layer{writer_.cell(), number, wall_clock_ns(), {}};
   for (const SweepFrame& taken : sweep.frames) {
     const Frame& frame = taken.frame;
     layer.views.push_back({frame.sensor, frame.X_CS, field_of_view(frame)});

@@ -48,12 +48,6 @@ CellPipeline recover_pipeline(const CellPipelineConfig& config, const RecoveredS
   return CellPipeline(config, boxes, recovered.next_box_id);
 }
 
-std::int64_t system_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 VersionKeeper::VersionKeeper(VersionStore& store, Publish publish, WallClock clock)
     : store_(store),
       publish_(std::move(publish)),

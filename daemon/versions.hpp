@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/environment/environment.hpp"
 #include "cellmap/environment/version_store.hpp"
 
@@ -20,8 +21,6 @@ namespace cellmap::daemon {
 
 /// Nanoseconds since the Unix epoch.
 using WallClock = std::function<std::int64_t()>;
-/// The system clock (CLOCK_REALTIME), what version stamps are measured on.
-[[nodiscard]] std::int64_t system_now_ns();
 
 /// Gets every version of the cell out, in the order that keeps a number seen by subscribers on disk:
 /// numbers it (VersionStore::next_version()), stamps it (the wall clock, but always above the previous stamp:
@@ -41,7 +40,7 @@ class VersionKeeper final {
   /// the first) to `env`. @throws Error when the write fails.
   using Publish = std::function<void(const Environment& env, const EnvironmentDelta& delta)>;
 
-  VersionKeeper(VersionStore& store, Publish publish, WallClock clock = system_now_ns);
+  VersionKeeper(VersionStore& store, Publish publish, WallClock clock = wall_clock_ns);
 
   /// At start: announces what the state directory holds, under the number VersionStore::resume() gives
   /// (saved again with `pipeline`'s map state when a newer number may have been lost). Faults as in flush().

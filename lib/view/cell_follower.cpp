@@ -1,15 +1,8 @@
 #include "cellmap/view/cell_follower.hpp"
 
+#include "cellmap/common/wall_clock.hpp"
+
 namespace cellmap::view {
-namespace {
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 CellFollower::CellFollower(const dds::Participant& participant, std::string cell, ViewState& state,
                            Publish publish)
@@ -26,7 +19,7 @@ void CellFollower::follow(const std::string& cell) {
   // The callback runs on the subscriber's thread as each version reaches the local copy.
   subscribers_[cell] = std::make_unique<transport::EnvironmentSubscriber>(
       participant_, cell, [this](const Environment& env, const EnvironmentDelta& delta) {
-        std::string message = state_.on_version(env, delta, now_ns());
+        std::string message = state_.on_version(env, delta, wall_clock_ns());
         if (!message.empty()) publish_(std::move(message));
       });
 }

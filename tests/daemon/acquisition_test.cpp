@@ -16,7 +16,6 @@ namespace cellmap::daemon {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kSimDomain = test::domain::kSimAcquisition;
 
 // Points of `sweep` inside the axis-aligned box at `centre` with `half_extents` grown by 5 mm, leaving out
 // the 5 cm above the table it stands on.
@@ -48,7 +47,7 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   test::use_loopback();
   DaemonConfig config =
       DaemonConfig::parse("cell: bench-7\nsweep_period: 0\nsource: {noise: false}\n", "test.yaml", ".");
-  const dds::Participant participant(kSimDomain);
+  const dds::Participant participant(test::domain::kSimAcquisition);
   LatestMailbox<FrameSweep> mailbox;
   Health health(config.cell, {config.sources[0].sensor});
   std::vector<std::string> refusal_lines;

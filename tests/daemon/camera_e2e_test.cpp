@@ -11,6 +11,7 @@
 #include <fstream>
 #include <thread>
 
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 #include "cellmap/sensor/replay_source.hpp"
@@ -28,13 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kReplayDomain = test::domain::kReplay;
-constexpr int kNoDeviceDomain = test::domain::kNoDevice;
-constexpr int kRobotPoseDomain = test::domain::kRobotPose;
-constexpr int kUnpluggedDomain = test::domain::kUnplugged;
-constexpr int kJointsDomain = test::domain::kJointsCamera;
-constexpr int kEndedDomain = test::domain::kReplayEnded;
-constexpr int kErrorDomain = test::domain::kReplayError;
 
 // Debian's OpenNI2 Dummy device at 320x240 (see below).
 const char* kDummy =
@@ -93,10 +87,10 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
       "cell: replay\nsweep_period: 0\nstatus_period: 0.2\nsource:\n  kind: replay\n"
       "  sensor: grabber\n  replay: {directory: replay, playback: fastest}\n";
 
-  const dds::Participant participant(kReplayDomain);
+  const dds::Participant participant(test::domain::kReplay);
   transport::EnvironmentSubscriber planner(participant, "replay");
   transport::StatusReader reader(participant);
-  auto daemon = start_daemon(yaml, kReplayDomain, kSweeps);
+  auto daemon = start_daemon(yaml, test::domain::kReplay, kSweeps);
   EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version published from the replay";
   const auto stopped = test::wait_for_status(
       reader, "replay", [](const transport::CellStatus& s) { return s.state == "stopped"; });
@@ -159,7 +153,7 @@ class DegradedReplayTest : public CameraE2eTest, public ::testing::WithParamInte
 
 TEST_P(DegradedReplayTest, KeepsTheLastVersionPublished) {
   const bool bad_frame = GetParam();
-  const int domain = bad_frame ? kErrorDomain : kEndedDomain;
+  const int domain = bad_frame ? test::domain::kReplayError : test::domain::kReplayEnded;
   // Four frames of a 160 × 120 camera (kToolPose) facing a wall 2 m ahead with a block 0.5 m in front of it.
   const fs::path replay = dir_.path() / "replay";
   fs::create_directories(replay);
@@ -212,9 +206,9 @@ TEST_F(CameraE2eTest, OpenNI2WithoutADeviceKeepsRunningDegradedAndStopsOnSigterm
   const std::string yaml =
       "cell: no-device\nstatus_period: 0.2\nsource:\n  kind: openni2\n  sensor: wrist\n"
       "  openni2: {reconnect: {initial_backoff: 0.2, max_backoff: 0.5}}\n";
-  const dds::Participant participant(kNoDeviceDomain);
+  const dds::Participant participant(test::domain::kNoDevice);
   transport::StatusReader reader(participant);
-  auto daemon = start_daemon(yaml, kNoDeviceDomain);
+  auto daemon = start_daemon(yaml, test::domain::kNoDevice);
   const auto degraded = test::wait_for_status(reader, "no-device", [](const transport::CellStatus& s) {
     return s.state == "degraded" && s.sensors.size() == 1 && s.sensors[0].state.rfind("disconnected", 0) == 0;
   });
@@ -244,9 +238,9 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
       "  pose_tolerance: 0.05\n  pose_wait: 0.3\n"
       "  openni2: {uri: Dummy, width: 320, height: 240, intrinsics: {fx: 285, fy: 285, cx: 159.5, cy: "
       "119.5}}\n";
-  const dds::Participant participant(kRobotPoseDomain);
+  const dds::Participant participant(test::domain::kRobotPose);
   transport::StatusReader reader(participant);
-  auto daemon = start_daemon(yaml, kRobotPoseDomain);
+  auto daemon = start_daemon(yaml, test::domain::kRobotPose);
 
   // No robot poses yet: frames stream but are dropped, none is fused.
   const auto unposed = test::wait_for_status(
@@ -264,9 +258,7 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
     state.cell = "wrist-cell";
     state.X_CE.translation() = Eigen::Vector3d(1.0, 2.0, 1.5);
     while (!stop) {
-      state.stamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                           std::chrono::system_clock::now().time_since_epoch())
-                           .count();
+      state.stamp_ns = wall_clock_ns();
       writer.write(state);
       std::this_thread::sleep_for(10ms);
     }
@@ -296,10 +288,10 @@ TEST_F(CameraE2eTest, OneOfTwoCamerasUnpluggedDegradesTheCellAndTheOtherKeepsThe
       "}\n"
       "  - {kind: v4l2, sensor: wrist, v4l2: {device: /dev/cellmap-unplugged, "
       "reconnect: {initial_backoff: 0.2, max_backoff: 0.5}}}\n";
-  const dds::Participant participant(kUnpluggedDomain);
+  const dds::Participant participant(test::domain::kUnplugged);
   transport::StatusReader reader(participant);
   transport::EnvironmentSubscriber planner(participant, "two-cameras");
-  auto daemon = start_daemon(yaml, kUnpluggedDomain);
+  auto daemon = start_daemon(yaml, test::domain::kUnplugged);
 
   const auto degraded = test::wait_for_status(reader, "two-cameras", [](const transport::CellStatus& s) {
     return s.state == "degraded" && s.sweeps >= 4;
@@ -325,9 +317,9 @@ TEST_F(CameraE2eTest, FramesArePosedFromJointSamplesThroughTheRobotModel) {
                                "robot: {gantry: {lower: [0, 0, 0], upper: [3, 2, 1]}}\n"
                                "source: {kind: openni2, sensor: wrist, openni2: ") +
                            kDummy + "}\n";
-  const dds::Participant participant(kJointsDomain);
+  const dds::Participant participant(test::domain::kJointsCamera);
   transport::StatusReader reader(participant);
-  auto daemon = start_daemon(yaml, kJointsDomain);
+  auto daemon = start_daemon(yaml, test::domain::kJointsCamera);
   const auto unposed = test::wait_for_status(
       reader, "joints-cell", [](const transport::CellStatus& s) { return s.dropped_frames >= 10; });
   ASSERT_TRUE(unposed.has_value()) << "frames without joint samples were not counted as dropped";
@@ -342,9 +334,7 @@ TEST_F(CameraE2eTest, FramesArePosedFromJointSamplesThroughTheRobotModel) {
     joints.names = {"x", "y", "z"};
     joints.positions = {1.5, 1.0, 0.8};
     while (!stop) {
-      joints.stamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                            std::chrono::system_clock::now().time_since_epoch())
-                            .count();
+      joints.stamp_ns = wall_clock_ns();
       writer.write(joints);
       std::this_thread::sleep_for(10ms);
     }

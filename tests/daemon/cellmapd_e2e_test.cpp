@@ -21,13 +21,6 @@ namespace {
 
 using namespace std::chrono_literals;
 // Each test has its own domain (support/dds_domains.hpp) so ctest -j runs them side by side.
-constexpr int kAddRemoveDomain = test::domain::kAddRemove;
-constexpr int kRestartDomain = test::domain::kRestart;
-constexpr int kSecureAddRemoveDomain = test::domain::kSecureAddRemove;
-constexpr int kSecureRestartDomain = test::domain::kSecureRestart;
-constexpr int kReloadDomain = test::domain::kReload;
-constexpr int kResumeDomain = test::domain::kResume;
-constexpr int kMailboxDomain = test::domain::kMailbox;
 using test::kPatience;
 using test::settled;
 
@@ -53,7 +46,7 @@ class CellmapdE2eTest : public ::testing::TestWithParam<bool> {
 INSTANTIATE_TEST_SUITE_P(, CellmapdE2eTest, ::testing::Bool(), test::security_name);
 
 TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
-  const int domain = use_domain(kAddRemoveDomain, kSecureAddRemoveDomain);
+  const int domain = use_domain(test::domain::kAddRemove, test::domain::kSecureAddRemove);
   auto daemon = start_daemon(domain);
   const dds::Participant participant = service_->participant(domain);
   test::DeltaRecorder recorder;
@@ -93,7 +86,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
 }
 
 TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGetsLatest) {
-  const int domain = use_domain(kRestartDomain, kSecureRestartDomain);
+  const int domain = use_domain(test::domain::kRestart, test::domain::kSecureRestart);
   auto daemon = start_daemon(domain);
   std::optional<Environment> before_kill;
   {
@@ -187,9 +180,9 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
         << keys;
   };
   write_config("sweep_period: 60\nlog_level: info\n");  // one sweep, then a minute's pause
-  auto daemon = service.start_daemon(kReloadDomain, /*log_on_stdout=*/true);
+  auto daemon = service.start_daemon(test::domain::kReload, /*log_on_stdout=*/true);
   test::DaemonLog log(*daemon);
-  const dds::Participant participant = service.participant(kReloadDomain);
+  const dds::Participant participant = service.participant(test::domain::kReload);
   transport::StatusReader reader(participant);
   const auto status_where = [&](const std::function<bool(const transport::CellStatus&)>& accept,
                                 std::chrono::milliseconds patience = kPatience) {
@@ -257,9 +250,9 @@ TEST(CellmapdStatusE2eTest, SweepsArrivingFasterThanProcessedAreDroppedAndCounte
   std::ofstream(service.config_file(), std::ios::trunc)
       << "cell: mailbox\nsweep_period: 0\nstatus_period: 0.2\nsource: {noise: false}\n"
          "occupancy: {resolution: 0.01}\n";
-  auto daemon = service.start_daemon(kMailboxDomain, /*log_on_stdout=*/true, kSweeps);
+  auto daemon = service.start_daemon(test::domain::kMailbox, /*log_on_stdout=*/true, kSweeps);
   test::DaemonLog log(*daemon);
-  const dds::Participant participant = service.participant(kMailboxDomain);
+  const dds::Participant participant = service.participant(test::domain::kMailbox);
   transport::StatusReader reader(participant);
   const auto stopped = test::wait_for_status(
       reader, "mailbox", log, [](const transport::CellStatus& s) { return s.state == "stopped"; });
@@ -306,9 +299,9 @@ TEST(CellmapdStateE2eTest, TruncatedNewestSnapshotResumesFromThePreviousGoodVers
   ASSERT_FALSE(newest.empty());
   std::filesystem::resize_file(newest, std::filesystem::file_size(newest) / 2);
 
-  auto daemon = service.start_daemon(kResumeDomain, /*log_on_stdout=*/true);
+  auto daemon = service.start_daemon(test::domain::kResume, /*log_on_stdout=*/true);
   test::DaemonLog log(*daemon);
-  const dds::Participant participant = service.participant(kResumeDomain);
+  const dds::Participant participant = service.participant(test::domain::kResume);
   transport::EnvironmentSubscriber late(participant, "resume");
   ASSERT_TRUE(test::wait_for_version(late, 3, log)) << "did not resume above the lost version 2";
   const Environment resumed = *late.environment();

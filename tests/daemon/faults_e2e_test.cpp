@@ -19,8 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kFirstVersionDomain = test::domain::kFirstVersionFault;
-constexpr int kLaterVersionDomain = test::domain::kLaterVersionFault;
 // The first version's map state is about 0.5 MB: room for three versions and a filler.
 constexpr const char* kTmpfsOptions = "size=4m";
 // A short settling (exact depths fill the map in a few sweeps): the tests are about what follows.
@@ -89,11 +87,11 @@ class FaultsE2eTest : public ::testing::Test {
 
 TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnlyHoldsTheNext) {
   const test::ServiceFixture service("full-first", kShortSettling, disk_.state_dir());
-  const dds::Participant participant(kFirstVersionDomain);
+  const dds::Participant participant(test::domain::kFirstVersionFault);
   transport::StatusReader reader(participant);
   transport::EnvironmentSubscriber planner(participant, service.cell());
   disk_.fill();
-  auto daemon = service.start_daemon(kFirstVersionDomain);
+  auto daemon = service.start_daemon(test::domain::kFirstVersionFault);
 
   const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
   ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
@@ -111,7 +109,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   disk_.make_read_only(true);
   const Eigen::Vector3d centre(2.12, 0.45, 0.9);
   ASSERT_FALSE(service
-                   .inject(kFirstVersionDomain,
+                   .inject(test::domain::kFirstVersionFault,
                            {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"})
                    .empty());
   const auto read_only = test::wait_for_status(reader, service.cell(), degraded_by("Read-only file system"));
@@ -128,17 +126,17 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
 
 TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAgain) {
   const test::ServiceFixture service("full-later", kShortSettling, disk_.state_dir());
-  const dds::Participant participant(kLaterVersionDomain);
+  const dds::Participant participant(test::domain::kLaterVersionFault);
   transport::StatusReader reader(participant);
   transport::EnvironmentSubscriber planner(participant, service.cell());
-  auto daemon = service.start_daemon(kLaterVersionDomain);
+  auto daemon = service.start_daemon(test::domain::kLaterVersionFault);
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version";
   const Environment before = test::settled(planner, 3s);
 
   disk_.fill();
   const Eigen::Vector3d centre(0.5, 1.5, 0.95);
   ASSERT_FALSE(service
-                   .inject(kLaterVersionDomain,
+                   .inject(test::domain::kLaterVersionFault,
                            {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"})
                    .empty());
   const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));

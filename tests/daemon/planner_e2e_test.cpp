@@ -14,8 +14,6 @@ namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kPlannerDomain = test::domain::kPlanner;
-constexpr int kSecurePlannerDomain = test::domain::kSecurePlanner;
 
 // The next JSON line the planner prints, or a failure.
 nlohmann::json next_state(test::ChildProcess& planner) {
@@ -32,7 +30,7 @@ class PlannerE2eTest : public ::testing::TestWithParam<bool> {};
 INSTANTIATE_TEST_SUITE_P(, PlannerE2eTest, ::testing::Bool(), test::security_name);
 
 TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
-  const int domain = GetParam() ? kSecurePlannerDomain : kPlannerDomain;
+  const int domain = GetParam() ? test::domain::kSecurePlanner : test::domain::kPlanner;
   const test::ServiceFixture service("planner", GetParam() ? std::optional(domain) : std::nullopt);
   auto daemon = service.start_daemon(domain);
   const dds::Participant participant = service.participant(domain);

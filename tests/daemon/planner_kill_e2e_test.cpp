@@ -21,7 +21,6 @@ namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kKillDomain = test::domain::kKill;
 constexpr int kRounds = 5;
 
 // Free spots on the table of the simulated cell for injected boxes (centre; half extents 0.08, 0.08, 0.1).
@@ -98,12 +97,13 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
 
   test::ServiceFixture service("kill");
   const auto start_subscriber = [&] {
-    return std::make_unique<test::ChildProcess>(std::vector<std::string>{
-        CELLMAP_PLANNER, "--domain", std::to_string(kKillDomain), "--cell", "kill", "--json", "--every"});
+    return std::make_unique<test::ChildProcess>(
+        std::vector<std::string>{CELLMAP_PLANNER, "--domain", std::to_string(test::domain::kKill), "--cell",
+                                 "kill", "--json", "--every"});
   };
   Observations seen;
   std::uint64_t subscriber_last = 0;  // the newest version the current subscriber process printed
-  std::unique_ptr<test::ChildProcess> daemon = service.start_daemon(kKillDomain, true);
+  std::unique_ptr<test::ChildProcess> daemon = service.start_daemon(test::domain::kKill, true);
   std::unique_ptr<test::ChildProcess> subscriber = start_subscriber();
   const auto collect = [&] {
     for (const std::string& line : drain(*daemon)) seen.daemon_line(line);
@@ -112,8 +112,9 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
 
   for (int round = 0; round < kRounds; ++round) {
     const char* spot = kSpots[rng() % std::size(kSpots)];
-    EXPECT_FALSE(service.inject(kKillDomain, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"})
-                     .empty());
+    EXPECT_FALSE(
+        service.inject(test::domain::kKill, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"})
+            .empty());
     // The daemon reports a new box within about five sweeps (1 s): the kill lands before, during (fusion,
     // persisting, publishing) or after that version.
     std::this_thread::sleep_for(uniform(0.0, 2.5));
@@ -130,7 +131,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
     if (victim != 0) expect_killed(*subscriber, "the subscriber");
     collect();
     std::this_thread::sleep_for(uniform(0.0, 1.0));
-    if (victim != 1) daemon = service.start_daemon(kKillDomain, true);
+    if (victim != 1) daemon = service.start_daemon(test::domain::kKill, true);
     if (victim != 0) {
       subscriber = start_subscriber();
       subscriber_last = 0;
@@ -142,9 +143,10 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   std::this_thread::sleep_for(1s);
   collect();
   const std::uint64_t before = seen.latest();
-  EXPECT_FALSE(
-      service.inject(kKillDomain, {"add-box", "--center", "1.0,1.2,1.2", "--half-extents", "0.08,0.08,0.08"})
-          .empty());
+  EXPECT_FALSE(service
+                   .inject(test::domain::kKill,
+                           {"add-box", "--center", "1.0,1.2,1.2", "--half-extents", "0.08,0.08,0.08"})
+                   .empty());
   const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
   while (seen.latest() <= before && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(100ms);

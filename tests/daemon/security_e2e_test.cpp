@@ -24,10 +24,6 @@ namespace {
 
 using namespace std::chrono_literals;
 using security::Role;
-constexpr int kAttackDomain = test::domain::kAttack;
-constexpr int kRolesDomain = test::domain::kRoles;
-constexpr int kOtherCaDomain = test::domain::kOtherCa;
-constexpr int kRefusalDomain = test::domain::kRefusal;
 
 // The daemon's status once `done` holds for it, or a failure after the patience.
 transport::CellStatus wait_for_status(transport::StatusReader& reader,
@@ -123,14 +119,14 @@ void expect_line(test::ChildProcess& process, const std::string& line) {
 
 TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNothing) {
   test::use_secure_loopback();
-  const test::ServiceFixture service("secure", kAttackDomain);
+  const test::ServiceFixture service("secure", test::domain::kAttack);
   const test::TestCredentials& credentials = *service.credentials();
-  auto daemon = service.start_daemon(kAttackDomain);
-  const dds::Participant participant = service.participant(kAttackDomain);  // this process: a planner
+  auto daemon = service.start_daemon(test::domain::kAttack);
+  const dds::Participant participant = service.participant(test::domain::kAttack);  // this process: a planner
   transport::EnvironmentSubscriber planner(participant, "secure");
   transport::StatusReader status(participant);
   // Where robot poses would go (the simulating daemon reads none): a reader with the daemon's credentials.
-  auto poses = start(probe(kAttackDomain, "secure", {"serve"}, &credentials, Role::kDaemon));
+  auto poses = start(probe(test::domain::kAttack, "secure", {"serve"}, &credentials, Role::kDaemon));
   expect_line(*poses, "ready");
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version over DDS Security";
   const Environment before = test::settled(planner, 3s);
@@ -138,8 +134,8 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
 
   // The outsider, first reading: our own tools without --security, which is what anyone on the plant
   // network runs, and readers of the environment, its deltas and the status.
-  const std::string domain = std::to_string(kAttackDomain);
-  auto spy = start(probe(kAttackDomain, "secure", {"spy", "3"}));
+  const std::string domain = std::to_string(test::domain::kAttack);
+  auto spy = start(probe(test::domain::kAttack, "secure", {"spy", "3"}));
   auto echo = start({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "3"});
   auto inject = start({CELLMAP_TOOL, "inject", "--domain", domain, "--wait", "3", "add-box", "--center",
                        "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
@@ -165,7 +161,8 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
   // planner's version, a fake snapshot of an empty cell, scene edits and robot poses every 100 ms.
   std::string ids;
   for (const Box& box : before.boxes()) ids += (ids.empty() ? "" : ",") + std::to_string(box.id);
-  auto outsider = start(probe(kAttackDomain, "secure", {"forge", std::to_string(before.version()), ids}));
+  auto outsider =
+      start(probe(test::domain::kAttack, "secure", {"forge", std::to_string(before.version()), ids}));
   expect_line(*outsider, "forging");
   // Six sweeps of the daemon (over a second): plain participants on loopback match in milliseconds, so
   // anything forged would have acted by then.
@@ -198,10 +195,10 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
   // A credentialed tool's edit with a centre of 1e300 is refused and counted, and never enters the scene: a
   // move of that obstacle afterwards finds none.
   const std::string far = service.inject(
-      kAttackDomain, {"add-box", "--center", "1e300,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+      test::domain::kAttack, {"add-box", "--center", "1e300,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(far.empty());
   wait_for_status(status, [](const transport::CellStatus& s) { return s.refused_inputs == 1; });
-  service.inject(kAttackDomain, {"move", "--name", far, "--center", "2.12,0.45,0.9"});
+  service.inject(test::domain::kAttack, {"move", "--name", far, "--center", "2.12,0.45,0.9"});
   const transport::CellStatus moved =
       wait_for_status(status, [](const transport::CellStatus& s) { return s.refused_inputs == 2; });
   const transport::CellStatus later = after_sweeps(status, moved, 6);
@@ -215,11 +212,11 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
 
 TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant) {
   test::use_secure_loopback();
-  const test::TestCredentials credentials("roles", kRolesDomain);
+  const test::TestCredentials credentials("roles", test::domain::kRoles);
   const auto grants_of = [&](Role role) {
     int code = 0;
     const std::vector<std::string> lines =
-        run(probe(kRolesDomain, "roles", {"writers"}, &credentials, role), &code);
+        run(probe(test::domain::kRoles, "roles", {"writers"}, &credentials, role), &code);
     EXPECT_EQ(code, 0);
     return lines.size() == 1 ? nlohmann::json::parse(lines[0]) : nlohmann::json::object();
   };
@@ -241,15 +238,15 @@ TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant
 
 TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
   test::use_secure_loopback();
-  const test::TestCredentials ours("ca", kOtherCaDomain);
-  const test::TestCredentials theirs("ca", kOtherCaDomain);  // valid in itself, but of other CAs
-  auto daemon = start(probe(kOtherCaDomain, "ca", {"serve", "--publish"}, &ours, Role::kDaemon));
+  const test::TestCredentials ours("ca", test::domain::kOtherCa);
+  const test::TestCredentials theirs("ca", test::domain::kOtherCa);  // valid in itself, but of other CAs
+  auto daemon = start(probe(test::domain::kOtherCa, "ca", {"serve", "--publish"}, &ours, Role::kDaemon));
   expect_line(*daemon, "ready");
-  const dds::Participant participant(kOtherCaDomain, ours.as(Role::kPlanner));
+  const dds::Participant participant(test::domain::kOtherCa, ours.as(Role::kPlanner));
   transport::EnvironmentSubscriber planner(participant, "ca");
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "our own peers never matched";
 
-  const std::string domain = std::to_string(kOtherCaDomain);
+  const std::string domain = std::to_string(test::domain::kOtherCa);
   const auto as_theirs = [&](std::vector<std::string> argv, Role role) {
     const std::vector<std::string> flags = theirs.flags(role);
     argv.insert(argv.end(), flags.begin(), flags.end());
@@ -278,13 +275,13 @@ TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
 }
 
 TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
-  const test::TestCredentials credentials("refusal", kRefusalDomain);
+  const test::TestCredentials credentials("refusal", test::domain::kRefusal);
   const test::TempDir state;
   const security::RoleFiles daemon = security::role_files(credentials.directory(), Role::kDaemon);
   ASSERT_EQ(::chmod(daemon.private_key.c_str(), 0640), 0);
   int code = 0;
   std::vector<std::string> lines =
-      run({CELLMAPD, "--domain", std::to_string(kRefusalDomain), "--state-dir", state.path().string(),
+      run({CELLMAPD, "--domain", std::to_string(test::domain::kRefusal), "--state-dir", state.path().string(),
            "--security", credentials.directory().string()},
           &code);
   ASSERT_EQ(lines.size(), 1u);
@@ -294,7 +291,7 @@ TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
       << lines[0];
   EXPECT_EQ(code, 1);
 
-  lines = run({CELLMAP_TOOL, "echo", "--domain", std::to_string(kRefusalDomain + 1), "--security",
+  lines = run({CELLMAP_TOOL, "echo", "--domain", std::to_string(test::domain::kRefusal + 1), "--security",
                credentials.directory().string()},
               &code);
   EXPECT_EQ(lines,
@@ -308,11 +305,11 @@ TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
 
 TEST(SecurityE2eTest, TheDaemonSaysOnceAtStartWhetherDdsSecurityIsOn) {
   test::use_secure_loopback();
-  const test::TestCredentials credentials("cell-1", kRefusalDomain);
+  const test::TestCredentials credentials("cell-1", test::domain::kRefusal);
   const auto log_of = [&](std::vector<std::string> extra) {
     const test::TempDir state;
     std::vector<std::string> argv{
-        CELLMAPD,   "--domain", std::to_string(kRefusalDomain), "--state-dir", state.path().string(),
+        CELLMAPD,   "--domain", std::to_string(test::domain::kRefusal), "--state-dir", state.path().string(),
         "--sweeps", "1"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     int code = 0;

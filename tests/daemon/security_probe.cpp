@@ -28,6 +28,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/text.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/transport/environment_monitor.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
@@ -40,12 +41,6 @@ namespace {
 using namespace cellmap;
 using namespace std::chrono_literals;
 using nlohmann::json;
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // True once SIGTERM (blocked in main) is pending.
 bool terminated() {
@@ -86,7 +81,7 @@ void serve(const dds::Participant& p, const std::string& cell, bool publish) {
     Box box;
     box.id = 1;
     box.half_extents = Eigen::Vector3d::Constant(0.1);
-    publisher->publish(Environment(cell, 1, now_ns(), {box}));
+    publisher->publish(Environment(cell, 1, wall_clock_ns(), {box}));
   }
   std::cout << "ready" << std::endl;
   std::size_t edit_count = 0;
@@ -109,10 +104,10 @@ void serve(const dds::Participant& p, const std::string& cell, bool publish) {
 
 void forge(const dds::Participant& p, const std::string& cell, std::uint64_t from, const std::string& ids) {
   transport::EnvironmentPublisher publisher(p, cell);
-  EnvironmentDelta wipe{cell, from, from + 1, now_ns(), {}, {}, {}};
+  EnvironmentDelta wipe{cell, from, from + 1, wall_clock_ns(), {}, {}, {}};
   for (const std::string& id : split(ids, ',')) wipe.removed.push_back(std::stoull(id));
-  publisher.publish(Environment(cell, from + 1, now_ns(), {}), wipe);
-  publisher.publish(Environment(cell, from + 2, now_ns(), {}));
+  publisher.publish(Environment(cell, from + 1, wall_clock_ns(), {}), wipe);
+  publisher.publish(Environment(cell, from + 2, wall_clock_ns(), {}));
   const transport::SceneEditWriter edits(p);
   const transport::RobotStateWriter poses(p);
   transport::SceneEdit edit;
@@ -126,7 +121,7 @@ void forge(const dds::Participant& p, const std::string& cell, std::uint64_t fro
   std::cout << "forging" << std::endl;
   while (!terminated()) {
     edits.write(edit);
-    pose.stamp_ns = now_ns();
+    pose.stamp_ns = wall_clock_ns();
     poses.write(pose);
     std::this_thread::sleep_for(100ms);
   }

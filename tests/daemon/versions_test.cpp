@@ -20,7 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr int kKeeperDomain = test::domain::kKeeper;
 constexpr auto kPatience = 30s;
 
 Box box_with_id(std::uint64_t id) {
@@ -92,7 +91,7 @@ class KeeperTest : public ::testing::Test {
   bool refuse = false;
   const std::string cell_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   test::TempDir dir_;
-  dds::Participant participant_{kKeeperDomain};
+  dds::Participant participant_{test::domain::kKeeper};
   transport::EnvironmentPublisher publisher_{participant_, cell_};
   transport::EnvironmentSubscriber subscriber_{participant_, cell_};
 };

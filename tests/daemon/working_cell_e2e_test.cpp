@@ -12,16 +12,12 @@
 #include "cellmap/sim/scene.hpp"
 #include "daemon/robot_surface.hpp"
 #include "daemon/service_e2e.hpp"
+#include "support/dds_domains.hpp"
 
 namespace cellmap {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kFilteredDomain = 160;
-constexpr int kUnfilteredDomain = 161;
-constexpr int kPostDomain = 164;
-constexpr int kWristDomain = 165;
-constexpr int kBothDomain = 166;
 
 const std::string kArmScene = CELLMAP_SOURCE_DIR "/config/scenes/arm_cell.yaml";
 // The arm cell's sensors as config/arm-cell.yaml has them.
@@ -103,7 +99,8 @@ std::vector<std::uint64_t> boxes_on_the_robot(const Environment& env, const sim:
 TEST_F(WorkingCellE2eTest, ArmInViewOfTheFixedCameraMakesOneVersionAndNoBoxOnTheRobot) {
   const std::uint64_t sweeps = long_tests() ? 500 : 25;
   const sim::Scene scene = sim::load_scene(kArmScene);
-  const std::vector<Environment> versions = run_daemon("sources: [" + kPost + "]\n", kFilteredDomain, sweeps);
+  const std::vector<Environment> versions =
+      run_daemon("sources: [" + kPost + "]\n", test::domain::kArmFiltered, sweeps);
   ASSERT_FALSE(versions.empty()) << "no version in " << sweeps << " sweeps";
   EXPECT_EQ(versions.back().version(), 1u) << "the moving arm made versions";
   EXPECT_GT(versions.front().boxes().size(), 5u);
@@ -118,8 +115,8 @@ TEST_F(WorkingCellE2eTest, ArmInViewOfTheFixedCameraMakesOneVersionAndNoBoxOnThe
 
 TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxesOnItself) {
   const sim::Scene scene = sim::load_scene(kArmScene);
-  const std::vector<Environment> versions =
-      run_daemon("sources: [" + kPost + "]\nself_filter: {enabled: false}\n", kUnfilteredDomain, 30);
+  const std::vector<Environment> versions = run_daemon(
+      "sources: [" + kPost + "]\nself_filter: {enabled: false}\n", test::domain::kArmUnfiltered, 30);
   ASSERT_FALSE(versions.empty());
   EXPECT_GT(versions.back().version(), 1u) << "the unfiltered arm made no version after the first";
   const std::size_t on_robot = boxes_on_the_robot(versions.back(), scene).size();
@@ -129,8 +126,8 @@ TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxes
 }
 
 // The share of the surface of every obstacle of the cell (floor, table, legs, pedestal, post, the objects on
-// the table; 2 cm samples) inside a box of `env`. Every obstacle: counting only the objects on the table, each
-// camera's boxes alone already held all of them (1.0 each).
+// the table; 2 cm samples) inside a box of `env`. Every obstacle: counting only the objects on the table,
+// each camera's boxes alone already held all of them (1.0 each).
 double surface_in_boxes(const Environment& env, const sim::Scene& scene) {
   std::size_t inside = 0, total = 0;
   for (const sim::Obstacle& obstacle : scene.obstacles) {
@@ -153,9 +150,9 @@ TEST_F(WorkingCellE2eTest, TwoSensorsFusedCoverMoreOfTheObstaclesThanEitherAlone
         run_daemon(settle + "sources: [" + sources + "]\n", domain, sweeps);
     return versions.empty() ? 0.0 : surface_in_boxes(versions.back(), scene);
   };
-  const double post = coverage(kPost, kPostDomain);
-  const double wrist = coverage(kWrist, kWristDomain);
-  const double both = coverage(kPost + ", " + kWrist, kBothDomain);
+  const double post = coverage(kPost, test::domain::kArmPostCoverage);
+  const double wrist = coverage(kWrist, test::domain::kArmWristCoverage);
+  const double both = coverage(kPost + ", " + kWrist, test::domain::kArmBothCoverage);
   std::cout << "share of the obstacles' surface inside boxes after " << sweeps << " sweeps: post " << post
             << ", wrist " << wrist << ", both " << both << "\n";
   EXPECT_GT(both, post);

@@ -2,9 +2,8 @@
 // Every DDS domain id the tests use, in one table. ctest runs tests side by side (-j 2) and DDS tests on
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
 // A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), the
-// browser test 220-221 (tests/view/view_browser_test.py), the working arm cell 160-161, 164-169 and
-// 173-179 (tests/daemon/working_cell_e2e_test.cpp and what it reserves), scripts/soak 179. Credentials tests
-// name domains 7, 197 and 233 without joining them.
+// browser test 220-221 (tests/view/view_browser_test.py), scripts/soak 179. Credentials tests name domains 7,
+// 197 and 233 without joining them. Ids end at 232.
 
 namespace cellmap::test::domain {
 
@@ -58,6 +57,13 @@ inline constexpr int kNoDevice = 183;
 inline constexpr int kRobotPose = 184;
 inline constexpr int kReplayEnded = 201;
 inline constexpr int kReplayError = 202;
+
+// working_cell_e2e_test: the arm cell's daemon, self filter on and off, and the coverage of each camera.
+inline constexpr int kArmFiltered = 160;
+inline constexpr int kArmUnfiltered = 161;
+inline constexpr int kArmPostCoverage = 164;
+inline constexpr int kArmWristCoverage = 165;
+inline constexpr int kArmBothCoverage = 166;
 
 // daemon_test: the daemon's parts in process.
 inline constexpr int kKeeper = 186;

@@ -11,19 +11,12 @@
 #include <string>
 #include <thread>
 
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "scene_steps.hpp"
 
-namespace {
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 int main(int argc, char** argv) {
   if (argc != 5) {
@@ -46,13 +39,13 @@ int main(int argc, char** argv) {
     const cellmap::dds::Participant participant(domain);
     cellmap::transport::EnvironmentPublisher publisher(participant, "cell-e2e");
     if (env.version() > 0) {
-      env = store.resume(now_ns());
+      env = store.resume(wall_clock_ns());
       std::cout << "republished " << env.version() << std::endl;
       publisher.publish(env);
     }
     for (int i = 0; i < versions; ++i) {
       const std::uint64_t v = store.next_version();
-      const cellmap::Environment next = cellmap::test::next_environment(env, v, now_ns());
+      const cellmap::Environment next = cellmap::test::next_environment(env, v, wall_clock_ns());
       store.save(next);
       std::cout << "publishing " << v << std::endl;
       publisher.publish(next, cellmap::diff(env, next));

@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "loopback.hpp"
 #include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
@@ -20,12 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 constexpr auto kPatience = 30s;  // generous: the machine is shared; passing runs take milliseconds
 const std::vector<std::string> kJoints{"j1", "j2", "j3"};
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 RobotJoints joints_at(const std::string& cell, std::int64_t stamp_ns, std::vector<std::string> names,
                       std::vector<double> positions) {
@@ -55,7 +50,7 @@ TEST(RobotJointsTest, ReaderGetsItsCellsSamplesInTheRobotsJointOrder) {
   RobotJointsReader reader(daemon, "cell-a", kJoints);
   RobotJointsWriter writer(controller);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
-  const std::int64_t t0 = now_ns();
+  const std::int64_t t0 = wall_clock_ns();
   RobotJoints named = joints_at("cell-a", t0, {"j3", "j1", "j2"}, {0.3, 0.1, 0.2});  // any order
   Payload carton;
   carton.X_EB.translation() = Eigen::Vector3d(0, 0, 0.2);
@@ -93,7 +88,7 @@ TEST(RobotJointsTest, SamplesThatDoNotFitTheRobotAreRefusedAndCounted) {
                            [&](const std::string& why) { last_refusal = why; });
   RobotJointsWriter writer(controller);
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
-  const std::int64_t t = now_ns();
+  const std::int64_t t = wall_clock_ns();
   writer.write(joints_at("cell-a", t, {"j1", "j2", "wrist"}, {0, 0, 0}));  // unknown joint
   writer.write(joints_at("cell-a", t, {"j1", "j1", "j2"}, {0, 0, 0}));     // repeated joint
   writer.write(joints_at("cell-a", t, {}, {0, 0}));                        // wrong count

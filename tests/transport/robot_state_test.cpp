@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "loopback.hpp"
 #include "support/dds_domains.hpp"
 #include "support/test_support.hpp"
@@ -95,9 +96,7 @@ TEST(RobotStateTest, RobotPoseCommandPublishesAStandingToolPose) {
   const std::string command = std::string(CELLMAP_TOOL) + " robot-pose --domain " +
                               std::to_string(test::domain::kPoseCommand) +
                               " --cell desk --pose 1,2,1.5,0.5,-0.5,0.5,-0.5 --rate 50 --duration 0.5 2>&1";
-  const auto before_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                             std::chrono::system_clock::now().time_since_epoch())
-                             .count();
+  const auto before_ns = wall_clock_ns();
   FILE* pipe = ::popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string output;

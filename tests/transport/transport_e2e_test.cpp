@@ -51,17 +51,16 @@ class TransportE2eTest : public ::testing::Test {
 };
 
 TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
-  constexpr int kDomain = test::domain::kLateJoinerProcess;
   test::TempDir dir;
-  test::ChildProcess daemon(helper(kDomain, dir.path(), 10, 0));
+  test::ChildProcess daemon(helper(test::domain::kLateJoinerProcess, dir.path(), 10, 0));
   std::vector<std::uint64_t> published;
   const std::uint64_t last = read_until(daemon, "done", published);
   ASSERT_EQ(last, 10u);
 
   // Both joiners arrive after ten versions: the library copy and `cellmap echo`.
-  test::ChildProcess echo(
-      {CELLMAP_TOOL, "echo", "--domain", std::to_string(kDomain), "--count", "11", "--timeout", "60"});
-  const dds::Participant planner(kDomain);
+  test::ChildProcess echo({CELLMAP_TOOL, "echo", "--domain", std::to_string(test::domain::kLateJoinerProcess),
+                           "--count", "11", "--timeout", "60"});
+  const dds::Participant planner(test::domain::kLateJoinerProcess);
   std::atomic<int> calls{0};
   EnvironmentSubscriber subscriber(planner, "cell-e2e",
                                    [&](const Environment&, const EnvironmentDelta&) { ++calls; });
@@ -95,9 +94,8 @@ TEST_F(TransportE2eTest, LateJoinerInAnotherProcessGetsTheLatestSnapshot) {
 }
 
 TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
-  constexpr int kDomain = test::domain::kFallsBehind;
   test::TempDir dir;
-  const dds::Participant planner(kDomain);
+  const dds::Participant planner(test::domain::kFallsBehind);
   std::mutex gate;
   std::unique_lock<std::mutex> hold(gate);  // the first callback blocks until the daemon is done
   std::promise<void> entered;
@@ -109,14 +107,14 @@ TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
         const std::lock_guard<std::mutex> wait_for_daemon(gate);
       },
       /*delta_depth=*/2);
-  test::ChildProcess daemon(helper(kDomain, dir.path(), 1, 0));
+  test::ChildProcess daemon(helper(test::domain::kFallsBehind, dir.path(), 1, 0));
   std::vector<std::uint64_t> published;
   read_until(daemon, "done", published);
   ASSERT_EQ(entered.get_future().wait_for(kPatience), std::future_status::ready);
   daemon.signal(SIGTERM);
   daemon.wait();
   // While the planner's callback is stuck, a second daemon run publishes 40 versions; its reader keeps 2.
-  test::ChildProcess busy(helper(kDomain, dir.path(), 40, 0));
+  test::ChildProcess busy(helper(test::domain::kFallsBehind, dir.path(), 40, 0));
   const std::uint64_t last = read_until(busy, "done", published);
   hold.unlock();
   ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
@@ -128,9 +126,8 @@ TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
 }
 
 TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
-  constexpr int kDomain = test::domain::kKilledPublisher;
   test::TempDir dir;
-  const dds::Participant planner(kDomain);
+  const dds::Participant planner(test::domain::kKilledPublisher);
   std::mutex mutex;
   std::vector<std::pair<Environment, EnvironmentDelta>> calls;
   EnvironmentSubscriber subscriber(planner, "cell-e2e",
@@ -138,13 +135,14 @@ TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
                                      const std::lock_guard<std::mutex> lock(mutex);
                                      calls.emplace_back(env, delta);
                                    });
-  test::ChildProcess echo({CELLMAP_TOOL, "echo", "--domain", std::to_string(kDomain), "--timeout", "600"});
+  test::ChildProcess echo(
+      {CELLMAP_TOOL, "echo", "--domain", std::to_string(test::domain::kKilledPublisher), "--timeout", "600"});
 
   std::vector<std::uint64_t> published;
   std::mt19937 random(5);
   // Three daemons killed at random instants while publishing every 10 ms, then one that finishes.
   for (int run = 0; run < 3; ++run) {
-    test::ChildProcess daemon(helper(kDomain, dir.path(), 100000, 10));
+    test::ChildProcess daemon(helper(test::domain::kKilledPublisher, dir.path(), 100000, 10));
     read_until(daemon, "publishing", published);
     std::this_thread::sleep_for(std::chrono::milliseconds(50 + random() % 200));
     daemon.signal(SIGKILL);
@@ -157,7 +155,7 @@ TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
   // Past the 1 s lease of the loopback config: the killed daemons' writers have expired at the subscriber,
   // which must not read that as "all boxes removed".
   std::this_thread::sleep_for(2500ms);
-  test::ChildProcess daemon(helper(kDomain, dir.path(), 5, 10));
+  test::ChildProcess daemon(helper(test::domain::kKilledPublisher, dir.path(), 5, 10));
   const std::uint64_t last = read_until(daemon, "done", published);
   ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
 

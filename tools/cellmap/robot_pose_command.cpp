@@ -11,6 +11,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/text.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/transport/robot_joints.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "commands.hpp"
@@ -89,9 +90,7 @@ std::uint64_t repeat(const RobotPoseOptions& options, const std::function<void(s
   std::uint64_t sent = 0;
   for (auto next = Clock::now(); options.duration == 0 || next < end; next += period) {
     std::this_thread::sleep_until(next);
-    send(std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-             .count());
+    send(wall_clock_ns());
     ++sent;
   }
   return sent;

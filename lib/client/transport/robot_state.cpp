@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/wall_clock.hpp"
 #include "cellmap/transport/topics.hpp"
 #include "wire.hpp"
 
@@ -50,9 +51,7 @@ RobotStateReader::~RobotStateReader() {
 std::vector<RobotState> RobotStateReader::take(std::chrono::nanoseconds timeout) {
   if (timeout.count() > 0) waitset_.wait(timeout);
   std::vector<RobotState> states;
-  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                  std::chrono::system_clock::now().time_since_epoch())
-                                  .count();
+  const std::int64_t now_ns = wall_clock_ns();
   reader_.take_all([&](const void* sample, const dds_sample_info_t&) {
     const auto& msg = *static_cast<const cellmap_msg_RobotState*>(sample);
     if (msg.cell != nullptr && cell_ != msg.cell) return;
