@@ -39,13 +39,13 @@ int main(int argc, char** argv) {
     const cellmap::dds::Participant participant(domain);
     cellmap::transport::EnvironmentPublisher publisher(participant, "cell-e2e");
     if (env.version() > 0) {
-      env = store.resume(wall_clock_ns());
+      env = store.resume(cellmap::wall_clock_ns());
       std::cout << "republished " << env.version() << std::endl;
       publisher.publish(env);
     }
     for (int i = 0; i < versions; ++i) {
       const std::uint64_t v = store.next_version();
-      const cellmap::Environment next = cellmap::test::next_environment(env, v, wall_clock_ns());
+      const cellmap::Environment next = cellmap::test::next_environment(env, v, cellmap::wall_clock_ns());
       store.save(next);
       std::cout << "publishing " << v << std::endl;
       publisher.publish(next, cellmap::diff(env, next));
