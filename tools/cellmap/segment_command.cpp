@@ -19,22 +19,25 @@ struct SegmentArgs {
   std::string input, pipeline = "cell", config, boxes, output;
 };
 
-void segment_as_cell(const SegmentArgs& args, const CloudFile& file) {
+// The config is read before the cloud: a bad config fails fast, whatever the cloud.
+void segment_as_cell(const SegmentArgs& args) {
   CellPipelineConfig config =
       args.config.empty()
           ? daemon::DaemonConfig::parse(daemon::default_config_yaml(), "cellmapd defaults", ".").pipeline
           : daemon::DaemonConfig::load(args.config).pipeline;
   if (!args.boxes.empty()) config.segment.box_kind = box_kind_from_string(args.boxes, "--boxes");
+  const CloudFile file = load_cloud_file(args.input);
   const CloudBoxes result = boxes_of_cloud(file.points, config);
   write_box_file(args.output, result.boxes);
   std::cerr << "cellmap segment: " << args.input << ": " << file.non_finite << " NaN/inf points dropped; "
             << summary(result) << " -> " << args.output << "\n";
 }
 
-void segment_as_points(const SegmentArgs& args, const CloudFile& file) {
+void segment_as_points(const SegmentArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   SegmentConfig config = args.config.empty() ? SegmentConfig{} : load_segment_config(args.config);
   if (!args.boxes.empty()) config.box_kind = box_kind_from_string(args.boxes, "--boxes");
+  const CloudFile file = load_cloud_file(args.input);
   const SegmentResult result = segment_cloud(file.points, config);
   write_box_file(args.output, result.boxes);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -62,11 +65,10 @@ void add_segment_command(CLI::App& app) {
       ->check(CLI::IsMember({"obb", "aabb"}));
   command->add_option("-o,--output", args->output, "boxes JSON file to write")->required();
   command->callback([args] {
-    const CloudFile file = load_cloud_file(args->input);
     if (args->pipeline == "cell") {
-      segment_as_cell(*args, file);
+      segment_as_cell(*args);
     } else {
-      segment_as_points(*args, file);
+      segment_as_points(*args);
     }
   });
 }
