@@ -39,6 +39,14 @@ ToolRun run_tool(const std::string& args) {
   return run;
 }
 
+// A 10 cm cube standing on a 40 cm floor square, seen from above one side.
+test::Scene cube_on_floor() {
+  test::Scene scene(Eigen::Vector3f(0.1f, -0.7f, 0.8f));
+  scene.add_box({0.0, 0.0, 0.05}, {0.05, 0.05, 0.05}, Eigen::Matrix3d::Identity());
+  scene.add_floor(0.2, {{Eigen::Vector2d(-0.05, -0.05), Eigen::Vector2d(0.05, 0.05)}});
+  return scene;
+}
+
 class SegmentCommand : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -83,9 +91,7 @@ TEST_F(SegmentCommand, BadInputExitsNonZeroWithOneLineNamingTheFile) {
 }
 
 TEST_F(SegmentCommand, WritesTheBoxesFileOfAPlyScene) {
-  test::Scene scene(Eigen::Vector3f(0.1f, -0.7f, 0.8f));
-  scene.add_box({0.0, 0.0, 0.05}, {0.05, 0.05, 0.05}, Eigen::Matrix3d::Identity());
-  scene.add_floor(0.2, {{Eigen::Vector2d(-0.05, -0.05), Eigen::Vector2d(0.05, 0.05)}});
+  const test::Scene scene = cube_on_floor();
   const fs::path ply = dir_ / "scene.ply";
   ASSERT_EQ(pcl::io::savePLYFileBinary(ply.string(), scene.points), 0);
   const fs::path out = dir_ / "boxes.json";
@@ -121,9 +127,7 @@ TEST_F(SegmentCommand, WritesTheBoxesFileOfAPlyScene) {
 // The default path: the cloud as cellmapd's settled map. Boxes hold whole 2 cm voxels, so every point is
 // inside one; `points` counts voxels.
 TEST_F(SegmentCommand, CellPipelineBoxesHoldEveryPointOfAPlyScene) {
-  test::Scene scene(Eigen::Vector3f(0.1f, -0.7f, 0.8f));
-  scene.add_box({0.0, 0.0, 0.05}, {0.05, 0.05, 0.05}, Eigen::Matrix3d::Identity());
-  scene.add_floor(0.2, {{Eigen::Vector2d(-0.05, -0.05), Eigen::Vector2d(0.05, 0.05)}});
+  const test::Scene scene = cube_on_floor();
   const fs::path ply = dir_ / "scene.ply";
   ASSERT_EQ(pcl::io::savePLYFileBinary(ply.string(), scene.points), 0);
   const fs::path out = dir_ / "boxes.json";

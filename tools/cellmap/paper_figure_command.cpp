@@ -29,11 +29,10 @@ void add_paper_figure_command(CLI::App& app) {
     write_file_atomically(out / "paper_figure.svg", planning::paper_figure_svg(paper));
     write_file_atomically(out / "row3_figure.csv", planning::paper_figure_csv(row3));
     write_file_atomically(out / "row3_figure.svg", planning::paper_figure_svg(row3));
-    write_file_atomically(out / "constraints.md",
-                          "The paper's setup (6 objects, y from -1 to 1 m):\n\n" +
-                              planning::paper_constraint_table(paper) +
-                              "\nOurs (3 boxes, y from -1.5 to 1.5 m):\n\n" +
-                              planning::paper_constraint_table(row3));
+    write_file_atomically(out / "constraints.md", "The paper's setup (6 objects, y from -1 to 1 m):\n\n" +
+                                                      planning::paper_constraint_table(paper) +
+                                                      "\nOurs (3 boxes, y from -1.5 to 1.5 m):\n\n" +
+                                                      planning::paper_constraint_table(row3));
     std::cout << "wrote " << out.string()
               << "/{paper_figure.csv, paper_figure.svg, row3_figure.csv, row3_figure.svg, constraints.md}\n";
   });

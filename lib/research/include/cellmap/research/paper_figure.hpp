@@ -5,11 +5,13 @@
 // Detection for Industrial Robotics Applications", AIRoV 2024.
 //
 // Two scenes (cell frame, metres); the moving cube has half extents 0.1 and centre (0, y, 0.1) in both.
-// - kPaper, the paper's setup as far as it states it: y from −1 to 1 in steps of 0.01 (201 checkpoints) past a
+// - kPaper, the paper's setup as far as it states it: y from −1 to 1 in steps of 0.01 (201 checkpoints) past
+// a
 //   row of n_env = 6 objects, so that GJK needs n_rob · n_env = 6 constraints per checkpoint. Assumed (the
 //   paper gives no sizes): six cuboids of half extents (0.1, 0.15, 0.1) centred at x = 0.4, z = 0.1 and
 //   y = −1, −0.6, −0.2, 0.2, 0.6, 1, every second one turned 30° about z.
-// - kRow3, ours: y from −1.5 to 1.5 (301 checkpoints) past three boxes of half extents (0.1, 0.2, 0.1) centred
+// - kRow3, ours: y from −1.5 to 1.5 (301 checkpoints) past three boxes of half extents (0.1, 0.2, 0.1)
+// centred
 //   at x = 0.4, z = 0.1 and y = −0.8, 0, 0.8, the middle one turned 30° about z. The cube's face is 0.2 from
 //   the outer boxes' faces and 0.1134 from the turned box's nearest edge.
 
@@ -20,6 +22,7 @@
 
 namespace cellmap::planning {
 
+/// Which scene a figure is computed on (see above).
 enum class PaperSetup { kPaper, kRow3 };
 
 struct PaperFigure final {
@@ -43,9 +46,9 @@ struct PaperFigure final {
 /// A self-contained SVG line plot of the four curves (distance over y), with axes and legend.
 [[nodiscard]] std::string paper_figure_svg(const PaperFigure& figure);
 /// Markdown table: constraints per checkpoint and over the whole sweep for each method, in both counting
-/// conventions for spheres: the paper's (n_rob · n_env · N, its 36 for N = 6 against GJK's 6: one constraint
-/// per sphere of a cover) and ours (n_rob · n_env · N², every robot sphere against every environment sphere,
-/// what the curves compute). GJK: n_rob · n_env.
+/// conventions for spheres: the paper's (n_rob · n_env · N: its 36 for N = 6 against GJK's 6 read as N per
+/// object pair; the paper does not say how it counts) and ours (n_rob · n_env · N², every robot sphere
+/// against every environment sphere, what the curves compute). GJK: n_rob · n_env.
 [[nodiscard]] std::string paper_constraint_table(const PaperFigure& figure);
 
 }  // namespace cellmap::planning
