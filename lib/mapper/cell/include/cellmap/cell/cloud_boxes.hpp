@@ -13,8 +13,8 @@
 
 namespace cellmap {
 
-/// The boxes of one cloud and what became of its points. Every point is in exactly one of: inside a box,
-/// `noise_points`, `outside_map`, `outside_boxes` (the safety property wants 0).
+/// The boxes of one cloud and what became of its points. Every point not counted in `noise_points`,
+/// `outside_map` or `outside_boxes` (the safety property wants 0) is inside a box; a noise point may be too.
 struct CloudBoxes final {
   BoxSet boxes;                   ///< version 1, frame "cell", ids 1..n
   std::size_t points = 0;         ///< points in
