@@ -14,29 +14,39 @@ namespace cellmap::planning {
 using collision::Obb;
 using Eigen::Vector3d;
 
-std::vector<Obb> paper_row() {
-  const Vector3d half(0.1, 0.2, 0.1);
-  return {
-      Obb(Vector3d(0.4, -0.8, 0.1), half),
-      Obb(Vector3d(0.4, 0.0, 0.1), half, Eigen::AngleAxisd(M_PI / 6, Vector3d::UnitZ()).toRotationMatrix()),
-      Obb(Vector3d(0.4, 0.8, 0.1), half)};
+std::vector<Obb> paper_row(PaperSetup setup) {
+  const Eigen::Matrix3d turned = Eigen::AngleAxisd(M_PI / 6, Vector3d::UnitZ()).toRotationMatrix();
+  if (setup == PaperSetup::kRow3) {
+    const Vector3d half(0.1, 0.2, 0.1);
+    return {Obb(Vector3d(0.4, -0.8, 0.1), half), Obb(Vector3d(0.4, 0.0, 0.1), half, turned),
+            Obb(Vector3d(0.4, 0.8, 0.1), half)};
+  }
+  std::vector<Obb> row;
+  for (int i = 0; i < 6; ++i) {
+    const Vector3d centre(0.4, -1.0 + 0.4 * i, 0.1);
+    const Vector3d half(0.1, 0.15, 0.1);
+    row.push_back(i % 2 == 0 ? Obb(centre, half) : Obb(centre, half, turned));
+  }
+  return row;
 }
 
 Obb paper_cube(double y) {
   return Obb(Vector3d(0.0, y, 0.1), Vector3d(0.1, 0.1, 0.1));
 }
 
-PaperFigure compute_paper_figure() {
+PaperFigure compute_paper_figure(PaperSetup setup) {
   PaperFigure figure;
-  const std::vector<Obb> row = paper_row();
+  const std::vector<Obb> row = paper_row(setup);
+  const double y_end = setup == PaperSetup::kPaper ? 1.0 : 1.5;
+  const int checkpoints = static_cast<int>(std::lround(200 * y_end)) + 1;
   figure.n_env = static_cast<int>(row.size());
   std::vector<std::vector<collision::Sphere>> row_spheres[3];
   for (int m = 0; m < 3; ++m) {
     for (const Obb& box : row)
       row_spheres[m].push_back(collision::sphere_cover(box, PaperFigure::kSphereCounts[m]));
   }
-  for (int k = 0; k <= 300; ++k) {
-    const double y = -1.5 + 0.01 * k;
+  for (int k = 0; k < checkpoints; ++k) {
+    const double y = -y_end + 0.01 * k;
     const Obb cube = paper_cube(y);
     figure.y.push_back(y);
     double gjk = std::numeric_limits<double>::infinity();
@@ -111,12 +121,13 @@ std::string paper_constraint_table(const PaperFigure& figure) {
   const std::size_t checkpoints = figure.y.size();
   const std::size_t pairs = static_cast<std::size_t>(figure.n_rob) * figure.n_env;
   std::ostringstream out;
-  out << "| method | spheres per box | constraints per checkpoint | constraints for " << checkpoints
-      << " checkpoints |\n|---|---|---|---|\n";
+  out << "| method | spheres per box | constraints per checkpoint, paper's count (ours) | constraints for "
+      << checkpoints << " checkpoints, paper's count (ours) |\n|---|---|---|---|\n";
   out << "| GJK | - | " << pairs << " | " << pairs * checkpoints << " |\n";
   for (int n : PaperFigure::kSphereCounts) {
-    const std::size_t per = pairs * n * n;
-    out << "| spheres | " << n << " | " << per << " | " << per * checkpoints << " |\n";
+    const std::size_t paper = pairs * n, ours = pairs * n * n;
+    out << "| spheres | " << n << " | " << paper << " (" << ours << ") | " << paper * checkpoints << " ("
+        << ours * checkpoints << ") |\n";
   }
   return out.str();
 }

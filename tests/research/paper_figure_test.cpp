@@ -9,7 +9,7 @@ namespace cellmap::planning {
 namespace {
 
 TEST(PaperFigureTest, KnownDistancesAndConservativeSpheres) {
-  const PaperFigure figure = compute_paper_figure();
+  const PaperFigure figure = compute_paper_figure(PaperSetup::kRow3);
   ASSERT_EQ(figure.y.size(), 301u);
   // y = -0.8: face to face with an outer box, 0.3 − 0.1 = 0.2.
   EXPECT_NEAR(figure.gjk[70], 0.2, 1e-12);
@@ -24,8 +24,26 @@ TEST(PaperFigureTest, KnownDistancesAndConservativeSpheres) {
   EXPECT_LT(figure.spheres[0][70], figure.spheres[2][70]);
 }
 
+// The paper's setup: y in [-1, 1], six objects, so GJK costs 6 constraints per checkpoint and spheres with
+// N = 6 cost 36 in the paper's count (216 counting every sphere pair, as the curves are computed).
+TEST(PaperFigureTest, PaperSetupCountsAsThePaperDoes) {
+  const PaperFigure figure = compute_paper_figure(PaperSetup::kPaper);
+  ASSERT_EQ(figure.y.size(), 201u);
+  EXPECT_DOUBLE_EQ(figure.y.front(), -1.0);
+  EXPECT_NEAR(figure.y.back(), 1.0, 1e-12);
+  EXPECT_EQ(figure.n_rob * figure.n_env, 6);
+  // y = -1: face to face with the first (unturned) cuboid, 0.3 − 0.1 = 0.2.
+  EXPECT_NEAR(figure.gjk[0], 0.2, 1e-12);
+  for (std::size_t k = 0; k < figure.y.size(); ++k) {
+    for (const auto& curve : figure.spheres) EXPECT_LE(curve[k], figure.gjk[k] + 1e-12) << figure.y[k];
+  }
+  const std::string table = paper_constraint_table(figure);
+  EXPECT_NE(table.find("| GJK | - | 6 | 1206 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| spheres | 6 | 36 (216) | 7236 (43416) |"), std::string::npos) << table;
+}
+
 TEST(PaperFigureTest, OutputsHaveTheContractFormat) {
-  const PaperFigure figure = compute_paper_figure();
+  const PaperFigure figure = compute_paper_figure(PaperSetup::kRow3);
   std::istringstream csv(paper_figure_csv(figure));
   std::string line;
   std::getline(csv, line);
@@ -41,7 +59,7 @@ TEST(PaperFigureTest, OutputsHaveTheContractFormat) {
   EXPECT_EQ(polylines, 4u);
   const std::string table = paper_constraint_table(figure);
   EXPECT_NE(table.find("| GJK | - | 3 | 903 |"), std::string::npos) << table;
-  EXPECT_NE(table.find("| spheres | 6 | 108 | 32508 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| spheres | 6 | 18 (108) | 5418 (32508) |"), std::string::npos) << table;
 }
 
 }  // namespace

@@ -39,6 +39,14 @@ ToolRun run_tool(const std::string& args) {
   return run;
 }
 
+// A 10 cm cube standing on a 40 cm floor square, seen from above one side.
+test::Scene cube_on_floor() {
+  test::Scene scene(Eigen::Vector3f(0.1f, -0.7f, 0.8f));
+  scene.add_box({0.0, 0.0, 0.05}, {0.05, 0.05, 0.05}, Eigen::Matrix3d::Identity());
+  scene.add_floor(0.2, {{Eigen::Vector2d(-0.05, -0.05), Eigen::Vector2d(0.05, 0.05)}});
+  return scene;
+}
+
 class SegmentCommand : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -74,14 +82,16 @@ TEST_F(SegmentCommand, BadInputExitsNonZeroWithOneLineNamingTheFile) {
   expect_one_line_failure((dir_ / "far.pcd").string() + out, "far.pcd: point 0 has an absurd coordinate");
   std::ofstream(dir_ / "bad.yaml") << "region_growing:\n  gap: 0\n";
   pcl::io::savePCDFileBinary((dir_ / "ok.pcd").string(), far);
-  expect_one_line_failure((dir_ / "ok.pcd").string() + " --config " + (dir_ / "bad.yaml").string() + out,
-                          "region_growing.gap");
+  expect_one_line_failure(
+      (dir_ / "ok.pcd").string() + " --pipeline points --config " + (dir_ / "bad.yaml").string() + out,
+      "region_growing.gap");
+  std::ofstream(dir_ / "bad_cell.yaml") << "segment:\n  region_growing:\n    gap: 0\n";
+  expect_one_line_failure((dir_ / "ok.pcd").string() + " --config " + (dir_ / "bad_cell.yaml").string() + out,
+                          "segment.region_growing.gap");
 }
 
 TEST_F(SegmentCommand, WritesTheBoxesFileOfAPlyScene) {
-  test::Scene scene(Eigen::Vector3f(0.1f, -0.7f, 0.8f));
-  scene.add_box({0.0, 0.0, 0.05}, {0.05, 0.05, 0.05}, Eigen::Matrix3d::Identity());
-  scene.add_floor(0.2, {{Eigen::Vector2d(-0.05, -0.05), Eigen::Vector2d(0.05, 0.05)}});
+  const test::Scene scene = cube_on_floor();
   const fs::path ply = dir_ / "scene.ply";
   ASSERT_EQ(pcl::io::savePLYFileBinary(ply.string(), scene.points), 0);
   const fs::path out = dir_ / "boxes.json";
@@ -89,7 +99,7 @@ TEST_F(SegmentCommand, WritesTheBoxesFileOfAPlyScene) {
   // outliers).
   std::ofstream(dir_ / "no_sor.yaml") << "outliers:\n  mode: 'off'\n";
   for (const std::string kind : {"obb", "aabb"}) {
-    const ToolRun run = run_tool(ply.string() + " --boxes " + kind + " --config " +
+    const ToolRun run = run_tool(ply.string() + " --pipeline points --boxes " + kind + " --config " +
                                  (dir_ / "no_sor.yaml").string() + " -o " + out.string());
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.err.find("boxes"), std::string::npos);
@@ -111,6 +121,28 @@ TEST_F(SegmentCommand, WritesTheBoxesFileOfAPlyScene) {
       for (const Box& box : set.boxes) inside |= box.contains(p.getVector3fMap().cast<double>(), 1e-9);
       EXPECT_TRUE(inside);
     }
+  }
+}
+
+// The default path: the cloud as cellmapd's settled map. Boxes hold whole 2 cm voxels, so every point is
+// inside one; `points` counts voxels.
+TEST_F(SegmentCommand, CellPipelineBoxesHoldEveryPointOfAPlyScene) {
+  const test::Scene scene = cube_on_floor();
+  const fs::path ply = dir_ / "scene.ply";
+  ASSERT_EQ(pcl::io::savePLYFileBinary(ply.string(), scene.points), 0);
+  const fs::path out = dir_ / "boxes.json";
+  const ToolRun run = run_tool(ply.string() + " -o " + out.string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("points outside every box 0"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "summary is one line";
+  const BoxSet set = read_box_file(out);
+  ASSERT_GE(set.boxes.size(), 1u);
+  EXPECT_LE(set.boxes.size(), 5u);  // the cube, the floor around it in up to 4 pieces (measured 4 in all)
+  for (std::size_t b = 0; b < set.boxes.size(); ++b) EXPECT_EQ(set.boxes[b].id, b + 1);
+  for (const auto& p : scene.points) {
+    bool inside = false;
+    for (const Box& box : set.boxes) inside |= box.contains(p.getVector3fMap().cast<double>(), 1e-6);
+    EXPECT_TRUE(inside);
   }
 }
 

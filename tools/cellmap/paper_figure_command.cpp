@@ -1,4 +1,5 @@
-// `cellmap paper-figure -o DIR`: the paper's minimum-distance sweep (GJK vs spheres N = 1, 2, 6).
+// `cellmap paper-figure -o DIR`: the paper's minimum-distance sweep (GJK vs spheres N = 1, 2, 6), in the
+// paper's setup and in ours.
 // The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
 // Detection for Industrial Robotics Applications", AIRoV 2024.
 #include <filesystem>
@@ -22,12 +23,18 @@ void add_paper_figure_command(CLI::App& app) {
     std::error_code error;
     std::filesystem::create_directories(out, error);
     if (error) throw Error(*dir + ": cannot create folder (" + error.message() + ")");
-    const planning::PaperFigure figure = planning::compute_paper_figure();
-    write_file_atomically(out / "paper_figure.csv", planning::paper_figure_csv(figure));
-    write_file_atomically(out / "paper_figure.svg", planning::paper_figure_svg(figure));
-    write_file_atomically(out / "constraints.md", planning::paper_constraint_table(figure));
-    std::cout << "wrote " << (out / "paper_figure.csv").string() << ", "
-              << (out / "paper_figure.svg").string() << ", " << (out / "constraints.md").string() << "\n";
+    const planning::PaperFigure paper = planning::compute_paper_figure(planning::PaperSetup::kPaper);
+    const planning::PaperFigure row3 = planning::compute_paper_figure(planning::PaperSetup::kRow3);
+    write_file_atomically(out / "paper_figure.csv", planning::paper_figure_csv(paper));
+    write_file_atomically(out / "paper_figure.svg", planning::paper_figure_svg(paper));
+    write_file_atomically(out / "row3_figure.csv", planning::paper_figure_csv(row3));
+    write_file_atomically(out / "row3_figure.svg", planning::paper_figure_svg(row3));
+    write_file_atomically(out / "constraints.md", "The paper's setup (6 objects, y from -1 to 1 m):\n\n" +
+                                                      planning::paper_constraint_table(paper) +
+                                                      "\nOurs (3 boxes, y from -1.5 to 1.5 m):\n\n" +
+                                                      planning::paper_constraint_table(row3));
+    std::cout << "wrote " << out.string()
+              << "/{paper_figure.csv, paper_figure.svg, row3_figure.csv, row3_figure.svg, constraints.md}\n";
   });
 }
 

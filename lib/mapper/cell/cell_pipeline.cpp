@@ -84,6 +84,15 @@ std::string CellPipeline::map_state() const {
   return out.str();
 }
 
+std::size_t CellPipeline::settle_on(const Cloud& points_C) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(points_C.size());
+  for (const pcl::PointXYZ& p : points_C) points.push_back(p.getVector3fMap().cast<double>());
+  viewpoint_C_ = points_C.sensor_origin_.head<3>().cast<double>();
+  settling_ = false;
+  return map_.mark_occupied(points);
+}
+
 void CellPipeline::filter_robot(const Robot& robot) {
   filter_ = std::make_unique<SelfFilter>(robot, config_.self_filter);
 }

@@ -200,6 +200,22 @@ OccupancyUpdate OccupancyMap::integrate(const Sweep& sweep) {
   return update;
 }
 
+std::size_t OccupancyMap::mark_occupied(const std::vector<Eigen::Vector3d>& points_C) {
+  const float occupied = octomap::logodds(config_.clamp_max);
+  std::size_t outside = 0;
+  for (const Eigen::Vector3d& p : points_C) {
+    octomap::OcTreeKey key;
+    if (!p.allFinite()) continue;
+    if (tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) {
+      tree_->setNodeValue(key, occupied, true);
+    } else {
+      ++outside;
+    }
+  }
+  tree_->updateInnerOccupancy();
+  return outside;
+}
+
 VoxelState OccupancyMap::state(const Eigen::Vector3d& p_C) const {
   octomap::OcTreeKey key;
   if (!p_C.allFinite() || !tree_->coordToKeyChecked(p_C.x(), p_C.y(), p_C.z(), key))

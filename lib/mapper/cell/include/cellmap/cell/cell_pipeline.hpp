@@ -138,6 +138,12 @@ class CellPipeline final {
   /// then applies resegment_everything() once (the first version), and from then on works on changes only.
   SweepReport process(const Sweep& sweep);
 
+  /// Takes one cloud (metres, cell frame) as the settled map instead of fused sweeps: every voxel holding one
+  /// of its points occupied (OccupancyMap::mark_occupied), normals facing its `sensor_origin_`, settling over.
+  /// resegment_everything() then makes of it exactly what the first version makes of a settled map: the
+  /// batch tool's path (cloud_boxes.hpp). @return the points outside the map's key range (skipped).
+  std::size_t settle_on(const Cloud& points_C);
+
   /// What process() makes of one sweep's confirmed changes, on the current state and without applying it:
   /// the occupied evidence inside the regions of `changes`, inside every current box that lost at least a
   /// tenth of its voxels, and inside every box lying wholly within that area, leaving out what the other

@@ -49,6 +49,12 @@ class OccupancyMap final {
   /// @throws Error if a scan origin is not finite or outside the map's key range.
   OccupancyUpdate integrate(const Sweep& sweep);
 
+  /// Takes one cloud (metres, cell frame) as settled evidence: every voxel holding one of its points is set
+  /// to the upper clamp (occupied), nothing is cleared. What a batch cloud gives the map when there are no
+  /// sweeps to fuse: a cloud the caller already trusts (one merged sweep, a scan from a file). Non-finite
+  /// points are skipped. @return the number of points outside the map's key range (also skipped).
+  std::size_t mark_occupied(const std::vector<Eigen::Vector3d>& points_C);
+
   /// State of the voxel holding `p_C` (metres, cell frame); unknown outside the key range.
   [[nodiscard]] VoxelState state(const Eigen::Vector3d& p_C) const;
   /// State of the leaf voxel `key`.
