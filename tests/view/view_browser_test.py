@@ -8,6 +8,7 @@ round N times (default 1, the CI run). The last screenshot is written to view_br
 directory (the build's tests folder under ctest).
 """
 import argparse
+import base64
 import io
 import os
 import queue
@@ -406,7 +407,8 @@ class ViewTest(unittest.TestCase):
             'the arm cell in the list of cells')
         self.browser.find_element(By.CSS_SELECTOR, '#cell-select option[value="arm-view"]').click()
         wait_for(lambda: self.js('cellmapView.cell()') == 'arm-view', 'the page to show the arm cell')
-        before = self.screenshot()
+        self.log('arm cell shown')
+        before = self.canvas()[1]
         self.browser.find_element(By.ID, 'layer-robot').click()
         logged = wait_for(lambda: re.search(r'layer robot: (\d+) shapes \((\d+) triangles\), (\d+) bytes',
                                             daemon.log_text()), 'the daemon to publish the robot')
@@ -426,20 +428,22 @@ class ViewTest(unittest.TestCase):
         self.browser.find_element(By.ID, 'layer-robot').click()
         wait_for(lambda: 'layer robot: no reader' in daemon.log_text(), 'the daemon to stop publishing')
         self.assertEqual(daemon.stop(), 0)
+        self.log('arm cell daemon stopped')
+
+    def canvas(self):
+        """The robot as in the last frame the page drew, and that frame (read together, in one script)."""
+        robot, url = self.js('[cellmapView.robot(), document.getElementById("canvas").toDataURL("image/png")]')
+        return robot, Image.open(io.BytesIO(base64.b64decode(url.split(',', 1)[1]))).convert('RGB')
 
     def drawn_robot(self, before):
-        """The robot as the page draws it, once the screenshot taken meanwhile shows one sweep's robot: the
-        centre of every link's drawn bounds is in the robot colour (where it was not before the layer)."""
+        """The robot as the page draws it: the centre of every link's drawn bounds is in the robot colour (where
+        it was not before the layer was shown)."""
         def look():
-            robot = self.js('cellmapView.robot()')
+            robot, frame = self.canvas()
             if not robot or not robot['shapes']:
                 return None
-            shot = self.screenshot()
-            if self.js('cellmapView.robot().sweep') != robot['sweep']:
-                return None  # a newer sweep came while the screenshot was taken
-            samples = self.pixels([s['center'] for s in robot['shapes']])
-            drawn = [s['link'] for s, (x, y) in zip(robot['shapes'], samples)
-                     if colour_near(before, shot, x, y, is_robot_colour, radius=3)]
+            drawn = [s['link'] for s in robot['shapes']
+                     if colour_near(before, frame, int(s['pixel'][0]), int(s['pixel'][1]), is_robot_colour, 3)]
             return robot if len(drawn) >= len(robot['shapes']) - 1 else None  # one may hide behind another
         return wait_for(look, 'the robot drawn')
 

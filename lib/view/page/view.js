@@ -187,6 +187,7 @@ function applyHighlights(now) {
 
 // ---- drawing on demand: a frame when something changed, and while highlights fade ----
 let frameRequested = false;
+let drawnRobot = null;  // the robot layer's group in the last frame drawn
 
 function requestRender() {
   if (frameRequested) return;
@@ -201,6 +202,7 @@ function drawFrame() {
   const now = performance.now();
   const redraw = applyHighlights(now);
   renderer.render(scene, camera);
+  drawnRobot = layerGroup.children.find((o) => o.userData.robot !== undefined) || null;
   if (pendingFrameStamps.length > 0) {
     const drawn = Date.now();
     for (const entry of pendingFrameStamps) entry.frame_ms = drawn;
@@ -705,15 +707,18 @@ window.cellmapView = {
   },
   // The change regions drawn: per region, its min and max corners (cell frame).
   regionBounds: () => layerGroup.children.filter((o) => o.userData.regions).flatMap((o) => o.userData.regions),
-  // The robot drawn: its sweep and per shape its link, whether carried, its frame's origin and the centre of
-  // its drawn bounds (cell frame).
+  // The robot as in the last frame drawn (what the canvas shows): its sweep and per shape its link, whether
+  // carried, its frame's origin and the centre of its bounds (cell frame), and where that centre is on the
+  // canvas (device pixels from its top left).
   robot: () => {
-    const group = layerGroup.children.find((o) => o.userData.robot !== undefined);
-    if (!group) return null;
-    const center = (m) => new THREE.Box3().setFromObject(m).getCenter(new THREE.Vector3()).toArray();
-    return { sweep: group.userData.robot,
-             shapes: group.children.map((m) => ({ ...m.userData.robotShape, position: m.position.toArray(),
-                                                  center: center(m) })) };
+    if (!drawnRobot) return null;
+    const shapes = drawnRobot.children.map((m) => {
+      const center = new THREE.Box3().setFromObject(m).getCenter(new THREE.Vector3());
+      const p = center.clone().project(camera);
+      return { ...m.userData.robotShape, position: m.position.toArray(), center: center.toArray(),
+               pixel: [((p.x + 1) / 2) * canvas.width, ((1 - p.y) / 2) * canvas.height] };
+    });
+    return { sweep: drawnRobot.userData.robot, shapes };
   },
   latency,
 };
