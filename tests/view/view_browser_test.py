@@ -330,7 +330,7 @@ class ViewTest(unittest.TestCase):
     def check_sensors(self, daemon):
         """Ticking "sensors" makes the daemon publish its frames' poses and fields of view, and the page draws
         each frustum: along the lines from each sensor, pixels turn the frustum colour."""
-        before = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+        before = self.screenshot()
         self.browser.find_element(By.ID, 'layer-sensors').click()
         logged = wait_for(lambda: re.search(r'layer sensors: (\d+) views, (\d+) bytes', daemon.log_text()),
                           'the daemon to publish the sensor views')
@@ -351,8 +351,8 @@ class ViewTest(unittest.TestCase):
                 samples.append((int(x * ratio), int(y * ratio)))
 
         def drawn_fraction():
-            after = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
-            hits = sum(1 for x, y in samples if frustum_pixel_near(before, after, x, y))
+            after = self.screenshot()
+            hits = sum(1 for x, y in samples if colour_near(before, after, x, y, is_frustum_colour))
             return hits / len(samples)
         fraction = wait_for(lambda: (lambda f: f if f >= 0.8 else None)(drawn_fraction()),
                             'the frustum lines drawn')
@@ -472,18 +472,10 @@ def is_robot_colour(pixel):
     return r > 90 and r - b > 60 and r - g > 25 and g > b
 
 
-def frustum_pixel_near(before, after, x, y, radius=2):
-    """Whether a pixel within `radius` of (x, y) turned the frustum colour (teal, 0x008c8c, antialiased over
-    the light background: green and blue well above red)."""
-    for dx in range(-radius, radius + 1):
-        for dy in range(-radius, radius + 1):
-            p = (x + dx, y + dy)
-            if not (0 <= p[0] < after.width and 0 <= p[1] < after.height):
-                continue
-            r, g, b = after.getpixel(p)
-            if g - r > 40 and b - r > 40 and abs(g - b) < 50 and after.getpixel(p) != before.getpixel(p):
-                return True
-    return False
+def is_frustum_colour(pixel):
+    """The frustum's teal (0x008c8c), antialiased over the light background: green and blue well above red."""
+    r, g, b = pixel
+    return g - r > 40 and b - r > 40 and abs(g - b) < 50
 
 
 def main():
