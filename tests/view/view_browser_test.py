@@ -467,9 +467,9 @@ def is_region_colour(pixel):
 
 
 def is_robot_colour(pixel):
-    """The robot's orange (0xf07818), shaded."""
+    """The robot's orange (0xf07818), shaded (faces turned down from the light are dark)."""
     r, g, b = pixel
-    return r > 90 and r - b > 60 and r - g > 25 and g > b
+    return r > 70 and r - b > 60 and r - g > 25 and g > b
 
 
 def is_frustum_colour(pixel):
