@@ -68,6 +68,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
 void Daemon::use_self_filter() {
   const std::optional<Robot> robot = acquisition_->robot();
   const SelfFilterConfig& filter = config_.pipeline.self_filter;
+  if (robot) layers_.show_robot(*robot, filter);
   if (!filter.enabled) {
     spdlog::info("self filter off (self_filter.enabled): the robot in view is mapped as an obstacle");
   } else if (!robot) {

@@ -44,7 +44,8 @@ class Daemon final {
   void acquire();
   void process();
   void handle(const FrameSweep& sweep, std::uint64_t number);
-  // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled).
+  // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the
+  // robot layer the model to show.
   void use_self_filter();
   void publish_status();
 

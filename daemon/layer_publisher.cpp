@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 
 #include "cellmap/common/error.hpp"
@@ -33,8 +34,25 @@ const char* name(Layer layer) {
       return "change regions";
     case Layer::kSensors:
       return "sensors";
+    case Layer::kRobot:
+      return "robot";
   }
   return "?";
+}
+
+// The robot's shapes at `at`, and the payload its tool holds (a box; none if it has no volume).
+std::vector<transport::PosedShape> posed_shapes(const Robot& robot, const RobotAt& at) {
+  std::vector<transport::PosedShape> shapes;
+  const std::vector<LinkShape>& on_links = robot.shapes();
+  for (std::size_t i = 0; i < on_links.size(); ++i) {
+    const Eigen::Isometry3d& X_CL = at.X_CL.at(static_cast<std::size_t>(robot.shape_links()[i]));
+    shapes.push_back({on_links[i].link, false, X_CL * on_links[i].X_LG, on_links[i].geometry});
+  }
+  if (at.payload && (at.payload->half_extents.array() > 0).all()) {
+    shapes.push_back({robot.link_names().back(), true, at.X_CL.back() * at.payload->X_EB,
+                      BoxShape{at.payload->half_extents}});
+  }
+  return shapes;
 }
 
 }  // namespace
@@ -48,6 +66,7 @@ void LayerPublisher::after_sweep(std::uint64_t number, const FrameSweep& sweep, 
     if (read(Layer::kVoxels, voxels_read_)) publish_voxels(number, map);
     if (read(Layer::kChangeRegions, regions_read_)) publish_regions(number, changes);
     if (read(Layer::kSensors, sensors_read_)) publish_sensors(number, sweep);
+    if (read(Layer::kRobot, robot_read_)) publish_robot(number, sweep);
   } catch (const Error& e) {
     spdlog::warn("layers: {}; retrying after the next sweep", e.what());
   }
@@ -110,6 +129,30 @@ void LayerPublisher::publish_sensors(std::uint64_t number, const FrameSweep& swe
     spdlog::info("layer sensors: {} views, {} bytes", layer.views.size(), transport::wire_size(layer));
   }
   sensor_readers_served_ = joined;
+}
+
+void LayerPublisher::show_robot(Robot robot, const SelfFilterConfig& filter) {
+  robot_ = std::move(robot);
+  padding_scale_ = filter.enabled ? filter.padding_scale : 1.0;
+  padding_ = filter.enabled ? filter.padding : 0.0;
+}
+
+void LayerPublisher::publish_robot(std::uint64_t number, const FrameSweep& sweep) {
+  const auto last = std::find_if(sweep.frames.rbegin(), sweep.frames.rend(),
+                                 [](const SweepFrame& taken) { return taken.robot.has_value(); });
+  if (!robot_ || last == sweep.frames.rend()) return;  // no robot model, or no frame posed it
+  if (last->robot->X_CL.size() != robot_->link_names().size())
+    throw Error("robot layer: the frame's robot has " + std::to_string(last->robot->X_CL.size()) +
+                " link poses, the model " + std::to_string(robot_->link_names().size()) + " links");
+  const std::uint32_t joined = writer_.readers_joined(Layer::kRobot);
+  const transport::RobotLayer layer{writer_.cell(), number,   system_now_ns(),
+                                    padding_scale_, padding_, posed_shapes(*robot_, *last->robot)};
+  writer_.write(layer);
+  if (joined != robot_readers_served_) {
+    spdlog::info("layer robot: {} shapes ({} triangles), {} bytes", layer.shapes.size(),
+                 robot_->triangle_count(), transport::wire_size(layer));
+  }
+  robot_readers_served_ = joined;
 }
 
 }  // namespace cellmap::daemon

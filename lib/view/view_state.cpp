@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 namespace cellmap::view {
 namespace {
 
@@ -94,10 +96,64 @@ json sensors_json(const transport::SensorLayer& layer) {
           {"views", views}};
 }
 
+// Mesh vertices to 0.1 mm: the page draws them, and short numbers keep the message small.
+json rounded(float v) {
+  return std::round(static_cast<double>(v) * 1e4) / 1e4;
+}
+
+struct ShapeJson {
+  json& out;
+  void operator()(const BoxShape& box) const {
+    out["kind"] = "box";
+    out["half_extents"] = vector_json(box.half_extents);
+  }
+  void operator()(const CylinderShape& cylinder) const {
+    out["kind"] = "cylinder";
+    out["radius"] = cylinder.radius;
+    out["half_length"] = cylinder.half_length;
+  }
+  void operator()(const SphereShape& sphere) const {
+    out["kind"] = "sphere";
+    out["radius"] = sphere.radius;
+  }
+  void operator()(const MeshShape& shape) const {
+    out["kind"] = "mesh";
+    json vertices = json::array();
+    for (const Eigen::Vector3d& v : shape.mesh->vertices)
+      for (int k = 0; k < 3; ++k) vertices.push_back(rounded(static_cast<float>(v[k])));
+    json triangles = json::array();
+    for (const Eigen::Vector3i& t : shape.mesh->triangles)
+      for (int k = 0; k < 3; ++k) triangles.push_back(t[k]);
+    out["vertices"] = std::move(vertices);
+    out["triangles"] = std::move(triangles);
+  }
+};
+
+json robot_json(const transport::RobotLayer& layer) {
+  json shapes = json::array();
+  for (const transport::PosedShape& shape : layer.shapes) {
+    const Eigen::Quaterniond q_CG(shape.X_CG.linear());
+    json out{{"link", shape.link},
+             {"carried", shape.carried},
+             {"position", vector_json(shape.X_CG.translation())},
+             {"rotation", json::array({q_CG.w(), q_CG.x(), q_CG.y(), q_CG.z()})}};
+    std::visit(ShapeJson{out}, shape.geometry);
+    shapes.push_back(std::move(out));
+  }
+  return {{"type", "robot"},
+          {"cell", layer.cell},
+          {"sweep", layer.sweep},
+          {"stamp_ns", layer.stamp_ns},
+          {"padding_scale", layer.padding_scale},
+          {"padding", layer.padding},
+          {"shapes", shapes}};
+}
+
 struct LayerJson {
   json operator()(const transport::VoxelLayer& layer) const { return voxels_json(layer); }
   json operator()(const transport::ChangeRegionLayer& layer) const { return regions_json(layer); }
   json operator()(const transport::SensorLayer& layer) const { return sensors_json(layer); }
+  json operator()(const transport::RobotLayer& layer) const { return robot_json(layer); }
 };
 
 }  // namespace
@@ -110,6 +166,8 @@ const char* layer_name(transport::Layer layer) {
       return "regions";
     case transport::Layer::kSensors:
       return "sensors";
+    case transport::Layer::kRobot:
+      return "robot";
   }
   return "?";
 }

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <thread>
 
 #include "cellmap/sweep/sweep.hpp"
@@ -162,6 +163,84 @@ TEST_F(LayerPublisherTest, SensorViewsGoOutAfterEachSweepWhileRead) {
 
   layers.after_sweep(3, sweep, map, {});  // the sensors move with every sweep: written each time
   EXPECT_EQ(next_layer<transport::SensorLayer>(reader).sweep, 3u);
+}
+
+// The robot layer shows the robot at the sweep's last frame that posed it: the gantry's parts are boxes given
+// at q = 0 in the cell frame, so at q each lies moved by the axes that carry it.
+TEST_F(LayerPublisherTest, RobotShapesFollowTheJointsOfEachSweep) {
+  dds::Participant daemon(test::domain::kRobotLayerPublisher);
+  dds::Participant viewer(test::domain::kRobotLayerPublisher);
+  const Eigen::Vector3d lower(0, 0, -0.6), upper(3, 2, 0);
+  const Eigen::Isometry3d X_CE_zero =
+      Eigen::Translation3d(0, 0, 2.4) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX());
+  const GantryParts parts = GantryParts::fitting(lower, upper, X_CE_zero);
+  const Robot robot = Robot::gantry(lower, upper, X_CE_zero, parts);
+  LayerPublisher layers(daemon, "cell-1");
+  SelfFilterConfig filter;
+  filter.padding = 0.03;
+  layers.show_robot(robot, filter);
+  const OccupancyMap map;
+  const auto sweep_at = [&](const Eigen::Vector3d& q, std::optional<Payload> payload) {
+    FrameSweep sweep;
+    sweep.frames.push_back(
+        {Frame{}, RobotAt{robot.link_poses(Eigen::Vector3d(0.5, 1.0, 0.0)), std::nullopt}});
+    sweep.frames.push_back({Frame{}, RobotAt{robot.link_poses(q), std::move(payload)}});
+    sweep.frames.push_back({Frame{}, std::nullopt});  // a frame without the robot's pose: not the latest
+    return sweep;
+  };
+  transport::LayerReader reader(viewer, Layer::kRobot);
+  wait_until_read(daemon, Layer::kRobot, 1);
+
+  const Eigen::Vector3d q1(2.5, 1.0, -0.2);
+  layers.after_sweep(1, sweep_at(q1, std::nullopt), map, {});
+  const auto first = next_layer<transport::RobotLayer>(reader);
+  EXPECT_EQ(first.sweep, 1u);
+  EXPECT_EQ(first.padding_scale, 1.0);
+  EXPECT_EQ(first.padding, 0.03);
+  ASSERT_EQ(first.shapes.size(), 3u);
+  const std::pair<const char*, Eigen::Vector3d> expected[] = {
+      {"bridge", parts.bridge.center + Eigen::Vector3d(q1.x(), 0, 0)},
+      {"carriage", parts.carriage.center + Eigen::Vector3d(q1.x(), q1.y(), 0)},
+      {"ram", parts.ram.center + q1}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(first.shapes[i].link, expected[i].first);
+    EXPECT_FALSE(first.shapes[i].carried);
+    EXPECT_TRUE(first.shapes[i].X_CG.translation().isApprox(expected[i].second, 1e-12))
+        << expected[i].first << " at " << first.shapes[i].X_CG.translation().transpose();
+    EXPECT_TRUE(first.shapes[i].X_CG.linear().isIdentity(1e-12));
+  }
+  EXPECT_EQ(std::get<BoxShape>(first.shapes[2].geometry).half_extents, parts.ram.half_extents);
+
+  // The joints changed, and the tool holds a carton 0.2 m below the flange (the tool's z points down).
+  const Eigen::Vector3d q2(0.4, 1.5, -0.5);
+  Payload carton{Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.2)), {0.15, 0.1, 0.1}};
+  layers.after_sweep(2, sweep_at(q2, carton), map, {});
+  const auto second = next_layer<transport::RobotLayer>(reader);
+  EXPECT_EQ(second.sweep, 2u);
+  ASSERT_EQ(second.shapes.size(), 4u);
+  EXPECT_TRUE(second.shapes[2].X_CG.translation().isApprox(parts.ram.center + q2, 1e-12));
+  const transport::PosedShape& held = second.shapes[3];
+  EXPECT_TRUE(held.carried);
+  EXPECT_EQ(held.link, "ram");
+  EXPECT_TRUE(held.X_CG.translation().isApprox(Eigen::Vector3d(0.4, 1.5, 2.4 - 0.5 - 0.2), 1e-12));
+  EXPECT_EQ(std::get<BoxShape>(held.geometry).half_extents, carton.half_extents);
+}
+
+TEST_F(LayerPublisherTest, NoRobotLayerWithoutARobotModel) {
+  dds::Participant daemon(test::domain::kRobotLayerPublisher);
+  dds::Participant viewer(test::domain::kRobotLayerPublisher);
+  const Robot robot = Robot::gantry({0, 0, -0.6}, {3, 2, 0});
+  LayerPublisher layers(daemon, "cell-2");  // show_robot() never called
+  transport::LayerReader reader(viewer, Layer::kRobot);
+  wait_until_read(daemon, Layer::kRobot, 1);
+  FrameSweep sweep;
+  sweep.frames.push_back({Frame{}, RobotAt{robot.link_poses(Eigen::Vector3d(1, 1, 0)), std::nullopt}});
+  layers.after_sweep(1, sweep, OccupancyMap{}, {});
+  layers.show_robot(robot, SelfFilterConfig{});
+  layers.after_sweep(2, sweep, OccupancyMap{}, {});
+  const auto got = next_layer<transport::RobotLayer>(reader);
+  EXPECT_EQ(got.sweep, 2u);         // not 1
+  EXPECT_TRUE(got.shapes.empty());  // a kinematics-only gantry has no shapes
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
 // A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), the
 // browser test 220-221 (tests/view/view_browser_test.py), scripts/soak 179. Credentials tests name domains 7,
-// 197 and 233 without joining them. Ids end at 232.
+// 197 and 233 without joining them. Ids above 232 cannot be joined: Cyclone's ports for domain d start at
+// 7400 + 250 · d, beyond 65535 there.
 
 namespace cellmap::test::domain {
 
@@ -69,6 +70,7 @@ inline constexpr int kArmBothCoverage = 166;
 inline constexpr int kKeeper = 186;
 inline constexpr int kSimAcquisition = 187;
 inline constexpr int kLayerPublisher = 223;
+inline constexpr int kRobotLayerPublisher = 137;
 
 // faults_e2e_test.
 inline constexpr int kFirstVersionFault = 188;
@@ -82,5 +84,6 @@ inline constexpr int kRefusal = 196;
 
 // transport_test: the viewer's layers.
 inline constexpr int kLayers = 222;
+inline constexpr int kRobotLayer = 136;
 
 }  // namespace cellmap::test::domain

@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """`cellmap view` in a real browser: cellmapd on the simulated cell (exact depths), `cellmap view`, `cellmap
-inject` and `cellmap render` as processes, and Debian's chromium (headless) driven by python3-selenium.
+inject` and `cellmap render` as processes, and Debian's chromium (headless) driven by python3-selenium. At the
+end cellmapd runs the arm cell (its fixed camera only) on the same domain, to see the robot layer move.
 
 Domain 220. CELLMAP_BROWSER_ROUNDS=N repeats the inject/remove/restart
 round N times (default 1, the CI run). The last screenshot is written to view_browser.png in the working
 directory (the build's tests folder under ctest).
 """
 import argparse
+import base64
 import io
 import os
 import queue
@@ -39,6 +41,8 @@ BACKGROUND = (0xfb, 0xfc, 0xfd)  # the scene's background colour in view.js
 TABLE_POINT = (1.0, 1.25, 0.75)  # on the default cell's table top, clear of every object (config/cell.yaml)
 NEW_BOX = ['add-box', '--center', '2.12,0.45,0.9', '--half-extents', '0.1,0.1,0.15']  # the README's example
 NEW_BOX_TOP = (2.12, 0.45, 1.05)
+NEW_BOX_CENTER = (2.12, 0.45, 0.9)
+ARM_BASE = (1.5, -0.45, 0.5)  # where config/scenes/arm_cell.yaml stands the arm's base_link
 
 ARGS = None
 
@@ -138,14 +142,14 @@ class ViewTest(unittest.TestCase):
                 p.stop(signal.SIGKILL)
 
     # ---- processes ----
-    def start_daemon(self):
-        config = os.path.join(self.dir, 'cellmapd.yaml')
+    def start_daemon(self, text=None, name='cellmapd'):
+        config = os.path.join(self.dir, f'{name}.yaml')
         with open(config, 'w') as f:
             # Exact depths fill the map in two sweeps: a short settling is enough.
-            f.write('cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n'
-                    'change: {settle_sweeps: 4}\n')
+            f.write(text or 'cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n'
+                            'change: {settle_sweeps: 4}\n')
         daemon = Process([ARGS.cellmapd, '--config', config, '--domain', str(LIVE_DOMAIN), '--state-dir',
-                          os.path.join(self.dir, 'state')], os.path.join(self.dir, 'cellmapd.log'))
+                          os.path.join(self.dir, f'{name}-state')], os.path.join(self.dir, f'{name}.log'))
         self.processes.append(daemon)
         return daemon
 
@@ -227,10 +231,14 @@ class ViewTest(unittest.TestCase):
             daemon, view = self.round(daemon, view, port, round_number)
         self.check_layers(daemon)
         self.check_sensors(daemon)
+        self.assertEqual(daemon.stop(), 0)
+        self.check_robot()
         self.assertTrue(self.js('window.notReloaded === true'), 'the page was reloaded')
 
     def round(self, daemon, view, port, round_number):
         before = self.listed_ids()
+        if round_number == 0:
+            self.browser.find_element(By.ID, 'layer-regions').click()
         # Watched while the tool still runs: the box glows for a few seconds only.
         inject = Process([ARGS.cellmap, 'inject', '--domain', str(LIVE_DOMAIN), '--wait', '60', *NEW_BOX],
                          os.path.join(self.dir, 'inject.log'))
@@ -248,6 +256,8 @@ class ViewTest(unittest.TestCase):
         self.assertIn(new_id, shown['changed'])
         wait_for(lambda: new_id in self.js('cellmapView.highlighted()'), 'the new box to glow in the scene')
         self.report_latency()
+        if round_number == 0:
+            self.check_regions(daemon)
         self.check_click(new_id)
         self.check_screenshot()
         name = inject.line()
@@ -320,7 +330,7 @@ class ViewTest(unittest.TestCase):
     def check_sensors(self, daemon):
         """Ticking "sensors" makes the daemon publish its frames' poses and fields of view, and the page draws
         each frustum: along the lines from each sensor, pixels turn the frustum colour."""
-        before = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+        before = self.screenshot()
         self.browser.find_element(By.ID, 'layer-sensors').click()
         logged = wait_for(lambda: re.search(r'layer sensors: (\d+) views, (\d+) bytes', daemon.log_text()),
                           'the daemon to publish the sensor views')
@@ -341,8 +351,8 @@ class ViewTest(unittest.TestCase):
                 samples.append((int(x * ratio), int(y * ratio)))
 
         def drawn_fraction():
-            after = Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
-            hits = sum(1 for x, y in samples if frustum_pixel_near(before, after, x, y))
+            after = self.screenshot()
+            hits = sum(1 for x, y in samples if colour_near(before, after, x, y, is_frustum_colour))
             return hits / len(samples)
         fraction = wait_for(lambda: (lambda f: f if f >= 0.8 else None)(drawn_fraction()),
                             'the frustum lines drawn')
@@ -351,18 +361,121 @@ class ViewTest(unittest.TestCase):
         wait_for(lambda: 'layer sensors: no reader' in daemon.log_text(), 'the daemon to stop publishing')
 
 
-def frustum_pixel_near(before, after, x, y, radius=2):
-    """Whether a pixel within `radius` of (x, y) turned the frustum colour (teal, 0x008c8c, antialiased over
-    the light background: green and blue well above red)."""
+    def screenshot(self):
+        return Image.open(io.BytesIO(self.browser.get_screenshot_as_png())).convert('RGB')
+
+    def pixels(self, points):
+        """Where cell-frame points appear in a screenshot (device pixels)."""
+        ratio = self.js('window.devicePixelRatio')
+        return [(int(x * ratio), int(y * ratio))
+                for x, y in (self.js('cellmapView.project(%f, %f, %f)' % tuple(p)) for p in points)]
+
+    def check_regions(self, daemon):
+        """The sweep that confirmed the new box sent its change region: the page draws a region around the box,
+        its top edges in the region colour, gone when the layer is unticked."""
+        logged = wait_for(lambda: re.search(r'layer change regions: (\d+) regions, (\d+) bytes', daemon.log_text()),
+                          'the daemon to publish the change regions')
+        self.log(f'change regions layer: {logged.group(1)} regions, {logged.group(2)} bytes')
+
+        def around_new_box():
+            return [r for r in self.js('cellmapView.regionBounds()')
+                    if all(lo <= c <= hi for lo, c, hi in zip(r[0], NEW_BOX_CENTER, r[1]))]
+        region = wait_for(around_new_box, 'a change region around the new box on the page')[0]
+        (x0, y0, _), (x1, y1, z1) = region
+        self.assertLess(x1 - x0, 0.6, region)  # the 0.2 m box and its margin, not the whole cell
+        corners = [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+        edges = [[[a + t / 10 * (b - a) for a, b in zip(corners[i], corners[(i + 1) % 4])] for t in range(1, 10)]
+                 for i in range(4)]
+        samples = self.pixels([p for edge in edges for p in edge])
+        shown = self.screenshot()
+        self.browser.find_element(By.ID, 'layer-regions').click()
+        wait_for(lambda: self.js('cellmapView.regionBounds().length === 0'), 'the regions to go from the page')
+        hidden = self.screenshot()
+        hits = sum(1 for x, y in samples if colour_near(hidden, shown, x, y, is_region_colour))
+        self.log(f'{hits} of {len(samples)} points along the region\'s top edges drawn in its colour')
+        self.assertGreaterEqual(hits, 0.6 * len(samples))
+        wait_for(lambda: 'layer change regions: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+
+    def check_robot(self):
+        """cellmapd on the arm cell: ticking "robot" draws the arm's links, its base where the scene stands it,
+        and the links move with the arm's joints from sweep to sweep."""
+        scene = os.path.join(ARGS.config_dir, 'scenes', 'arm_cell.yaml')
+        daemon = self.start_daemon(f'cell: arm-view\nsweep_period: 0.5\nstatus_period: 0.5\n'
+                                   f'sources:\n  - {{kind: sim, scene: {scene}, sensor: post}}\n', 'arm')
+        select = wait_for(lambda: (lambda o: o if 'arm-view' in o else None)(
+            [o.text for o in self.browser.find_elements(By.CSS_SELECTOR, '#cell-select option')]),
+            'the arm cell in the list of cells')
+        self.browser.find_element(By.CSS_SELECTOR, '#cell-select option[value="arm-view"]').click()
+        wait_for(lambda: self.js('cellmapView.cell()') == 'arm-view', 'the page to show the arm cell')
+        self.log('arm cell shown')
+        before = self.canvas()[1]
+        self.browser.find_element(By.ID, 'layer-robot').click()
+        logged = wait_for(lambda: re.search(r'layer robot: (\d+) shapes \((\d+) triangles\), (\d+) bytes',
+                                            daemon.log_text()), 'the daemon to publish the robot')
+        self.log(f'robot layer: {logged.group(1)} shapes, {logged.group(2)} triangles, {logged.group(3)} bytes '
+                 f'per sweep (cells listed: {select})')
+        first = self.drawn_robot(before)
+        base = next(s for s in first['shapes'] if s['link'] == 'base_link')
+        for got, want in zip(base['position'], ARM_BASE):
+            self.assertAlmostEqual(got, want, delta=1e-6)
+        tool = lambda robot: next(s for s in robot['shapes'] if s['link'] == 'link_6')['center']
+        second = wait_for(lambda: (lambda r: r if r['sweep'] > first['sweep'] and
+                                   max(abs(a - b) for a, b in zip(tool(r), tool(first))) > 0.05 else None)(
+            self.drawn_robot(before)), 'the arm to move on the page')
+        moved = [b - a for a, b in zip(tool(first), tool(second))]
+        self.log(f'sweeps {first["sweep"]} -> {second["sweep"]}: link_6 moved by '
+                 f'({moved[0]:.3f}, {moved[1]:.3f}, {moved[2]:.3f}) m, drawn at its place each time')
+        self.browser.find_element(By.ID, 'layer-robot').click()
+        wait_for(lambda: 'layer robot: no reader' in daemon.log_text(), 'the daemon to stop publishing')
+        self.assertEqual(daemon.stop(), 0)
+        self.log('arm cell daemon stopped')
+
+    def canvas(self):
+        """The robot as in the last frame the page drew, and that frame (read together, in one script)."""
+        robot, url = self.js('[cellmapView.robot(), document.getElementById("canvas").toDataURL("image/png")]')
+        return robot, Image.open(io.BytesIO(base64.b64decode(url.split(',', 1)[1]))).convert('RGB')
+
+    def drawn_robot(self, before):
+        """The robot as the page draws it: the centre of every link's drawn bounds is in the robot colour (where
+        it was not before the layer was shown)."""
+        def look():
+            robot, frame = self.canvas()
+            if not robot or not robot['shapes']:
+                return None
+            drawn = [s['link'] for s in robot['shapes']
+                     if colour_near(before, frame, int(s['pixel'][0]), int(s['pixel'][1]), is_robot_colour, 3)]
+            return robot if len(drawn) >= len(robot['shapes']) - 1 else None  # one may hide behind another
+        return wait_for(look, 'the robot drawn')
+
+
+def colour_near(before, after, x, y, is_colour, radius=2):
+    """Whether a pixel within `radius` of (x, y) is of a colour (`is_colour`) and was not before."""
     for dx in range(-radius, radius + 1):
         for dy in range(-radius, radius + 1):
             p = (x + dx, y + dy)
             if not (0 <= p[0] < after.width and 0 <= p[1] < after.height):
                 continue
-            r, g, b = after.getpixel(p)
-            if g - r > 40 and b - r > 40 and abs(g - b) < 50 and after.getpixel(p) != before.getpixel(p):
+            if is_colour(after.getpixel(p)) and after.getpixel(p) != before.getpixel(p):
                 return True
     return False
+
+
+def is_region_colour(pixel):
+    """The change regions' magenta (0xe0399a), antialiased over the light background."""
+    r, g, b = pixel
+    return r - g > 60 and b - g > 25
+
+
+def is_robot_colour(pixel):
+    """The robot's orange (0xf07818), shaded (faces turned down from the light are dark)."""
+    r, g, b = pixel
+    return r > 70 and r - b > 60 and r - g > 25 and g > b
+
+
+def is_frustum_colour(pixel):
+    """The frustum's teal (0x008c8c), antialiased over the light background: green and blue well above red."""
+    r, g, b = pixel
+    return g - r > 40 and b - r > 40 and abs(g - b) < 50
 
 
 def main():
@@ -370,6 +483,7 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument('--cellmap', required=True)
     parser.add_argument('--cellmapd', required=True)
+    parser.add_argument('--config-dir', required=True)  # the repository's config/, for the arm cell
     ARGS, rest = parser.parse_known_args()
     unittest.main(argv=[sys.argv[0], '-v', *rest])
 

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 namespace cellmap::view {
@@ -192,6 +193,48 @@ TEST(ViewStateTest, SensorViewsCarryPoseAndOutline) {
   EXPECT_EQ(message["views"][1]["max_range"], 0.0);
   EXPECT_EQ(state.layers(transport::Layer::kSensors).size(), 1u);
   EXPECT_TRUE(state.layers(transport::Layer::kChangeRegions).empty());
+}
+
+TEST(ViewStateTest, RobotShapesCarryPoseKindAndSizes) {
+  ViewState state(0, "");
+  auto mesh = std::make_shared<TriangleMesh>();
+  mesh->vertices = {{0, 0, 0}, {0.123456, 0, 0}, {0, 0.2, 0}};
+  mesh->triangles = {{0, 1, 2}};
+  Eigen::Isometry3d X_CG = Eigen::Isometry3d::Identity();
+  X_CG.translation() = Eigen::Vector3d(1.5, -0.45, 0.5);
+  X_CG.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const transport::RobotLayer layer{
+      "cell-a",
+      4,
+      99,
+      1.0,
+      0.04,
+      {{"base_link", false, X_CG, MeshShape{mesh}},
+       {"link_2", false, Eigen::Isometry3d::Identity(), CylinderShape{0.05, 0.2}},
+       {"link_3", false, Eigen::Isometry3d::Identity(), SphereShape{0.07}},
+       {"tool0", true, Eigen::Isometry3d::Identity(), BoxShape{{0.2, 0.15, 0.1}}}}};
+  const json message = json::parse(state.on_layer(layer));
+  EXPECT_EQ(message["type"], "robot");
+  EXPECT_EQ(message["sweep"], 4);
+  EXPECT_EQ(message["padding"], 0.04);
+  ASSERT_EQ(message["shapes"].size(), 4u);
+  const json& base = message["shapes"][0];
+  EXPECT_EQ(base["link"], "base_link");
+  EXPECT_EQ(base["kind"], "mesh");
+  EXPECT_EQ(base["position"], json::array({1.5, -0.45, 0.5}));
+  EXPECT_NEAR(base["rotation"][0].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(base["rotation"][3].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(base["vertices"], json::array({0.0, 0.0, 0.0, 0.1235, 0.0, 0.0, 0.0, 0.2, 0.0}));  // to 0.1 mm
+  EXPECT_EQ(base["triangles"], json::array({0, 1, 2}));
+  EXPECT_EQ(message["shapes"][1]["kind"], "cylinder");
+  EXPECT_EQ(message["shapes"][1]["radius"], 0.05);
+  EXPECT_EQ(message["shapes"][1]["half_length"], 0.2);
+  EXPECT_EQ(message["shapes"][2]["kind"], "sphere");
+  EXPECT_EQ(message["shapes"][2]["radius"], 0.07);
+  EXPECT_EQ(message["shapes"][3]["kind"], "box");
+  EXPECT_EQ(message["shapes"][3]["carried"], true);
+  EXPECT_EQ(message["shapes"][3]["half_extents"], json::array({0.2, 0.15, 0.1}));
+  EXPECT_EQ(state.layers(transport::Layer::kRobot).size(), 1u);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "cellmap/transport/layers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "cellmap/common/error.hpp"
 #include "wire.hpp"
@@ -17,6 +19,8 @@ const char* topic_name(Layer layer) {
       return kChangeRegionLayerTopic;
     case Layer::kSensors:
       return kSensorLayerTopic;
+    case Layer::kRobot:
+      return kRobotLayerTopic;
   }
   throw Error("layers: unknown layer");
 }
@@ -29,6 +33,8 @@ const dds_topic_descriptor_t* descriptor(Layer layer) {
       return &cellmap_msg_ChangeRegionLayer_desc;
     case Layer::kSensors:
       return &cellmap_msg_SensorLayer_desc;
+    case Layer::kRobot:
+      return &cellmap_msg_RobotLayer_desc;
   }
   throw Error("layers: unknown layer");
 }
@@ -41,6 +47,27 @@ Sequence sequence_of(const std::vector<T>& items) {
   seq._buffer = const_cast<T*>(items.data());
   seq._release = false;
   return seq;
+}
+
+void put_pose(const Eigen::Isometry3d& X, double position[3], double orientation[4]) {
+  const Eigen::Quaterniond q(X.linear());
+  for (int k = 0; k < 3; ++k) position[k] = X.translation()[k];
+  orientation[0] = q.w();
+  orientation[1] = q.x();
+  orientation[2] = q.y();
+  orientation[3] = q.z();
+}
+
+/// @throws Error starting with `where` if a number is not finite or the rotation is not a unit quaternion.
+Eigen::Isometry3d pose_of(const double position[3], const double orientation[4], const std::string& where) {
+  const Eigen::Vector3d p(position[0], position[1], position[2]);
+  const Eigen::Quaterniond q(orientation[0], orientation[1], orientation[2], orientation[3]);
+  if (!p.allFinite() || !q.coeffs().allFinite()) throw Error(where + ": not a finite number");
+  if (std::abs(q.norm() - 1.0) > 1e-6) throw Error(where + ": orientation: must be a unit quaternion");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = q.normalized().toRotationMatrix();
+  X.translation() = p;
+  return X;
 }
 
 // Owns what a cellmap_msg_VoxelLayer points into, so it must outlive the write.
@@ -116,13 +143,7 @@ class SensorSample {
   cellmap_msg_SensorView to_msg(const SensorView& view, std::size_t i) {
     cellmap_msg_SensorView msg{};
     msg.sensor = names_[i].data();
-    const Eigen::Vector3d p_CS = view.X_CS.translation();
-    const Eigen::Quaterniond q_CS(view.X_CS.linear());
-    for (int k = 0; k < 3; ++k) msg.position[k] = p_CS[k];
-    msg.orientation[0] = q_CS.w();
-    msg.orientation[1] = q_CS.x();
-    msg.orientation[2] = q_CS.y();
-    msg.orientation[3] = q_CS.z();
+    put_pose(view.X_CS, msg.position, msg.orientation);
     msg.max_range = view.field_of_view ? view.field_of_view->max_range : 0.0;
     msg.closed = view.field_of_view && view.field_of_view->closed;
     msg.outline = sequence_of<dds_sequence_double>(outlines_[i]);
@@ -134,6 +155,74 @@ class SensorSample {
   std::vector<std::vector<double>> outlines_;
   std::vector<cellmap_msg_SensorView> views_;
   cellmap_msg_SensorLayer msg_{};
+};
+
+// Owns the link names, mesh vertices and indices a cellmap_msg_RobotLayer points into.
+class RobotSample {
+ public:
+  explicit RobotSample(const RobotLayer& layer) : cell_(layer.cell) {
+    for (const PosedShape& shape : layer.shapes) {
+      links_.push_back(shape.link);
+      std::vector<float>& vertices = vertices_.emplace_back();
+      std::vector<std::uint32_t>& triangles = triangles_.emplace_back();
+      if (const auto* mesh = std::get_if<MeshShape>(&shape.geometry)) {
+        for (const Eigen::Vector3d& v : mesh->mesh->vertices)
+          vertices.insert(vertices.end(),
+                          {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
+        for (const Eigen::Vector3i& t : mesh->mesh->triangles)
+          triangles.insert(triangles.end(),
+                           {static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+                            static_cast<std::uint32_t>(t[2])});
+      }
+    }
+    for (std::size_t i = 0; i < layer.shapes.size(); ++i) shapes_.push_back(to_msg(layer.shapes[i], i));
+    msg_.cell = cell_.data();
+    msg_.sweep = layer.sweep;
+    msg_.stamp_ns = layer.stamp_ns;
+    msg_.padding_scale = layer.padding_scale;
+    msg_.padding = layer.padding;
+    msg_.shapes = sequence_of<dds_sequence_cellmap_msg_RobotShape>(shapes_);
+  }
+  RobotSample(const RobotSample&) = delete;
+  RobotSample& operator=(const RobotSample&) = delete;
+  [[nodiscard]] const cellmap_msg_RobotLayer* get() const { return &msg_; }
+
+ private:
+  struct KindAndSize {
+    cellmap_msg_RobotShapeKind kind;
+    std::array<double, 3> size;
+    KindAndSize operator()(const BoxShape& box) const {
+      return {cellmap_msg_ROBOT_SHAPE_BOX,
+              {box.half_extents.x(), box.half_extents.y(), box.half_extents.z()}};
+    }
+    KindAndSize operator()(const CylinderShape& c) const {
+      return {cellmap_msg_ROBOT_SHAPE_CYLINDER, {c.radius, c.half_length, 0.0}};
+    }
+    KindAndSize operator()(const SphereShape& s) const {
+      return {cellmap_msg_ROBOT_SHAPE_SPHERE, {s.radius, 0, 0}};
+    }
+    KindAndSize operator()(const MeshShape&) const { return {cellmap_msg_ROBOT_SHAPE_MESH, {0, 0, 0}}; }
+  };
+
+  cellmap_msg_RobotShape to_msg(const PosedShape& shape, std::size_t i) {
+    cellmap_msg_RobotShape msg{};
+    msg.link = links_[i].data();
+    msg.carried = shape.carried;
+    put_pose(shape.X_CG, msg.position, msg.orientation);
+    const KindAndSize kind = std::visit(KindAndSize{}, shape.geometry);
+    msg.kind = kind.kind;
+    for (int k = 0; k < 3; ++k) msg.size[k] = kind.size[k];
+    msg.vertices = sequence_of<dds_sequence_float>(vertices_[i]);
+    msg.triangles = sequence_of<dds_sequence_uint32>(triangles_[i]);
+    return msg;
+  }
+
+  std::string cell_;
+  std::vector<std::string> links_;  // filled before shapes_ points into them
+  std::vector<std::vector<float>> vertices_;
+  std::vector<std::vector<std::uint32_t>> triangles_;
+  std::vector<cellmap_msg_RobotShape> shapes_;
+  cellmap_msg_RobotLayer msg_{};
 };
 
 VoxelLayer from_wire(const cellmap_msg_VoxelLayer& msg) {
@@ -175,14 +264,8 @@ ChangeRegionLayer from_wire(const cellmap_msg_ChangeRegionLayer& msg) {
 SensorView from_wire(const cellmap_msg_SensorView& msg, const std::string& where) {
   SensorView view;
   view.sensor = msg.sensor != nullptr ? msg.sensor : "";
-  const Eigen::Vector3d p_CS(msg.position[0], msg.position[1], msg.position[2]);
-  const Eigen::Quaterniond q_CS(msg.orientation[0], msg.orientation[1], msg.orientation[2],
-                                msg.orientation[3]);
-  if (!p_CS.allFinite() || !q_CS.coeffs().allFinite() || !std::isfinite(msg.max_range))
-    throw Error(where + ": not a finite number");
-  if (std::abs(q_CS.norm() - 1.0) > 1e-6) throw Error(where + ": orientation: must be a unit quaternion");
-  view.X_CS.linear() = q_CS.normalized().toRotationMatrix();
-  view.X_CS.translation() = p_CS;
+  view.X_CS = pose_of(msg.position, msg.orientation, where);
+  if (!std::isfinite(msg.max_range)) throw Error(where + ": not a finite number");
   if (msg.outline._length % 3 != 0) throw Error(where + ": outline: not x, y, z triples");
   if (msg.max_range < 0) throw Error(where + ": max_range: must not be negative");
   if (msg.max_range == 0) return view;  // the source did not know its field of view
@@ -204,6 +287,65 @@ SensorLayer from_wire(const cellmap_msg_SensorLayer& msg) {
   for (std::uint32_t i = 0; i < msg.views._length; ++i) {
     layer.views.push_back(from_wire(msg.views._buffer[i],
                                     std::string(kSensorLayerTopic) + ": views[" + std::to_string(i) + "]"));
+  }
+  return layer;
+}
+
+std::shared_ptr<const TriangleMesh> mesh_of(const cellmap_msg_RobotShape& msg, const std::string& where) {
+  if (msg.vertices._length % 3 != 0) throw Error(where + ": vertices: not x, y, z triples");
+  if (msg.triangles._length % 3 != 0) throw Error(where + ": triangles: not three indices each");
+  auto mesh = std::make_shared<TriangleMesh>();
+  for (std::uint32_t i = 0; i < msg.vertices._length; i += 3) {
+    const float* v = msg.vertices._buffer + i;
+    mesh->vertices.emplace_back(v[0], v[1], v[2]);
+  }
+  for (std::uint32_t i = 0; i < msg.triangles._length; i += 3) {
+    const std::uint32_t* t = msg.triangles._buffer + i;
+    if (std::max({t[0], t[1], t[2]}) >= mesh->vertices.size())
+      throw Error(where + ": triangles: index beyond the vertices");
+    mesh->triangles.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]));
+  }
+  return mesh;
+}
+
+PosedShape from_wire(const cellmap_msg_RobotShape& msg, const std::string& where) {
+  PosedShape shape;
+  shape.link = msg.link != nullptr ? msg.link : "";
+  shape.carried = msg.carried;
+  shape.X_CG = pose_of(msg.position, msg.orientation, where);
+  const double* size = msg.size;
+  switch (msg.kind) {
+    case cellmap_msg_ROBOT_SHAPE_BOX:
+      shape.geometry = BoxShape{{size[0], size[1], size[2]}};
+      break;
+    case cellmap_msg_ROBOT_SHAPE_CYLINDER:
+      shape.geometry = CylinderShape{size[0], size[1]};
+      break;
+    case cellmap_msg_ROBOT_SHAPE_SPHERE:
+      shape.geometry = SphereShape{size[0]};
+      break;
+    case cellmap_msg_ROBOT_SHAPE_MESH:
+      shape.geometry = MeshShape{mesh_of(msg, where)};
+      break;
+    default:
+      throw Error(where + ": kind: unknown");
+  }
+  validate_shape({shape.link, Eigen::Isometry3d::Identity(), shape.geometry}, where);
+  return shape;
+}
+
+RobotLayer from_wire(const cellmap_msg_RobotLayer& msg) {
+  RobotLayer layer;
+  layer.cell = wire::cell_of(msg.cell, kRobotLayerTopic);
+  layer.sweep = msg.sweep;
+  layer.stamp_ns = msg.stamp_ns;
+  layer.padding_scale = msg.padding_scale;
+  layer.padding = msg.padding;
+  if (!std::isfinite(layer.padding_scale) || !std::isfinite(layer.padding))
+    throw Error(std::string(kRobotLayerTopic) + ": padding: not a finite number");
+  for (std::uint32_t i = 0; i < msg.shapes._length; ++i) {
+    layer.shapes.push_back(from_wire(msg.shapes._buffer[i],
+                                     std::string(kRobotLayerTopic) + ": shapes[" + std::to_string(i) + "]"));
   }
   return layer;
 }
@@ -265,14 +407,21 @@ std::size_t wire_size(const SensorLayer& layer) {
   return wire::serialized_size(sample.get(), cellmap_msg_SensorLayer_desc);
 }
 
+std::size_t wire_size(const RobotLayer& layer) {
+  const RobotSample sample(layer);
+  return wire::serialized_size(sample.get(), cellmap_msg_RobotLayer_desc);
+}
+
 LayerWriter::LayerWriter(const dds::Participant& participant, std::string cell)
     : cell_(std::move(cell)),
       voxel_topic_(participant, descriptor(Layer::kVoxels), kVoxelLayerTopic),
       region_topic_(participant, descriptor(Layer::kChangeRegions), kChangeRegionLayerTopic),
       sensor_topic_(participant, descriptor(Layer::kSensors), kSensorLayerTopic),
+      robot_topic_(participant, descriptor(Layer::kRobot), kRobotLayerTopic),
       voxel_writer_(participant, voxel_topic_, layer_qos()),
       region_writer_(participant, region_topic_, layer_qos()),
-      sensor_writer_(participant, sensor_topic_, layer_qos()) {
+      sensor_writer_(participant, sensor_topic_, layer_qos()),
+      robot_writer_(participant, robot_topic_, layer_qos()) {
   if (cell_.empty()) throw Error("layer writer: cell must not be empty");
 }
 
@@ -284,6 +433,8 @@ const dds::Writer& LayerWriter::writer(Layer layer) const {
       return region_writer_;
     case Layer::kSensors:
       return sensor_writer_;
+    case Layer::kRobot:
+      return robot_writer_;
   }
   throw Error("layer writer: unknown layer");
 }
@@ -316,6 +467,17 @@ void LayerWriter::write(const SensorLayer& layer) const {
   sensor_writer_.write(sample.get());
 }
 
+void LayerWriter::write(const RobotLayer& layer) const {
+  require_cell(layer.cell, cell_, kRobotLayerTopic);
+  for (std::size_t i = 0; i < layer.shapes.size(); ++i) {
+    const PosedShape& shape = layer.shapes[i];
+    validate_shape({shape.link, shape.X_CG, shape.geometry},
+                   std::string(kRobotLayerTopic) + ": shapes[" + std::to_string(i) + "]");
+  }
+  const RobotSample sample(layer);
+  robot_writer_.write(sample.get());
+}
+
 LayerReader::LayerReader(const dds::Participant& participant, Layer layer)
     : layer_(layer),
       topic_(participant, descriptor(layer), topic_name(layer)),
@@ -346,6 +508,9 @@ std::vector<LayerMessage> LayerReader::take(std::chrono::nanoseconds timeout) {
           break;
         case Layer::kSensors:
           layers.emplace_back(from_wire(*static_cast<const cellmap_msg_SensorLayer*>(sample)));
+          break;
+        case Layer::kRobot:
+          layers.emplace_back(from_wire(*static_cast<const cellmap_msg_RobotLayer*>(sample)));
           break;
       }
     } catch (const Error&) {

@@ -34,7 +34,7 @@ std::map<security::Role, security::TopicGrants> role_grants() {
   const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
   std::vector<std::string> environment_and_layers = environment;
   environment_and_layers.insert(environment_and_layers.end(),
-                                {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic});
+                                {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic, kRobotLayerTopic});
   return {{Role::kDaemon, {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
           {Role::kPlanner, {{}, environment_and_layers}},
           {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}}},

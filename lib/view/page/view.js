@@ -187,6 +187,7 @@ function applyHighlights(now) {
 
 // ---- drawing on demand: a frame when something changed, and while highlights fade ----
 let frameRequested = false;
+let drawnRobot = null;  // the robot layer's group in the last frame drawn
 
 function requestRender() {
   if (frameRequested) return;
@@ -201,6 +202,7 @@ function drawFrame() {
   const now = performance.now();
   const redraw = applyHighlights(now);
   renderer.render(scene, camera);
+  drawnRobot = layerGroup.children.find((o) => o.userData.robot !== undefined) || null;
   if (pendingFrameStamps.length > 0) {
     const drawn = Date.now();
     for (const entry of pendingFrameStamps) entry.frame_ms = drawn;
@@ -419,14 +421,14 @@ $('cell-select').addEventListener('change', (e) => {
 // ---- messages from the server ----
 function newCell(name) {
   return { name, version: 0, stamp_ns: 0, joined_at: 0, boxes: new Map(), timeline: [], status: null,
-           voxels: null, regions: null, sensors: null };
+           voxels: null, regions: null, sensors: null, robot: null };
 }
 
 function onState(message) {
   domain = message.domain;
   cellFilter = message.cell_filter;
   const layers = new Map([...cells].map(([name, c]) => [name, { voxels: c.voxels, regions: c.regions,
-                                                                   sensors: c.sensors }]));
+                                                                   sensors: c.sensors, robot: c.robot }]));
   cells.clear();
   for (const c of message.cells) {
     const cell = newCell(c.cell);
@@ -523,6 +525,7 @@ function rebuildLayers() {
   if (voxels) layerGroup.add(voxelObject(cell.voxels));
   if ($('layer-regions').checked && cell.regions) layerGroup.add(regionObject(cell.regions));
   if ($('layer-sensors').checked && cell.sensors) layerGroup.add(sensorObject(cell.sensors));
+  if ($('layer-robot').checked && cell.robot) layerGroup.add(robotObject(cell.robot));
   requestRender();
 }
 
@@ -559,6 +562,7 @@ function regionObject(layer) {
     lines.position.set(...[0, 1, 2].map((i) => (region.max[i] + region.min[i]) / 2));
     group.add(lines);
   }
+  group.userData.regions = layer.regions.map((region) => [region.min, region.max]);
   return group;
 }
 
@@ -596,14 +600,51 @@ function sensorObject(layer) {
   return group;
 }
 
+// The robot's collision shapes where it was at the latest sweep, solid, in one colour (a carried payload in
+// another); they are not clickable. The self filter cuts them out grown by the layer's padding.
+const ROBOT_COLOUR = 0xf07818;
+const PAYLOAD_COLOUR = 0x8a5a2b;
+
+function shapeGeometry(shape) {
+  if (shape.kind === 'box') {
+    const [x, y, z] = shape.half_extents.map((h) => 2 * h);
+    return new THREE.BoxBufferGeometry(x, y, z);
+  }
+  if (shape.kind === 'cylinder') {
+    const geometry = new THREE.CylinderBufferGeometry(shape.radius, shape.radius, 2 * shape.half_length, 24);
+    return geometry.rotateX(Math.PI / 2);  // three.js cylinders stand along y, the shape's along its z
+  }
+  if (shape.kind === 'sphere') return new THREE.SphereBufferGeometry(shape.radius, 24, 16);
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(shape.vertices, 3));
+  geometry.setIndex(shape.triangles);
+  geometry.computeVertexNormals();
+  return geometry;
+}
+
+function robotObject(layer) {
+  const group = new THREE.Group();
+  for (const shape of layer.shapes) {
+    const material = new THREE.MeshLambertMaterial({ color: shape.carried ? PAYLOAD_COLOUR : ROBOT_COLOUR,
+                                                     side: THREE.DoubleSide });  // meshes' winding varies
+    const mesh = new THREE.Mesh(shapeGeometry(shape), material);
+    mesh.position.set(...shape.position);
+    const [w, x, y, z] = shape.rotation;
+    mesh.quaternion.set(x, y, z, w);
+    mesh.userData.robotShape = { link: shape.link, carried: shape.carried };
+    mesh.raycast = () => {};  // clicks go to the boxes
+    group.add(mesh);
+  }
+  group.userData.robot = layer.sweep;
+  return group;
+}
+
 function sendLayers() {
   send({ type: 'layers', voxels: $('layer-voxels').checked, regions: $('layer-regions').checked,
-         sensors: $('layer-sensors').checked });
+         sensors: $('layer-sensors').checked, robot: $('layer-robot').checked });
   rebuildLayers();
 }
-$('layer-voxels').addEventListener('change', sendLayers);
-$('layer-regions').addEventListener('change', sendLayers);
-$('layer-sensors').addEventListener('change', sendLayers);
+for (const name of ['voxels', 'regions', 'sensors', 'robot']) $(`layer-${name}`).addEventListener('change', sendLayers);
 
 // ---- the WebSocket: reconnects by itself, and the server sends the whole state on each connection ----
 let retryMs = 500;
@@ -632,7 +673,7 @@ function connect() {
     if (message.type === 'state') onState(message);
     else if (message.type === 'version') onVersion(message);
     else if (message.type === 'status') onStatus(message);
-    else if (['voxels', 'regions', 'sensors'].includes(message.type)) onLayer(message);
+    else if (['voxels', 'regions', 'sensors', 'robot'].includes(message.type)) onLayer(message);
   };
   socket.onclose = () => {
     if (connected) setConnection('reconnecting', 'bad');
@@ -651,7 +692,7 @@ window.cellmapView = {
   boxIds: () => [...meshes.keys()].sort((a, b) => a - b),
   highlighted: () => [...meshes.keys()].filter((id) => meshes.get(id).glow > 0),  // as in the last frame drawn
   voxelRuns: () => layerGroup.children.filter((o) => o.isInstancedMesh).reduce((n, o) => n + o.count, 0),
-  // The sweep of the latest layer ("voxels" or "regions") of the shown cell, or null.
+  // The sweep of the latest layer ("voxels", "regions", "sensors" or "robot") of the shown cell, or null.
   layerSweep: (type) => ((cells.get(selectedCell) || {})[type] || { sweep: null }).sweep,
   // Where a point of the cell frame appears in the page (CSS pixels from the top left of the document).
   project: (x, y, z) => {
@@ -663,6 +704,21 @@ window.cellmapView = {
   sensorSegments: () => {
     const group = layerGroup.children.find((o) => o.userData.segments);
     return group ? group.userData.segments.map((s) => s && s.map((p) => [p.x, p.y, p.z])) : [];
+  },
+  // The change regions drawn: per region, its min and max corners (cell frame).
+  regionBounds: () => layerGroup.children.filter((o) => o.userData.regions).flatMap((o) => o.userData.regions),
+  // The robot as in the last frame drawn (what the canvas shows): its sweep and per shape its link, whether
+  // carried, its frame's origin and the centre of its bounds (cell frame), and where that centre is on the
+  // canvas (device pixels from its top left).
+  robot: () => {
+    if (!drawnRobot) return null;
+    const shapes = drawnRobot.children.map((m) => {
+      const center = new THREE.Box3().setFromObject(m).getCenter(new THREE.Vector3());
+      const p = center.clone().project(camera);
+      return { ...m.userData.robotShape, position: m.position.toArray(), center: center.toArray(),
+               pixel: [((p.x + 1) / 2) * canvas.width, ((1 - p.y) / 2) * canvas.height] };
+    });
+    return { sweep: drawnRobot.userData.robot, shapes };
   },
   latency,
 };

@@ -13,14 +13,18 @@
 //   {"type":"sensors", "cell", "sweep", "stamp_ns", "views":[{"sensor", "position", "rotation" [w,x,y,z],
 //    "max_range", "closed", "outline":[[x,y,z]...]}...]}  (outline: unit rays in the sensor frame; empty and
 //    max_range 0 when unknown)
+//   {"type":"robot", "cell", "sweep", "stamp_ns", "padding_scale", "padding", "shapes":[{"link", "carried",
+//    "position", "rotation" [w,x,y,z], "kind", and by kind "half_extents" (box), "radius", "half_length"
+//    (cylinder, axis along its z), "radius" (sphere), "vertices":[x,y,z, ...] (0.1 mm), "triangles":[i,j,k,
+//    ...] (mesh)}...]}  (the shape's frame in the cell frame; vertices in the shape's frame)
 // CELL = {"cell", "version", "stamp_ns", "boxes":[BOX...], "timeline":[ENTRY...], "status":STATUS|null}
 // BOX = {"id", "center", "half_extents", "rotation" [w,x,y,z], "points", "changed_in"} where changed_in is
 //   the version that added or last modified the box, null if that was before the viewer joined
 // ENTRY = {"from_version", "to_version", "stamp_ns", "received_ns", "added", "modified", "removed"} (counts)
 // STATUS = {"cell", "daemon" (false once it is gone), "state", "sensors":[{"name","state"}...],
 //   "last_sweep_ns", "sweeps", "dropped_frames", "boxes", "version"}
-// Page → server: {"type":"layers", "voxels":bool, "regions":bool, "sensors":bool} (which layers this page
-// shows; a missing key is false) and
+// Page → server: {"type":"layers", "voxels":bool, "regions":bool, "sensors":bool, "robot":bool} (which layers
+// this page shows; a missing key is false) and
 // {"type":"resync"} (the page missed a version: it gets a "state" again).
 
 #include <cstddef>
@@ -55,8 +59,8 @@ class ViewState final {
   /// The cell's daemon is gone (its status writer left or its lease expired). Returns the "status" message,
   /// with daemon false and the last report's fields.
   std::string on_daemon_gone(const std::string& cell);
-  /// A layer arrived. Returns its message ("voxels", "regions" or "sensors"), which is also kept for pages
-  /// that ask later.
+  /// A layer arrived. Returns its message ("voxels", "regions", "sensors" or "robot"), which is also kept for
+  /// pages that ask later.
   std::string on_layer(const transport::LayerMessage& layer);
 
   /// The "state" message: every cell as it is now.

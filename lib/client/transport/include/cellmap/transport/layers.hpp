@@ -1,8 +1,9 @@
 #pragma once
 // The optional layers a viewer can ask the daemon for: the occupied voxels of the map, the change regions
-// of the latest sweep and where its frames were taken from. A layer has its own topic (cellmap/layer/...),
-// and the daemon computes and writes it only while a reader of that topic is matched: asking for a layer
-// means opening its reader, and a layer nobody reads costs nothing, neither on the network nor in the daemon.
+// of the latest sweep, where its frames were taken from and where the robot was. A layer has its own topic
+// (cellmap/layer/...), and the daemon computes and writes it only while a reader of that topic is matched:
+// asking for a layer means opening its reader, and a layer nobody reads costs nothing, neither on the network
+// nor in the daemon.
 
 #include <Eigen/Geometry>
 
@@ -17,6 +18,7 @@
 
 #include "cellmap/common/field_of_view.hpp"
 #include "cellmap/common/region.hpp"
+#include "cellmap/robot/geometry.hpp"
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/topics.hpp"
 
@@ -79,9 +81,29 @@ struct SensorLayer final {
   std::vector<SensorView> views;
 };
 
-using LayerMessage = std::variant<VoxelLayer, ChangeRegionLayer, SensorLayer>;
-enum class Layer { kVoxels, kChangeRegions, kSensors };
-inline constexpr std::array<Layer, 3> kLayers{Layer::kVoxels, Layer::kChangeRegions, Layer::kSensors};
+/// One collision shape of the robot in the cell frame.
+struct PosedShape final {
+  std::string link;      ///< the link it is fixed to (the tool link for a carried payload)
+  bool carried = false;  ///< a payload the tool holds
+  Eigen::Isometry3d X_CG = Eigen::Isometry3d::Identity();  ///< the shape's frame G in the cell frame
+  LinkGeometry geometry = BoxShape{};  ///< meshes travel as float vertices (about 0.1 µm lost at 1 m)
+};
+
+/// cellmap/layer/robot: the robot's collision shapes, as the self filter cuts them out before padding, where
+/// the robot was at the latest frame of a sweep that had the robot's pose.
+struct RobotLayer final {
+  std::string cell;
+  std::uint64_t sweep = 0;
+  std::int64_t stamp_ns = 0;   ///< when it was published, ns since the Unix epoch
+  double padding_scale = 1.0;  ///< the self filter's padding: every shape scaled about its centre, then
+  double padding = 0.0;        ///< grown by this many metres on every side (1 and 0 with the filter off)
+  std::vector<PosedShape> shapes;
+};
+
+using LayerMessage = std::variant<VoxelLayer, ChangeRegionLayer, SensorLayer, RobotLayer>;
+enum class Layer { kVoxels, kChangeRegions, kSensors, kRobot };
+inline constexpr std::array<Layer, 4> kLayers{Layer::kVoxels, Layer::kChangeRegions, Layer::kSensors,
+                                              Layer::kRobot};
 /// Which layer a message is of (LayerMessage's alternatives are in the order of kLayers).
 [[nodiscard]] inline Layer layer_of(const LayerMessage& message) {
   static_assert(std::variant_size_v<LayerMessage> == kLayers.size());
@@ -93,6 +115,7 @@ inline constexpr std::array<Layer, 3> kLayers{Layer::kVoxels, Layer::kChangeRegi
 [[nodiscard]] std::size_t wire_size(const VoxelLayer& layer);
 [[nodiscard]] std::size_t wire_size(const ChangeRegionLayer& layer);
 [[nodiscard]] std::size_t wire_size(const SensorLayer& layer);
+[[nodiscard]] std::size_t wire_size(const RobotLayer& layer);
 
 /// The daemon's side: one writer per layer for one cell (RELIABLE, VOLATILE, KEEP_LAST 1). `participant` must
 /// outlive it. Thread-safe as Cyclone's writes are.
@@ -111,6 +134,8 @@ class LayerWriter final {
   void write(const ChangeRegionLayer& layer) const;
   /// @throws Error if the layer is of another cell or the write fails.
   void write(const SensorLayer& layer) const;
+  /// @throws Error if the layer is of another cell, a shape is invalid (validate_shape) or the write fails.
+  void write(const RobotLayer& layer) const;
   [[nodiscard]] const std::string& cell() const { return cell_; }
 
  private:
@@ -120,9 +145,11 @@ class LayerWriter final {
   dds::Topic voxel_topic_;
   dds::Topic region_topic_;
   dds::Topic sensor_topic_;
+  dds::Topic robot_topic_;
   dds::Writer voxel_writer_;
   dds::Writer region_writer_;
   dds::Writer sensor_writer_;
+  dds::Writer robot_writer_;
 };
 
 /// A viewer's side: reads one layer of every cell. Opening it is what asks the daemons for the layer;
@@ -136,7 +163,8 @@ class LayerReader final {
   LayerReader& operator=(const LayerReader&) = delete;
   /// Waits up to `timeout` (zero: just looks) and returns the layers received, oldest first. Malformed
   /// samples (empty cell, non-finite numbers, a non-positive resolution, a rotation that is not a unit
-  /// quaternion, an outline of a length not a multiple of 3) are skipped and counted.
+  /// quaternion, an outline of a length not a multiple of 3, a shape that validate_shape refuses) are skipped
+  /// and counted.
   std::vector<LayerMessage> take(std::chrono::nanoseconds timeout = std::chrono::nanoseconds(0));
   [[nodiscard]] Layer layer() const { return layer_; }
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }

@@ -18,6 +18,7 @@ inline constexpr const char* kRobotStateTopic = "cellmap/robot_state";
 inline constexpr const char* kVoxelLayerTopic = "cellmap/layer/voxels";
 inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_regions";
 inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
+inline constexpr const char* kRobotLayerTopic = "cellmap/layer/robot";
 inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
