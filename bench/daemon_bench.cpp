@@ -211,6 +211,7 @@ class Recording {
     const fs::path dir = dir_ / camera.name;
     fs::create_directories(dir);
     for (const bool with_crate : {false, true}) {
+      if (with_crate && changes() == 0) continue;  // never shown
       sim::Scene scene = sim::default_scene();
       const int sensor = scene.find_sensor(camera.name);
       scene.sensors[static_cast<std::size_t>(sensor)].intrinsics = camera.intrinsics;
@@ -495,8 +496,9 @@ int run(const Options& options) {
   std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
               percentile(waits, 1.0));
   std::printf("sweeps processed: %zu, versions published: %zu\n", sweeps.size(), t.versions);
-  std::printf("CPU per fused frame by stage (stages: process CPU while they ran, all threads):\n");
-  print_stage("acquisition", acquisition, t.fused, "(camera threads: read, decode, pose, group)");
+  std::printf("CPU per fused frame by stage (each on its thread, with the helper threads it started):\n");
+  print_stage("acquisition", acquisition, played,
+              "(camera threads, per frame played: read, decode, pose, group)");
   print_stage("self filter", t.filter, t.fused,
               "(frames to cell-frame scans, no-return rays; replays carry no robot)");
   print_stage("fusion", t.fuse, t.fused, "");
