@@ -68,6 +68,7 @@ struct Options {
   int stops = 20;                // distinct gantry positions rendered per pass (a frame shows the nearest)
   double no_return_range = 4.5;  // the Kinect's (time-of-flight)
   int settle_sweeps = 15;        // change.settle_sweeps (cellmapd's default)
+  int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
   int domain = 144;
   int anchor_frames = 6;  // frames per camera fused by the anchor
 };
@@ -256,19 +257,18 @@ std::string yaml_vector(const Eigen::Vector3d& v) {
   return text;
 }
 
-std::string source_yaml(const Camera& camera, const fs::path& dir) {
+std::string source_yaml(const Camera& camera, const fs::path& dir, int sweep_frames) {
   const Eigen::Quaterniond r(camera.X_ES.linear());
   char rotation[128];
   std::snprintf(rotation, sizeof rotation, "[%.17g, %.17g, %.17g, %.17g]", r.w(), r.x(), r.y(), r.z());
-  return "  - {kind: replay, sensor: " + camera.name +
+  return "  - {kind: replay, sensor: " + camera.name + ", sweep_frames: " + std::to_string(sweep_frames) +
          ", no_return_range: " + std::to_string(camera.no_return_range) +
          ", mount: tool, pose: {position: " + yaml_vector(camera.X_ES.translation()) +
          ", rotation: " + rotation + "}, replay: {directory: " + (dir / camera.name).string() +
          ", playback: recorded}}\n";
 }
 
-// --- the run
-// -------------------------------------------------------------------------------------------------
+// --- the run ---------------------------------------------------------------------------------------------
 
 // What the processing thread reported, sweep by sweep.
 class Traces {
@@ -449,7 +449,7 @@ int run(const Options& options) {
                      "\nstate_dir: " + (dir / "state").string() +
                      "\nlog_level: warn\nchange: {settle_sweeps: " + std::to_string(options.settle_sweeps) +
                      "}\nsources:\n";
-  for (const Camera& camera : cameras) yaml += source_yaml(camera, dir);
+  for (const Camera& camera : cameras) yaml += source_yaml(camera, dir, options.sweep_frames);
   daemon::DaemonConfig config = daemon::DaemonConfig::parse(yaml, "bench", dir);
   spdlog::set_level(spdlog::level::warn);
 
@@ -551,6 +551,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--settle-sweeps", options.settle_sweeps,
                  "sweeps before the first version (change.settle_sweeps)")
+      ->check(CLI::Range(0, 100000));
+  app.add_option("--sweep-frames", options.sweep_frames,
+                 "frames that close a sweep (sweep_frames; 0 = only sweep_period)")
       ->check(CLI::Range(0, 100000));
   app.add_option("--stops", options.stops, "gantry positions rendered per pass")->check(CLI::Range(2, 1000));
   app.add_option("--domain", options.domain, "DDS domain id")->check(CLI::Range(0, 232));
