@@ -44,6 +44,8 @@
 #include "cellmap/sim/simulator.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "daemon.hpp"
+#include "native_modes.hpp"
+#include "subscriber_arrivals.hpp"
 
 namespace {
 
@@ -52,13 +54,6 @@ using namespace cellmap;
 using Clock = std::chrono::steady_clock;  // CLOCK_MONOTONIC: comparable across processes
 
 constexpr const char* kCell = "bench-daemon";
-// Loopback unicast only, as in the tests; used when the caller did not configure Cyclone.
-constexpr const char* kLoopbackConfig =
-    "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface "
-    "address=\"127.0.0.1\"/></Interfaces>"
-    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-    "<Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
-
 struct Options {
   double seconds = 40.0;         // recording length
   double rate = 30.0;            // frames per second of each camera
@@ -73,23 +68,15 @@ struct Options {
   int anchor_frames = 6;  // frames per camera fused by the anchor
 };
 
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
-}
-
-// What the subscriber process reports for each version it received.
-struct Arrival {
-  std::uint64_t version;
-  std::int64_t received_ns;
-};
+using bench::Arrival;
+using bench::kLoopbackConfig;
+using bench::now_ns;
 
 int run_subscriber(std::uint32_t domain) {
   const dds::Participant participant(domain);
   transport::EnvironmentSubscriber subscriber(
-      participant, kCell, [](const Environment& env, const EnvironmentDelta&) {
-        const Arrival arrival{env.version(), now_ns()};
-        if (::write(STDOUT_FILENO, &arrival, sizeof arrival) != sizeof arrival) std::_Exit(3);
-      });
+      participant, kCell,
+      [](const Environment& env, const EnvironmentDelta&) { bench::report_arrival(env.version()); });
   ::pause();  // killed by the parent
   return 0;
 }
@@ -143,16 +130,7 @@ class SubscriberProcess {
 // --- the recordings
 // ------------------------------------------------------------------------------------------
 
-// The RealSense D435's 848 × 480 depth mode (as `cellmap bench fusion` makes it).
-PinholeIntrinsics d435_848x480() {
-  PinholeIntrinsics k = sim::default_intrinsics(sim::SensorModel::kRealsenseD435);
-  k.width = 848;
-  k.height = 480;
-  k.fx = k.fy = 430.0;
-  k.cx = 423.5;
-  k.cy = 239.5;
-  return k;
-}
+using bench::d435_848x480;
 
 // The crate that appears on the table, clear of every obstacle of the default cell.
 sim::Obstacle crate() {
