@@ -32,6 +32,7 @@
 #include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "ratio_report.hpp"
+#include "subscriber_arrivals.hpp"
 #include "wire.hpp"       // the transport stage's private wire types: the anchor writes raw snapshots
 #include "wire_size.hpp"  // internal to the transport stage
 
@@ -42,26 +43,12 @@ using Clock = std::chrono::steady_clock;  // CLOCK_MONOTONIC on Linux: comparabl
 
 constexpr int kBoxes = 200;
 constexpr const char* kCell = "bench";
-// Loopback unicast only, as in the tests; used when the caller did not configure Cyclone.
-constexpr const char* kLoopbackConfig =
-    "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface "
-    "address=\"127.0.0.1\"/></Interfaces>"
-    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-    "<Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
-}
-
-// What the subscriber process reports for each version it received.
-struct Arrival {
-  std::uint64_t version;
-  std::int64_t received_ns;
-};
+using bench::Arrival;
+using bench::kLoopbackConfig;
+using bench::now_ns;
 
 void report(std::uint64_t version) {
-  const Arrival arrival{version, now_ns()};
-  if (::write(STDOUT_FILENO, &arrival, sizeof arrival) != sizeof arrival) std::_Exit(3);
+  bench::report_arrival(version);
 }
 
 Environment cell_with_boxes(std::uint64_t version) {

@@ -18,6 +18,7 @@
 #include "cellmap/occupancy/occupancy_map.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/simulator.hpp"
+#include "native_modes.hpp"
 #include "occupancy/box_scene.hpp"
 #include "occupancy/grabber_scans.hpp"
 #include "ratio_report.hpp"
@@ -115,18 +116,6 @@ std::vector<Sweep> native_cell_frames(cellmap::sim::SensorModel model,
   return sweeps;
 }
 
-// The RealSense D435's 848 × 480 depth mode (≈ 89° × 58° field of view; the simulator's default mode is
-// 640 × 480), with the default mode's range limits.
-cellmap::PinholeIntrinsics d435_848x480() {
-  cellmap::PinholeIntrinsics k = cellmap::sim::default_intrinsics(cellmap::sim::SensorModel::kRealsenseD435);
-  k.width = 848;
-  k.height = 480;
-  k.fx = k.fy = 430.0;
-  k.cx = 423.5;
-  k.cy = 239.5;
-  return k;
-}
-
 void print_agreement(const std::string& set) {
   const std::vector<Sweep>& sweeps = frame_sets().at(set);
   std::vector<octomap::Pointcloud> clouds;
@@ -166,7 +155,8 @@ int main(int argc, char** argv) {
   using cellmap::sim::SensorModel;
   frame_sets()["cell_kinect_v2_512x424"] =
       native_cell_frames(SensorModel::kKinectV2, cellmap::sim::default_intrinsics(SensorModel::kKinectV2));
-  frame_sets()["cell_d435_848x480"] = native_cell_frames(SensorModel::kRealsenseD435, d435_848x480());
+  frame_sets()["cell_d435_848x480"] =
+      native_cell_frames(SensorModel::kRealsenseD435, cellmap::bench::d435_848x480());
 
   for (const auto& entry : frame_sets()) {
     const std::string& name = entry.first;

@@ -12,6 +12,7 @@
 #include "camera_input.hpp"
 #include "cellmap/cell/frame_grouper.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 #include "cellmap/transport/scene_edits.hpp"
 #include "simulated_cell.hpp"
 
@@ -56,6 +57,7 @@ class SimAcquisition final : public Acquisition {
       // Sweeps as fast as processed still cover one pass of the plan each in the motion's time.
       const double duration = sweep_period_ > 0 ? sweep_period_.load() : cell_.pass_duration();
       if (deliver(stamp, duration)) stamp += duration;
+      cpu_ = cpu_seconds_with_helpers();  // the renderer splits frames over threads
       if (max_sweeps > 0 && ++sweeps >= max_sweeps) return;
       // The period is read on every turn: a period changed by SIGHUP applies at once, not after the old one.
       while (!stop && Clock::now() < start + seconds(sweep_period_.load()))
@@ -69,6 +71,7 @@ class SimAcquisition final : public Acquisition {
   }
   [[nodiscard]] std::optional<Robot> robot() const override { return cell_.robot(); }
   [[nodiscard]] std::uint64_t dropped_frames() const override { return dropped_; }
+  [[nodiscard]] double cpu_seconds() const override { return cpu_; }
   void set_sweep_period(double seconds) override { sweep_period_ = seconds; }
 
  private:
@@ -106,6 +109,7 @@ class SimAcquisition final : public Acquisition {
   std::vector<std::string> sensors_;
   std::atomic<double> sweep_period_;
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<double> cpu_{0.0};  // the acquisition thread's
 };
 
 // A replay played as fast as processed must lose no sweep.
@@ -162,6 +166,9 @@ class CameraLoop final {
     return streaming_;
   }
   [[nodiscard]] bool streaming() const { return streaming_; }
+  // The camera thread's CPU seconds, as it last noted them (note_cpu(), on the camera thread).
+  void note_cpu() { cpu_ = thread_cpu_seconds(); }
+  [[nodiscard]] double cpu_seconds() const { return cpu_; }
 
   // Frames dropped for want of a pose, logged at most once a second.
   void report_drops(const RobotInput* robot, double pose_tolerance) {
@@ -183,6 +190,7 @@ class CameraLoop final {
   AcquisitionOutput output_;
   SourceStatus reported_;
   std::atomic<bool> streaming_{true};
+  std::atomic<double> cpu_{0.0};
   std::uint64_t drops_logged_ = 0;
   Clock::time_point next_drop_log_ = Clock::now();
 };
@@ -231,6 +239,11 @@ class CameraAcquisition final : public Acquisition {
     for (const auto& loop : loops_) dropped += loop->camera().dropped_frames();
     return dropped;
   }
+  [[nodiscard]] double cpu_seconds() const override {
+    double cpu = 0.0;
+    for (const auto& loop : loops_) cpu += loop->cpu_seconds();
+    return cpu;
+  }
 
  private:
   static bool is_replay(const SourceConfig& s) {
@@ -251,6 +264,7 @@ class CameraAcquisition final : public Acquisition {
       const bool none_streaming =
           std::none_of(loops_.begin(), loops_.end(), [](const auto& l) { return l->streaming(); });
       if (group(std::move(frames), none_streaming, stop, max_sweeps)) done = true;
+      loop.note_cpu();
       if (max_sweeps > 0 && !counted_end && loop.camera().status().state == SourceState::kEnded) {
         counted_end = true;
         if (++ended == loops_.size()) done = true;

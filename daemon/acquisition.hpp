@@ -46,6 +46,9 @@ class Acquisition {
   /// Frames dropped before they made a sweep (without a robot pose or joint sample at their stamp).
   /// Thread-safe.
   [[nodiscard]] virtual std::uint64_t dropped_frames() const { return 0; }
+  /// CPU seconds the source's threads used so far (rendering, or reading, decoding and posing frames, and
+  /// grouping them). Thread-safe.
+  [[nodiscard]] virtual double cpu_seconds() const = 0;
   /// SIGHUP: seconds between sweep starts from the next sweep on; ignored by cameras (their sweep grouping
   /// is fixed when they start). Thread-safe.
   virtual void set_sweep_period(double /*seconds*/) {}

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 #include "cellmap/common/wall_clock.hpp"
 #include "reload.hpp"
 
@@ -36,6 +37,20 @@ void log_dds_security(const dds::Participant& participant, int domain) {
   }
 }
 
+// Measures one step on the calling thread.
+class Stopwatch {
+ public:
+  Stopwatch() : wall_(Clock::now()), cpu_(thread_cpu_seconds()) {}
+  void add_to(StepCost& cost) const {
+    cost.wall += std::chrono::duration<double>(Clock::now() - wall_).count();
+    cost.cpu += thread_cpu_seconds() - cpu_;
+  }
+
+ private:
+  Clock::time_point wall_;
+  double cpu_;
+};
+
 std::vector<std::string> sensor_names(const DaemonConfig& config) {
   std::vector<std::string> names;
   for (const SourceConfig& source : config.sources) names.push_back(source.sensor);
@@ -52,8 +67,12 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
       publisher_(participant_, config_.cell, config_.delta_depth),
       layers_(participant_, config_.cell),
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
-      keeper_(store_, [this](const Environment& env,
-                             const EnvironmentDelta& delta) { publisher_.publish(env, delta); }),
+      keeper_(store_,
+              [this](const Environment& env, const EnvironmentDelta& delta) {
+                const Stopwatch watch;
+                publisher_.publish(env, delta);
+                watch.add_to(publish_cost_);
+              }),
       health_(config_.cell, sensor_names(config_)),
       refusals_([](const std::string& line) { spdlog::warn("{}", line); }) {
   log_dds_security(participant_, config_.domain);
@@ -145,8 +164,20 @@ void Daemon::process() {
 }
 
 void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
+  SweepTrace trace;
+  trace.number = number;
+  trace.sweep = &sweep;
+  trace.report = run_pipeline(sweep, number);
+  flush(trace);
+  if (!options_.on_sweep) return;
+  trace.version = published_version_;
+  trace.acquisition_cpu = acquisition_->cpu_seconds();
+  options_.on_sweep(trace);
+}
+
+std::optional<SweepReport> Daemon::run_pipeline(const FrameSweep& sweep, std::uint64_t number) {
   try {
-    const SweepReport report = pipeline_.process(sweep);
+    SweepReport report = pipeline_.process(sweep);
     health_.sweep_processed(number, wall_clock_ns());
     spdlog::info(
         "sweep {}: {} frames, {} points, {} on the robot, {} hit / {} free voxels, {} flipped, {} change "
@@ -156,11 +187,22 @@ void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
         report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_change,
         report.t_segment, mailbox_.dropped());
     layers_.after_sweep(number, sweep, pipeline_.map(), report.changes);
+    return report;
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
     spdlog::error("sweep {}: {}; keeping version {}", number, e.what(), keeper_.published().version());
+    return std::nullopt;
   }
+}
+
+void Daemon::flush(SweepTrace& trace) {
+  publish_cost_ = {};
+  const Stopwatch watch;
   keeper_.flush(pipeline_);
+  watch.add_to(trace.persist);
+  trace.persist.wall -= publish_cost_.wall;
+  trace.persist.cpu -= publish_cost_.cpu;
+  trace.publish = publish_cost_;
   published_version_ = keeper_.published().version();
 }
 

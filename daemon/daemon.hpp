@@ -7,7 +7,9 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 
 #include "acquisition.hpp"
 #include "cellmap/cell/cell_pipeline.hpp"
@@ -23,10 +25,30 @@
 
 namespace cellmap::daemon {
 
+/// Seconds one step took: wall time, and CPU time of the thread that ran it.
+struct StepCost {
+  double wall = 0.0;
+  double cpu = 0.0;
+};
+
+/// One sweep the processing thread handled, for measuring the daemon (`cellmap bench daemon`).
+struct SweepTrace {
+  std::uint64_t number = 0;           ///< sweeps handled so far, this one included
+  const FrameSweep* sweep = nullptr;  ///< the sweep; valid during the call only
+  std::optional<SweepReport> report;  ///< what the pipeline did; nullopt if the sweep failed
+  StepCost persist;              ///< saving the version the sweep made (boxes and map state), if it made one
+  StepCost publish;              ///< publishing it (snapshot and delta)
+  std::uint64_t version = 0;     ///< the version subscribers have after the sweep
+  double acquisition_cpu = 0.0;  ///< CPU seconds the sweep source's threads used so far
+};
+
 /// What the command line adds to the config.
 struct RunOptions {
   std::filesystem::path config_file;  ///< re-read on SIGHUP; empty = the built-in defaults
   std::uint64_t max_sweeps = 0;       ///< stop after this many sweeps (0 = until SIGTERM/SIGINT)
+  /// Called on the processing thread after each sweep was handled and its version went out; must return
+  /// quickly. Empty = none.
+  std::function<void(const SweepTrace&)> on_sweep;
 };
 
 class Daemon final {
@@ -44,6 +66,10 @@ class Daemon final {
   void acquire();
   void process();
   void handle(const FrameSweep& sweep, std::uint64_t number);
+  // Runs the pipeline on the sweep and logs what it did; nullopt if the sweep failed (logged, reported).
+  std::optional<SweepReport> run_pipeline(const FrameSweep& sweep, std::uint64_t number);
+  // Saves and publishes what the sweep changed: keeper_.flush(), its cost split into saving and publishing.
+  void flush(SweepTrace& trace);
   // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the
   // robot layer the model to show.
   void use_self_filter();
@@ -65,6 +91,7 @@ class Daemon final {
   std::atomic<bool> stop_{false};
   std::atomic<bool> acquisition_done_{false};
   std::string status_fault_;  // the last reason a status was not published, logged once
+  StepCost publish_cost_;     // of the publications during the current flush()
 };
 
 }  // namespace cellmap::daemon

@@ -145,7 +145,7 @@ void LayerPublisher::publish_robot(std::uint64_t number, const FrameSweep& sweep
     throw Error("robot layer: the frame's robot has " + std::to_string(last->robot->X_CL.size()) +
                 " link poses, the model " + std::to_string(robot_->link_names().size()) + " links");
   const std::uint32_t joined = writer_.readers_joined(Layer::kRobot);
-  const transport::RobotLayer layer{writer_.cell(), number,   system_now_ns(),
+  const transport::RobotLayer layer{writer_.cell(), number,   wall_clock_ns(),
                                     padding_scale_, padding_, posed_shapes(*robot_, *last->robot)};
   writer_.write(layer);
   if (joined != robot_readers_served_) {

@@ -1,10 +1,10 @@
 #pragma once
 // Every DDS domain id the tests use, in one table. ctest runs tests side by side (-j 2) and DDS tests on
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
-// A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), the
-// browser test 220-221 (tests/view/view_browser_test.py), scripts/soak 179. Credentials tests name domains 7,
-// 197 and 233 without joining them. Ids above 232 cannot be joined: Cyclone's ports for domain d start at
-// 7400 + 250 · d, beyond 65535 there.
+// A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp) and 144
+// (bench/daemon_bench.cpp), the browser test 220-221 (tests/view/view_browser_test.py), scripts/soak 179.
+// Credentials tests name domains 7, 197 and 233 without joining them. Ids above 232 cannot be joined:
+// Cyclone's ports for domain d start at 7400 + 250 · d, beyond 65535 there.
 
 namespace cellmap::test::domain {
 
@@ -85,5 +85,8 @@ inline constexpr int kRefusal = 196;
 // transport_test: the viewer's layers.
 inline constexpr int kLayers = 222;
 inline constexpr int kRobotLayer = 136;
+
+// daemon_bench_test: `cellmap bench daemon` at a low rate (its subscriber in a process of its own).
+inline constexpr int kBenchDaemon = 230;
 
 }  // namespace cellmap::test::domain

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 #include "coverage.hpp"
 #include "no_return.hpp"
 
@@ -24,9 +25,20 @@ constexpr std::string_view kStateMagic = "cellmap-map-state 3";
 // anew.
 constexpr double kRefitShare = 0.1;
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+// Wall time of one stage, and CPU time of the calling thread with its helpers.
+class StageClock {
+ public:
+  StageClock() : wall_(std::chrono::steady_clock::now()), cpu_(cpu_seconds_with_helpers()) {}
+  // Seconds since construction (wall, then CPU), written to `wall` and `cpu`.
+  void stop(double& wall, double& cpu) const {
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count();
+    cpu = cpu_seconds_with_helpers() - cpu_;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point wall_;
+  double cpu_;
+};
 
 bool contains_id(const std::vector<std::uint64_t>& ids, std::uint64_t id) {
   return std::find(ids.begin(), ids.end(), id) != ids.end();
@@ -101,7 +113,7 @@ SweepReport CellPipeline::process(const FrameSweep& frames) {
   Sweep sweep;
   sweep.stamp = frames.stamp;
   std::size_t robot_points = 0, no_return_rays = 0;
-  const auto start = std::chrono::steady_clock::now();
+  const StageClock filter_clock;
   for (const SweepFrame& f : frames.frames) {
     if (!filter_ || !f.robot || !config_.self_filter.enabled) {
       sweep.scans.push_back(to_scan(f.frame));
@@ -114,12 +126,14 @@ SweepReport CellPipeline::process(const FrameSweep& frames) {
       no_return_rays +=
           add_no_return_rays(f.frame, f.no_return_range, no_return_phase_++, sweep.scans.back());
   }
-  const double t_filter = seconds_since(start);
+  double t_filter = 0, cpu_filter = 0;
+  filter_clock.stop(t_filter, cpu_filter);
   SweepReport report = process(sweep);
   report.frames = frames.frames.size();
   report.robot_points = robot_points;
   report.no_return_rays = no_return_rays;
   report.t_filter = t_filter;
+  report.cpu_filter = cpu_filter;
   return report;
 }
 
@@ -129,25 +143,25 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
   report.frames = sweep.scans.size();
   update_viewpoint(sweep);
 
-  auto start = std::chrono::steady_clock::now();
+  const StageClock fuse_clock;
   const OccupancyUpdate update = map_.integrate(sweep);
-  report.t_fuse = seconds_since(start);
+  fuse_clock.stop(report.t_fuse, report.cpu_fuse);
   report.hit_voxels = update.hit_voxels;
   report.free_voxels = update.free_voxels;
   report.flipped = update.appeared.size() + update.vanished.size();
 
-  start = std::chrono::steady_clock::now();
+  const StageClock change_clock;
   ChangeSet changes = detector_.update(update, map_);
-  report.t_change = seconds_since(start);
+  change_clock.stop(report.t_change, report.cpu_change);
   report.regions = changes.regions.size();
   report.boxes = boxes_.size();
   if (!resegmentation_due(changes)) return report;
 
-  start = std::chrono::steady_clock::now();
+  const StageClock segment_clock;
   // The map has settled: one segmentation of all of it makes the first version; changes from then on.
   Resegmentation resegmentation = settling_ ? resegment_everything() : resegment(changes);
   settling_ = false;
-  report.t_segment = seconds_since(start);
+  segment_clock.stop(report.t_segment, report.cpu_segment);
   report.changes = std::move(changes);
   apply(std::move(resegmentation), report);
   return report;

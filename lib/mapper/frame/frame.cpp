@@ -19,15 +19,19 @@ void PinholeIntrinsics::validate() const {
 
 namespace {
 
-// Depth in metres of each pixel with a return in [min_range, max_range], else 0.
-std::vector<double> valid_depths(const DepthImage& image) {
+// Depth in metres of each pixel with a return in [min_range, max_range], else 0, written to `z`.
+void valid_depths(const DepthImage& image, std::vector<double>& z) {
   const PinholeIntrinsics& k = image.intrinsics;
-  std::vector<double> z(image.depth.size(), 0.0);
+  z.resize(image.depth.size());
   for (std::size_t p = 0; p < z.size(); ++p) {
     const double d = image.depth[p] * k.depth_scale;
-    if (image.depth[p] != 0 && d >= k.min_range && d <= k.max_range) z[p] = d;
+    z[p] = image.depth[p] != 0 && d >= k.min_range && d <= k.max_range ? d : 0.0;
   }
-  return z;
+}
+
+// Whether valid depth `zq` of a neighbour is nearer than `zp` by more than `limit`.
+inline bool nearer(double zp, double zq, double limit) {
+  return zq > 0 && zp - zq > limit;
 }
 
 // Whether a valid 8-neighbour of pixel (u, v) is nearer by more than max_jump of the pixel's depth.
@@ -36,10 +40,17 @@ std::vector<double> valid_depths(const DepthImage& image) {
 bool behind_depth_edge(const std::vector<double>& z, int width, int height, int u, int v, double max_jump) {
   const double zp = z[static_cast<std::size_t>(v) * width + u];
   const double limit = max_jump * zp;
+  if (u > 0 && v > 0 && u + 1 < width && v + 1 < height) {  // inside: no bounds to check
+    const double* above = &z[static_cast<std::size_t>(v - 1) * width + u];
+    const double* row = above + width;
+    const double* below = row + width;
+    return nearer(zp, above[-1], limit) || nearer(zp, above[0], limit) || nearer(zp, above[1], limit) ||
+           nearer(zp, row[-1], limit) || nearer(zp, row[1], limit) || nearer(zp, below[-1], limit) ||
+           nearer(zp, below[0], limit) || nearer(zp, below[1], limit);
+  }
   for (int nv = std::max(0, v - 1); nv <= std::min(height - 1, v + 1); ++nv) {
     for (int nu = std::max(0, u - 1); nu <= std::min(width - 1, u + 1); ++nu) {
-      const double zq = z[static_cast<std::size_t>(nv) * width + nu];
-      if (zq > 0 && zp - zq > limit) return true;
+      if (nearer(zp, z[static_cast<std::size_t>(nv) * width + nu], limit)) return true;
     }
   }
   return false;
@@ -56,21 +67,24 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
                 std::to_string(k.width) + "x" + std::to_string(k.height));
   }
   Cloud cloud;
-  cloud.reserve(pixels);
+  auto& points = cloud.points;  // filled directly: the cloud's push_back also rewrites width and height
+  points.reserve(pixels);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const double inv_fx = 1.0 / k.fx;
   const double inv_fy = 1.0 / k.fy;
-  const std::vector<double> depths = valid_depths(image);
+  // Kept per thread: a frame's worth of doubles, fresh memory (zeroed and page-faulted) on every frame else.
+  thread_local std::vector<double> depths;
+  valid_depths(image, depths);
   for (int v = 0; v < k.height; ++v) {
     for (int u = 0; u < k.width; ++u) {
       const double z = depths[static_cast<std::size_t>(v) * k.width + u];
       if (z == 0 ||
           (k.max_depth_jump > 0 && behind_depth_edge(depths, k.width, k.height, u, v, k.max_depth_jump))) {
-        if (organized) cloud.push_back(pcl::PointXYZ(nan, nan, nan));
+        if (organized) points.emplace_back(nan, nan, nan);
         continue;
       }
-      cloud.push_back(pcl::PointXYZ(static_cast<float>((u - k.cx) * z * inv_fx),
-                                    static_cast<float>((v - k.cy) * z * inv_fy), static_cast<float>(z)));
+      points.emplace_back(static_cast<float>((u - k.cx) * z * inv_fx),
+                          static_cast<float>((v - k.cy) * z * inv_fy), static_cast<float>(z));
     }
   }
   if (organized) {

@@ -21,11 +21,12 @@ Scan to_scan(const Frame& frame) {
   Scan scan;
   scan.origin_C = frame.X_CS.translation();
   const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
-  scan.points_C.reserve(frame.points_S.size());
+  auto& points_C = scan.points_C.points;  // filled directly: the cloud's push_back also rewrites its size
+  points_C.reserve(frame.points_S.size());
   for (const pcl::PointXYZ& p : frame.points_S) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
     const Eigen::Vector3f p_C = X_CS * p.getVector3fMap();
-    scan.points_C.push_back(pcl::PointXYZ(p_C.x(), p_C.y(), p_C.z()));
+    points_C.emplace_back(p_C.x(), p_C.y(), p_C.z());
   }
   scan.points_C.width = static_cast<std::uint32_t>(scan.points_C.size());
   scan.points_C.height = 1;

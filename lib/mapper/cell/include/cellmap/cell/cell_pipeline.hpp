@@ -98,6 +98,10 @@ struct SweepReport final {
   std::size_t evidence = 0;        ///< occupied voxels re-segmented
   std::size_t boxes = 0;           ///< boxes after the sweep
   double t_fuse = 0, t_change = 0, t_segment = 0;  ///< seconds
+  /// CPU seconds of the self filter (frames to scans included), fusion, change detection and re-segmentation
+  /// on the calling thread and the helper threads it split them onto (cpu_seconds_with_helpers()): what a
+  /// stage costs, which a wall time on a shared machine hides.
+  double cpu_filter = 0, cpu_fuse = 0, cpu_change = 0, cpu_segment = 0;
   ChangeSet changes;  ///< the change regions re-segmented in this sweep (gathered over gather_sweeps)
   std::optional<Reconciled> change;  ///< set when the boxes changed (a new version is due)
 };

@@ -1,0 +1,545 @@
+// cellmap bench daemon: the whole daemon path fed with two native cameras of the default cell at frame rate.
+//
+// Two replay recordings of the default cell's cameras on the gantry's tool, in their native modes (Kinect v2
+// 512 × 424 with no_return_range 4.5 m, it is a time-of-flight camera; RealSense D435 848 × 480), rendered
+// at start with the cameras' noise: the gantry goes back and forth over the table, and a crate appears on
+// the table and goes again every --change-every seconds after a warm-up. cellmapd's own wiring (Daemon: the
+// camera threads, sweep grouping, the latest-wins mailbox, the cell pipeline, the version keeper saving to
+// a state directory, DDS publication) plays them at their recorded speed, and a subscriber process (the
+// planner client library) follows the cell on loopback.
+//
+// Reports frames fused per second per camera, frames dropped (played but never fused), CPU per frame by
+// stage, and the latency from the frame that confirmed a change (the last frame of the sweep that made a
+// version, at the time its camera delivered it) to the version's arrival at the subscriber. The anchor of
+// the ratio line: OctoMap's discretized insertPointCloud on frames of the same recordings, CPU per frame.
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/sensor/depth_io.hpp"
+#include "cellmap/sensor/replay_source.hpp"
+#include "cellmap/sim/default_scene.hpp"
+#include "cellmap/sim/recording.hpp"
+#include "cellmap/sim/simulator.hpp"
+#include "cellmap/transport/environment_subscriber.hpp"
+#include "daemon.hpp"
+#include "native_modes.hpp"
+#include "subscriber_arrivals.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace cellmap;
+using Clock = std::chrono::steady_clock;  // CLOCK_MONOTONIC: comparable across processes
+
+constexpr const char* kCell = "bench-daemon";
+struct Options {
+  double seconds = 40.0;         // recording length
+  double rate = 30.0;            // frames per second of each camera
+  double warmup = 12.0;          // seconds before the first change (the map settles meanwhile)
+  double change_every = 4.0;     // seconds between the crate appearing and going
+  double pass_seconds = 2.0;     // the gantry's time from one end of the table to the other
+  int stops = 20;                // distinct gantry positions rendered per pass (a frame shows the nearest)
+  double no_return_range = 4.5;  // the Kinect's (time-of-flight)
+  int settle_sweeps = 15;        // change.settle_sweeps (cellmapd's default)
+  int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
+  int domain = 144;
+  int anchor_frames = 6;  // frames per camera fused by the anchor
+};
+
+using bench::Arrival;
+using bench::kLoopbackConfig;
+using bench::now_ns;
+
+int run_subscriber(std::uint32_t domain) {
+  const dds::Participant participant(domain);
+  transport::EnvironmentSubscriber subscriber(
+      participant, kCell,
+      [](const Environment& env, const EnvironmentDelta&) { bench::report_arrival(env.version()); });
+  ::pause();  // killed by the parent
+  return 0;
+}
+
+// The subscriber in a process of its own; its arrivals are collected on a thread.
+class SubscriberProcess {
+ public:
+  explicit SubscriberProcess(int domain) {
+    int fds[2];
+    if (::pipe(fds) != 0) throw std::runtime_error("pipe failed");
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(fds[1], STDOUT_FILENO);
+      ::close(fds[0]);
+      ::close(fds[1]);
+      const std::string domain_text = std::to_string(domain);
+      ::execl("/proc/self/exe", "cellmap-bench-daemon", "--subscriber", domain_text.c_str(), nullptr);
+      std::_Exit(127);
+    }
+    ::close(fds[1]);
+    in_ = fds[0];
+    reader_ = std::thread([this] { collect(); });
+  }
+  ~SubscriberProcess() {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    reader_.join();
+    ::close(in_);
+  }
+  // The first arrival of each version.
+  [[nodiscard]] std::map<std::uint64_t, std::int64_t> arrivals() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return arrivals_;
+  }
+
+ private:
+  void collect() {
+    Arrival arrival{};
+    while (::read(in_, &arrival, sizeof arrival) == sizeof arrival) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      arrivals_.emplace(arrival.version, arrival.received_ns);
+    }
+  }
+  pid_t pid_ = -1;
+  int in_ = -1;
+  std::thread reader_;
+  mutable std::mutex mutex_;
+  std::map<std::uint64_t, std::int64_t> arrivals_;
+};
+
+// --- the recordings
+// ------------------------------------------------------------------------------------------
+
+using bench::d435_848x480;
+
+// The crate that appears on the table, clear of every obstacle of the default cell.
+sim::Obstacle crate() {
+  sim::Obstacle o;
+  o.name = "bench_crate";
+  o.shape = sim::BoxShape{Eigen::Vector3d(0.15, 0.1, 0.1)};
+  o.X_CO = Eigen::Translation3d(1.0, 1.2, 0.85) * Eigen::Isometry3d::Identity();
+  return o;
+}
+
+struct Camera {
+  Camera(std::string name, const PinholeIntrinsics& intrinsics, double no_return_range)
+      : name(std::move(name)), intrinsics(intrinsics), no_return_range(no_return_range) {}
+  std::string name;  // the scene's sensor
+  PinholeIntrinsics intrinsics;
+  double no_return_range;
+  Eigen::Isometry3d X_ES = Eigen::Isometry3d::Identity();
+  std::vector<Frame> anchor_frames;  // the first frames, posed, for the anchor
+};
+
+class Recording {
+ public:
+  Recording(const Options& options, fs::path dir) : options_(options), dir_(std::move(dir)) {
+    pass_frames_ =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(options.pass_seconds * options.rate)));
+    stops_ = static_cast<int>(
+        std::clamp<std::size_t>(static_cast<std::size_t>(options.stops), 2, pass_frames_ + 1));
+    frames_ = static_cast<std::size_t>(std::lround(options.seconds * options.rate));
+  }
+
+  // The gantry's stop nearest to where it is at frame i: back and forth along the default plan's line over
+  // the table.
+  [[nodiscard]] int stop_of(std::size_t i) const {
+    const std::size_t j = i % (2 * pass_frames_);
+    const double along =
+        j < pass_frames_ ? double(j) / double(pass_frames_) : 2.0 - double(j) / double(pass_frames_);
+    return static_cast<int>(std::lround(along * (stops_ - 1)));
+  }
+  [[nodiscard]] Eigen::VectorXd q_at(int stop) const {
+    return Eigen::Vector3d(0.5 + 2.0 * stop / (stops_ - 1), 1.0, 0.0);
+  }
+  [[nodiscard]] double stamp_of(std::size_t i) const { return static_cast<double>(i) / options_.rate; }
+  // Whether the crate stands on the table at `t`.
+  [[nodiscard]] bool crate_at(double t) const {
+    if (t < options_.warmup) return false;
+    return static_cast<long>((t - options_.warmup) / options_.change_every) % 2 == 0;
+  }
+  [[nodiscard]] std::size_t changes() const {
+    std::size_t n = 0;
+    for (std::size_t i = 1; i < frames_; ++i) n += crate_at(stamp_of(i)) != crate_at(stamp_of(i - 1));
+    return n;
+  }
+  [[nodiscard]] std::size_t frames() const { return frames_; }
+
+  // Renders `camera`'s stops with and without the crate and writes its replay directory.
+  void write(Camera& camera) const {
+    const fs::path dir = dir_ / camera.name;
+    fs::create_directories(dir);
+    for (const bool with_crate : {false, true}) {
+      if (with_crate && changes() == 0) continue;  // never shown
+      sim::Scene scene = sim::default_scene();
+      const int sensor = scene.find_sensor(camera.name);
+      scene.sensors[static_cast<std::size_t>(sensor)].intrinsics = camera.intrinsics;
+      camera.X_ES = scene.sensors[static_cast<std::size_t>(sensor)].X_ES;
+      if (with_crate) scene.obstacles.push_back(crate());
+      const sim::Simulator simulator(std::move(scene));
+      for (int stop = 0; stop < stops_; ++stop) {
+        sim::SimFrame rendered =
+            simulator.render(sensor, q_at(stop), 0.0, with_crate ? 1 : 0, static_cast<std::uint64_t>(stop));
+        const DepthImage& depth = *rendered.frame.depth;
+        write_depth_png((dir / image(with_crate, stop)).string(),
+                        RawDepth{depth.intrinsics.width, depth.intrinsics.height, depth.depth});
+        if (!with_crate && static_cast<int>(camera.anchor_frames.size()) < options_.anchor_frames)
+          camera.anchor_frames.push_back(std::move(rendered.frame));
+      }
+    }
+    sim::write_intrinsics(dir / "intrinsics.yaml", camera.intrinsics);
+    const sim::Scene scene = sim::default_scene();
+    std::vector<ReplayEntry> entries;
+    for (std::size_t i = 0; i < frames_; ++i) {
+      const double t = stamp_of(i);
+      const int stop = stop_of(i);
+      entries.push_back(ReplayEntry{image(crate_at(t), stop), t, scene.robot.tool_pose(q_at(stop))});
+    }
+    write_replay_poses((dir / "poses.csv").string(), entries);
+  }
+
+ private:
+  static std::string image(bool with_crate, int stop) {
+    return (with_crate ? "crate_" : "empty_") + std::to_string(stop) + ".png";
+  }
+  Options options_;
+  fs::path dir_;
+  std::size_t pass_frames_ = 1;
+  int stops_ = 0;
+  std::size_t frames_ = 0;
+};
+
+std::string yaml_vector(const Eigen::Vector3d& v) {
+  char text[128];
+  std::snprintf(text, sizeof text, "[%.17g, %.17g, %.17g]", v.x(), v.y(), v.z());
+  return text;
+}
+
+std::string source_yaml(const Camera& camera, const fs::path& dir, int sweep_frames) {
+  const Eigen::Quaterniond r(camera.X_ES.linear());
+  char rotation[128];
+  std::snprintf(rotation, sizeof rotation, "[%.17g, %.17g, %.17g, %.17g]", r.w(), r.x(), r.y(), r.z());
+  return "  - {kind: replay, sensor: " + camera.name + ", sweep_frames: " + std::to_string(sweep_frames) +
+         ", no_return_range: " + std::to_string(camera.no_return_range) +
+         ", mount: tool, pose: {position: " + yaml_vector(camera.X_ES.translation()) +
+         ", rotation: " + rotation + "}, replay: {directory: " + (dir / camera.name).string() +
+         ", playback: recorded}}\n";
+}
+
+// --- the run ---------------------------------------------------------------------------------------------
+
+// What the processing thread reported, sweep by sweep.
+class Traces {
+ public:
+  void add(const daemon::SweepTrace& trace) {
+    Sweep sweep;
+    sweep.stamp = trace.sweep->stamp;
+    sweep.taken_ns = now_ns();
+    for (const SweepFrame& f : trace.sweep->frames) ++sweep.frames_by_camera[f.frame.sensor];
+    sweep.report = trace.report;
+    if (sweep.report) sweep.report->changes = {};
+    sweep.persist = trace.persist;
+    sweep.publish = trace.publish;
+    sweep.version = trace.version;
+    sweep.acquisition_cpu = trace.acquisition_cpu;
+    std::lock_guard<std::mutex> lock(mutex_);
+    sweeps_.push_back(std::move(sweep));
+  }
+  struct Sweep {
+    double stamp = 0.0;
+    std::int64_t taken_ns = 0;
+    std::map<std::string, std::size_t> frames_by_camera;
+    std::optional<SweepReport> report;
+    daemon::StepCost persist, publish;
+    std::uint64_t version = 0;
+    double acquisition_cpu = 0.0;
+  };
+  [[nodiscard]] std::vector<Sweep> sweeps() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return sweeps_;
+  }
+  [[nodiscard]] double last_stamp() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return sweeps_.empty() ? -1.0 : sweeps_.back().stamp;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<Sweep> sweeps_;
+};
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return NAN;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5)];
+}
+
+double process_cpu_seconds() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+// CPU seconds per frame of OctoMap's discretized insertPointCloud (the anchor) and of OccupancyMap::integrate
+// (the fusion bench's path: each frame a sweep of its own), on the cameras' first frames.
+std::pair<double, double> fusion_per_frame(const std::vector<Camera>& cameras) {
+  const OccupancyConfig config;
+  std::vector<Sweep> sweeps;
+  std::vector<octomap::Pointcloud> clouds;
+  for (const Camera& camera : cameras) {
+    for (const Frame& frame : camera.anchor_frames) {
+      Sweep sweep;
+      sweep.scans.push_back(to_scan(frame));
+      octomap::Pointcloud cloud;
+      for (const auto& p : sweep.scans.front().points_C.points)
+        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud.push_back(p.x, p.y, p.z);
+      clouds.push_back(std::move(cloud));
+      sweeps.push_back(std::move(sweep));
+    }
+  }
+  if (sweeps.empty()) return {NAN, NAN};
+  double start = process_cpu_seconds();
+  octomap::OcTree tree(config.resolution);
+  apply_sensor_model(config, tree);
+  for (std::size_t i = 0; i < sweeps.size(); ++i) {
+    const Eigen::Vector3d& o = sweeps[i].scans.front().origin_C;
+    tree.insertPointCloud(clouds[i], octomap::point3d(float(o.x()), float(o.y()), float(o.z())),
+                          config.max_range, false, true);
+  }
+  const double anchor = (process_cpu_seconds() - start) / static_cast<double>(sweeps.size());
+  start = process_cpu_seconds();
+  OccupancyMap map(config);
+  for (const Sweep& sweep : sweeps) map.integrate(sweep);
+  const double ours = (process_cpu_seconds() - start) / static_cast<double>(sweeps.size());
+  return {anchor, ours};
+}
+
+double load_average() {
+  double load[1] = {NAN};
+  ::getloadavg(load, 1);
+  return load[0];
+}
+
+struct Totals {
+  std::map<std::string, std::size_t> fused_by_camera;
+  std::size_t fused = 0;
+  double filter = 0, fuse = 0, change = 0, segment = 0, persist = 0, publish = 0;  // CPU seconds
+  double fuse_wall = 0;
+  std::size_t versions = 0;  // sweeps that published a version
+};
+
+Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
+  Totals t;
+  std::uint64_t version = sweeps.empty() ? 0 : sweeps.front().version;
+  for (const Traces::Sweep& s : sweeps) {
+    if (!s.report) continue;
+    for (const auto& [camera, n] : s.frames_by_camera) {
+      t.fused_by_camera[camera] += n;
+      t.fused += n;
+    }
+    t.filter += s.report->cpu_filter;
+    t.fuse += s.report->cpu_fuse;
+    t.fuse_wall += s.report->t_fuse;
+    t.change += s.report->cpu_change;
+    t.segment += s.report->cpu_segment;
+    t.persist += s.persist.cpu;
+    t.publish += s.publish.cpu;
+    if (s.version != version) ++t.versions;
+    version = s.version;
+  }
+  return t;
+}
+
+// Latency from each version's confirming frame (the last frame of the sweep that made it, at the time its
+// replay delivered it) to its arrival at the subscriber, ms; the first version (the settled map) left out.
+std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps,
+                                        const std::map<std::uint64_t, std::int64_t>& arrivals,
+                                        std::int64_t start_ns) {
+  std::vector<double> latencies;
+  std::uint64_t version = 0;
+  bool first = true;
+  for (const Traces::Sweep& s : sweeps) {
+    if (s.version == version) continue;
+    version = s.version;
+    if (first) {
+      first = false;
+      continue;
+    }
+    const auto arrival = arrivals.find(version);
+    if (arrival == arrivals.end()) continue;
+    const double delivered_ns = static_cast<double>(start_ns) + s.stamp * 1e9;
+    latencies.push_back((static_cast<double>(arrival->second) - delivered_ns) / 1e6);
+  }
+  return latencies;
+}
+
+void print_stage(const char* stage, double cpu, std::size_t frames, const char* note) {
+  std::printf("  %-18s %9.2f ms %s\n", stage, frames ? 1e3 * cpu / static_cast<double>(frames) : NAN, note);
+}
+
+int run(const Options& options) {
+  const fs::path dir = fs::temp_directory_path() / ("cellmap-bench-daemon-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{dir};
+
+  const Recording recording(options, dir);
+  std::vector<Camera> cameras{
+      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
+      {"realsense", d435_848x480(), 0.0}};
+  const auto render_start = Clock::now();
+  for (Camera& camera : cameras) recording.write(camera);
+  std::printf(
+      "recordings: %zu frames per camera at %.1f Hz (%.1f s), Kinect v2 512x424 (no_return_range %.1f m) "
+      "and RealSense D435 848x480; the crate appears or goes %zu times from %.1f s on, every %.1f s; "
+      "rendered and written in %.1f s\n",
+      recording.frames(), options.rate, options.seconds, options.no_return_range, recording.changes(),
+      options.warmup, options.change_every,
+      std::chrono::duration<double>(Clock::now() - render_start).count());
+
+  // Before any thread (the subscriber's reader, the daemon's): they all inherit the blocked signals.
+  const daemon::Signals signals;
+  SubscriberProcess subscriber(options.domain);
+  std::string yaml = "cell: " + std::string(kCell) + "\ndomain: " + std::to_string(options.domain) +
+                     "\nstate_dir: " + (dir / "state").string() +
+                     "\nlog_level: warn\nchange: {settle_sweeps: " + std::to_string(options.settle_sweeps) +
+                     "}\nsources:\n";
+  for (const Camera& camera : cameras) yaml += source_yaml(camera, dir, options.sweep_frames);
+  daemon::DaemonConfig config = daemon::DaemonConfig::parse(yaml, "bench", dir);
+  spdlog::set_level(spdlog::level::warn);
+
+  Traces traces;
+  daemon::RunOptions run_options;
+  run_options.on_sweep = [&traces](const daemon::SweepTrace& trace) { traces.add(trace); };
+  daemon::Daemon daemon(config, run_options);
+
+  // Stops the daemon once the last frames were processed (or long after the recording ended).
+  const double last_stamp = recording.stamp_of(recording.frames() - 1);
+  std::atomic<bool> finished{false};
+  std::thread stopper([&] {
+    const auto give_up = Clock::now() + std::chrono::duration<double>(options.seconds * 3 + 60);
+    while (traces.last_stamp() < last_stamp && Clock::now() < give_up)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the last version's way to the subscriber
+    finished = true;
+    ::kill(::getpid(), SIGTERM);
+  });
+  const double cpu_start = process_cpu_seconds();
+  const double load_start = load_average();
+  const std::int64_t start_ns = now_ns();
+  daemon.run(signals);
+  const double run_seconds = static_cast<double>(now_ns() - start_ns) / 1e9;
+  const double cpu_total = process_cpu_seconds() - cpu_start;
+  stopper.join();
+
+  const std::vector<Traces::Sweep> sweeps = traces.sweeps();
+  const Totals t = add_up(sweeps);
+  const std::size_t played = recording.frames() * cameras.size();
+  const double acquisition = sweeps.empty() ? 0.0 : sweeps.back().acquisition_cpu;
+  std::printf(
+      "\ncellmapd, %zu cameras at %.1f Hz for %.1f s (run %.1f s, load average %.2f at start, %.2f at end)\n",
+      cameras.size(), options.rate, options.seconds, run_seconds, load_start, load_average());
+  for (const Camera& camera : cameras) {
+    const std::size_t fused = t.fused_by_camera.count(camera.name) ? t.fused_by_camera.at(camera.name) : 0;
+    std::printf("  %-10s frames fused %5zu of %5zu, %6.1f per second\n", camera.name.c_str(), fused,
+                recording.frames(), static_cast<double>(fused) / options.seconds);
+  }
+  std::printf("frames dropped: %zu of %zu\n", played - t.fused, played);
+  std::vector<double> waits;  // from a sweep's last frame being due to its processing
+  for (const Traces::Sweep& s : sweeps)
+    waits.push_back(static_cast<double>(s.taken_ns - start_ns) / 1e6 - s.stamp * 1e3);
+  std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
+              percentile(waits, 1.0));
+  std::printf("sweeps processed: %zu, versions published: %zu\n", sweeps.size(), t.versions);
+  std::printf("CPU per fused frame by stage (each on its thread, with the helper threads it started):\n");
+  print_stage("acquisition", acquisition, played,
+              "(camera threads, per frame played: read, decode, pose, group)");
+  print_stage("self filter", t.filter, t.fused,
+              "(frames to cell-frame scans, no-return rays; replays carry no robot)");
+  print_stage("fusion", t.fuse, t.fused, "");
+  print_stage("change", t.change, t.fused, "");
+  print_stage("re-segmentation", t.segment, t.fused, "(sweeps with a change, and the first version)");
+  print_stage("persist", t.persist, t.fused, "(processing thread: version and map state to disk)");
+  print_stage("publish", t.publish, t.fused, "(processing thread: snapshot and delta)");
+  print_stage("whole process", cpu_total, t.fused, "(every thread, DDS included)");
+  std::printf("  per version: persist %.1f ms CPU, publish %.2f ms CPU\n",
+              t.versions ? 1e3 * t.persist / static_cast<double>(t.versions) : NAN,
+              t.versions ? 1e3 * t.publish / static_cast<double>(t.versions) : NAN);
+
+  const std::map<std::uint64_t, std::int64_t> arrivals = subscriber.arrivals();
+  std::printf("versions received by the subscriber: %zu (the last: %llu)\n", arrivals.size(),
+              arrivals.empty() ? 0ULL : static_cast<unsigned long long>(arrivals.rbegin()->first));
+  const std::vector<double> latencies = confirm_to_delta_ms(sweeps, arrivals, start_ns);
+  std::printf(
+      "confirm-to-delta latency: %zu versions after the first, p50 %.1f ms, p99 %.1f ms, max %.1f ms\n",
+      latencies.size(), percentile(latencies, 0.5), percentile(latencies, 0.99), percentile(latencies, 1.0));
+
+  const auto [anchor, bench_fusion] = fusion_per_frame(cameras);
+  const double daemon_fusion = t.fused ? t.fuse / static_cast<double>(t.fused) : NAN;
+  std::printf(
+      "fusion CPU per frame: daemon %.1f ms, the same frames fused one per sweep %.1f ms, OctoMap "
+      "insertPointCloud(discretize=true) %.1f ms\n",
+      1e3 * daemon_fusion, 1e3 * bench_fusion, 1e3 * anchor);
+  std::printf("ratio daemon fusion per frame (vs discretized insert): %.2fx\n", anchor / daemon_fusion);
+  std::printf("ratio frames fused (vs frames played): %.3fx\n",
+              played ? static_cast<double>(t.fused) / static_cast<double>(played) : NAN);
+  return finished ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::setenv("CYCLONEDDS_URI", kLoopbackConfig, 0);  // keep the caller's configuration if there is one
+  if (argc == 3 && std::strcmp(argv[1], "--subscriber") == 0)
+    return run_subscriber(static_cast<std::uint32_t>(std::stoul(argv[2])));
+  CLI::App app{
+      "cellmap bench daemon: cellmapd fed with two native cameras of the default cell (recordings played at "
+      "their recorded speed); frames fused and dropped, CPU per frame by stage, confirm-to-delta latency"};
+  Options options;
+  app.add_option("--seconds", options.seconds, "recording length")->check(CLI::Range(1.0, 3600.0));
+  app.add_option("--rate", options.rate, "frames per second of each camera")->check(CLI::Range(0.5, 120.0));
+  app.add_option("--warmup", options.warmup, "seconds before the first change")
+      ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--change-every", options.change_every, "seconds between changes")
+      ->check(CLI::Range(0.5, 3600.0));
+  app.add_option("--no-return-range", options.no_return_range, "the Kinect's no_return_range, metres")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--settle-sweeps", options.settle_sweeps,
+                 "sweeps before the first version (change.settle_sweeps)")
+      ->check(CLI::Range(0, 100000));
+  app.add_option("--sweep-frames", options.sweep_frames,
+                 "frames that close a sweep (sweep_frames; 0 = only sweep_period)")
+      ->check(CLI::Range(0, 100000));
+  app.add_option("--stops", options.stops, "gantry positions rendered per pass")->check(CLI::Range(2, 1000));
+  app.add_option("--domain", options.domain, "DDS domain id")->check(CLI::Range(0, 232));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    return run(options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench daemon: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,51 @@
+// `cellmap bench daemon` at a low frame rate: the bench runs cellmapd's path end to end, fuses every frame
+// of both cameras and its subscriber receives the versions it publishes. Speed is not asserted here.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <regex>
+#include <string>
+
+#include "support/dds_domains.hpp"
+#include "support/test_support.hpp"
+
+namespace {
+
+struct BenchRun {
+  int exit_code = -1;
+  std::string output;
+};
+
+BenchRun run_bench(const std::string& arguments) {
+  const std::string command = std::string(CELLMAP_BENCH_DAEMON) + " " + arguments + " 2>&1";
+  BenchRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) run.output += buffer;
+  run.exit_code = cellmap::test::exit_code(::pclose(pipe));
+  return run;
+}
+
+// The number after `label` in `text`, or -1.
+long number_after(const std::string& text, const std::string& label) {
+  std::smatch match;
+  if (!std::regex_search(text, match, std::regex(label + " *([0-9]+)"))) return -1;
+  return std::stol(match[1]);
+}
+
+TEST(DaemonBenchTest, FusesEveryFrameOfBothCamerasAtALowRate) {
+  // 0.5 Hz for 8 s: 4 frames per camera, each pair a sweep; the first version after the first sweep, the
+  // crate never appears. Two seconds per sweep leave room for the first version on a busy machine.
+  const BenchRun run = run_bench("--rate 0.5 --seconds 8 --settle-sweeps 1 --warmup 100 --domain " +
+                                 std::to_string(cellmap::test::domain::kBenchDaemon));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(number_after(run.output, "kinect +frames fused"), 4) << run.output;
+  EXPECT_EQ(number_after(run.output, "realsense +frames fused"), 4) << run.output;
+  EXPECT_EQ(number_after(run.output, "frames dropped:"), 0) << run.output;
+  EXPECT_GE(number_after(run.output, "versions received by the subscriber:"), 1) << run.output;
+  EXPECT_NE(run.output.find("ratio daemon fusion per frame (vs discretized insert): "), std::string::npos)
+      << run.output;
+}
+
+}  // namespace
