@@ -24,13 +24,14 @@ ConstraintSet empty_set(const std::vector<std::vector<Obb>>& robot_at_checkpoint
   return set;
 }
 
-// The dense batch runs the first projections of signed_distance on this many environment boxes at once;
-// the pairs they leave open go through signed_distance itself, so every entry equals signed_distance.
-constexpr int kLanes = 4;
+// The dense batch runs the first projections of signed_distance on kLanes environment boxes at once; the
+// pairs they leave open go through signed_distance itself, so every entry equals signed_distance.
+using EnvironmentLanes = BoxLanes<Double2>;
+constexpr int kLanes = EnvironmentLanes::kLanes;
 
 // The environment in blocks of kLanes (the last block padded with copies of the last box).
-std::vector<BoxLanes<kLanes>> environment_lanes(const std::vector<Obb>& environment) {
-  std::vector<BoxLanes<kLanes>> blocks((environment.size() + kLanes - 1) / kLanes);
+std::vector<EnvironmentLanes> environment_lanes(const std::vector<Obb>& environment) {
+  std::vector<EnvironmentLanes> blocks((environment.size() + kLanes - 1) / kLanes);
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     for (int l = 0; l < kLanes; ++l) {
       blocks[b].set(l, environment[std::min(b * kLanes + l, environment.size() - 1)]);
@@ -55,12 +56,12 @@ ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoi
                           const std::vector<Obb>& environment) {
   ConstraintSet set = empty_set(robot_at_checkpoints, environment);
   set.entries.reserve(set.n_constr());
-  const std::vector<BoxLanes<kLanes>> blocks = environment_lanes(environment);
+  const std::vector<EnvironmentLanes> blocks = environment_lanes(environment);
   for (int k = 0; k < set.n_checkpoints; ++k) {
     for (int r = 0; r < set.n_rob; ++r) {
       const Obb& robot_box = robot_at_checkpoints[k][r];
       for (std::size_t block = 0; block < blocks.size(); ++block) {
-        ProjectionLanes<kLanes> projection;
+        ProjectionLanes<Double2> projection;
         relative_poses(robot_box, blocks[block], &projection);
         project_twice(robot_box.half_extents, blocks[block], &projection);
         const int first = static_cast<int>(block) * kLanes;
