@@ -60,16 +60,19 @@ ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoi
   for (int k = 0; k < set.n_checkpoints; ++k) {
     for (int r = 0; r < set.n_rob; ++r) {
       const Obb& robot_box = robot_at_checkpoints[k][r];
+      EnvironmentLanes robot_lanes;  // the robot box in every lane
+      for (int l = 0; l < kLanes; ++l) robot_lanes.set(l, robot_box);
       for (std::size_t block = 0; block < blocks.size(); ++block) {
         ProjectionLanes<Double2> projection;
-        relative_poses(robot_box, blocks[block], &projection);
-        project_twice(robot_box.half_extents, blocks[block], &projection);
+        project_twice(robot_lanes.view(), blocks[block].view(), &projection);
+        const SeparatedLanes<Double2> separated(robot_lanes.view(), projection.p, projection.gap,
+                                                projection.gap2);
         const int first = static_cast<int>(block) * kLanes;
         for (int l = 0; l < kLanes && first + l < set.n_env; ++l) {
           const int e = first + l;
-          set.entries.push_back({k, r, e,
-                                 projection.certified[l] ? separated_lane(robot_box, projection, l)
-                                                         : signed_distance(robot_box, environment[e])});
+          set.entries.push_back(
+              {k, r, e,
+               projection.certified[l] ? separated.lane(l) : signed_distance(robot_box, environment[e])});
         }
       }
     }

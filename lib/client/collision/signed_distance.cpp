@@ -84,7 +84,7 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
     const Vector3d gap = g.point_b - g.point_a;
     const double distance2 = gap.squaredNorm();
     if (!g.intersecting && distance2 > 0.0) {
-      return separated_in_cell(a, g.point_a.data(), g.point_b.data(), gap.data(), distance2);
+      return separated_in_cell(a, g.point_a.data(), gap.data(), distance2);
     }
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
@@ -104,7 +104,7 @@ SignedDistance signed_distance_iterated(const Obb& a, const Obb& b,
   if (mutually_closest_points_from(a.half_extents, b.half_extents, rel, projection.scale2, p, y, q)) {
     const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
     const double distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
-    if (distance2 > kClearlySeparated2 * projection.scale2) return separated_in_cell(a, p, q, gap, distance2);
+    if (distance2 > kClearlySeparated2 * projection.scale2) return separated_in_cell(a, p, gap, distance2);
   }
   return signed_distance_by_axes(a, b, rel);
 }
@@ -112,12 +112,9 @@ SignedDistance signed_distance_iterated(const Obb& a, const Obb& b,
 }  // namespace
 
 SignedDistance signed_distance(const Obb& a, const Obb& b) {
-  BoxLanes<double> lane;
-  lane.set(0, b);
   ProjectionLanes<double> projection;
-  relative_poses(a, lane, &projection);
-  project_twice(a.half_extents, lane, &projection);
-  if (projection.certified[0]) return separated_lane(a, projection, 0);
+  project_twice(view_of(a), view_of(b), &projection);
+  if (projection.certified[0]) return separated_in_cell(a, projection.p, projection.gap, projection.gap2);
   return signed_distance_iterated(a, b, projection);
 }
 
