@@ -60,8 +60,7 @@ ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoi
   for (int k = 0; k < set.n_checkpoints; ++k) {
     for (int r = 0; r < set.n_rob; ++r) {
       const Obb& robot_box = robot_at_checkpoints[k][r];
-      EnvironmentLanes robot_lanes;  // the robot box in every lane
-      for (int l = 0; l < kLanes; ++l) robot_lanes.set(l, robot_box);
+      const EnvironmentLanes robot_lanes = EnvironmentLanes::broadcast(robot_box);
       for (std::size_t block = 0; block < blocks.size(); ++block) {
         ProjectionLanes<Double2> projection;
         project_twice(robot_lanes.view(), blocks[block].view(), &projection);

@@ -85,6 +85,14 @@ struct BoxLanes final {
     for (int i = 0; i < 9; ++i) set_lane(&rotation[i], l, box.rotation.data()[i]);
     for (int i = 0; i < 3; ++i) set_lane(&half[i], l, box.half_extents[i]);
   }
+  /// `box` in every lane.
+  static BoxLanes broadcast(const Obb& box) {
+    BoxLanes lanes;
+    for (int i = 0; i < 3; ++i) lanes.center[i] = T{} + box.center[i];
+    for (int i = 0; i < 9; ++i) lanes.rotation[i] = T{} + box.rotation.data()[i];
+    for (int i = 0; i < 3; ++i) lanes.half[i] = T{} + box.half_extents[i];
+    return lanes;
+  }
   [[nodiscard]] BoxView<T> view() const { return {center, rotation, half}; }
 };
 
