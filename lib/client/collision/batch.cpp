@@ -24,13 +24,14 @@ ConstraintSet empty_set(const std::vector<std::vector<Obb>>& robot_at_checkpoint
   return set;
 }
 
-// The dense batch runs the first projections of signed_distance on this many environment boxes at once;
-// the pairs they leave open go through signed_distance itself, so every entry equals signed_distance.
-constexpr int kLanes = 4;
+// The dense batch runs the first projections of signed_distance on kLanes environment boxes at once; the
+// pairs they leave open go through signed_distance itself, so every entry equals signed_distance.
+using EnvironmentLanes = BoxLanes<Double2>;
+constexpr int kLanes = EnvironmentLanes::kLanes;
 
 // The environment in blocks of kLanes (the last block padded with copies of the last box).
-std::vector<BoxLanes<kLanes>> environment_lanes(const std::vector<Obb>& environment) {
-  std::vector<BoxLanes<kLanes>> blocks((environment.size() + kLanes - 1) / kLanes);
+std::vector<EnvironmentLanes> environment_lanes(const std::vector<Obb>& environment) {
+  std::vector<EnvironmentLanes> blocks((environment.size() + kLanes - 1) / kLanes);
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     for (int l = 0; l < kLanes; ++l) {
       blocks[b].set(l, environment[std::min(b * kLanes + l, environment.size() - 1)]);
@@ -55,20 +56,22 @@ ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoi
                           const std::vector<Obb>& environment) {
   ConstraintSet set = empty_set(robot_at_checkpoints, environment);
   set.entries.reserve(set.n_constr());
-  const std::vector<BoxLanes<kLanes>> blocks = environment_lanes(environment);
+  const std::vector<EnvironmentLanes> blocks = environment_lanes(environment);
   for (int k = 0; k < set.n_checkpoints; ++k) {
     for (int r = 0; r < set.n_rob; ++r) {
       const Obb& robot_box = robot_at_checkpoints[k][r];
+      const EnvironmentLanes robot_lanes = EnvironmentLanes::broadcast(robot_box);
       for (std::size_t block = 0; block < blocks.size(); ++block) {
-        ProjectionLanes<kLanes> projection;
-        relative_poses(robot_box, blocks[block], &projection);
-        project_twice(robot_box.half_extents, blocks[block], &projection);
+        ProjectionLanes<Double2> projection;
+        project_twice(robot_lanes.view(), blocks[block].view(), &projection);
+        const SeparatedLanes<Double2> separated(robot_lanes.view(), projection.p, projection.gap,
+                                                projection.gap2);
         const int first = static_cast<int>(block) * kLanes;
         for (int l = 0; l < kLanes && first + l < set.n_env; ++l) {
           const int e = first + l;
-          set.entries.push_back({k, r, e,
-                                 projection.certified[l] ? separated_lane(robot_box, projection, l)
-                                                         : signed_distance(robot_box, environment[e])});
+          set.entries.push_back(
+              {k, r, e,
+               projection.certified[l] ? separated.lane(l) : signed_distance(robot_box, environment[e])});
         }
       }
     }

@@ -51,18 +51,18 @@ bool jump_on_a(const double* ha, const double* hb, const double* R, const double
 
 }  // namespace mutual_projections_detail
 
-/// Mutually closest points: from A's point closest to B's centre, project onto B, back onto A, and so on,
-/// jumping ahead where an edge faces an edge or a face (see jump_on_b, jump_on_a). When each point is the
-/// other's closest point (to 1e-13 of the scene size, `scale2` = |ha|^2 + |hb|^2 + |t|^2), they are a
-/// closest pair (mutually closest points of two convex sets are: the direction between them lies in both
-/// normal cones). Writes the pair (A's frame: p of A, q of B) and returns true when that happened within a
-/// few steps (~99 % of random separated pairs); overlapping boxes end on a common point.
+/// Mutually closest points: from A's point p and B's point y closest to it (B's coordinates), project onto A,
+/// back onto B, and so on, jumping ahead where an edge faces an edge or a face (see jump_on_b, jump_on_a).
+/// When each point is the other's closest point (to 1e-13 of the scene size, `scale2` = |ha|^2 + |hb|^2 +
+/// |t|^2), they are a closest pair (mutually closest points of two convex sets are: the direction between
+/// them lies in both normal cones). Updates p and y, writes B's point q (A's frame) and returns true when
+/// that happened within a few steps; overlapping boxes end on a common point.
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
 inline bool
-mutually_closest_points(const Eigen::Vector3d& ha_, const Eigen::Vector3d& hb_, const RelativePose& rel,
-                        double scale2, double* p, double* q) {
+mutually_closest_points_from(const Eigen::Vector3d& ha_, const Eigen::Vector3d& hb_, const RelativePose& rel,
+                             double scale2, double* p, double* y, double* q) {
   using namespace mutual_projections_detail;
   const double* ha = ha_.data();
   const double* hb = hb_.data();
@@ -70,12 +70,9 @@ mutually_closest_points(const Eigen::Vector3d& ha_, const Eigen::Vector3d& hb_, 
   const double* t = rel.t.data();
   const double tolerance2 = 1e-26 * scale2;
   constexpr int kSteps = 6;
-  // y: B's point (B's coordinates), q = t + R y. `y_fits`: y is B's point closest to p (false right after
-  // a jump); p is A's point closest to q unless it just jumped.
-  double y[3];
-  closest_in_a(ha, t, p);
-  closest_in_b(R, t, hb, p, y);
-  bool y_fits = true;
+  // `y_fits`: y is B's point closest to p (false right after a jump); p is A's point closest to q unless it
+  // just jumped.
+  bool y_fits = !jump_on_b(ha, hb, R, t, p, y);
   for (int step = 0;; ++step) {
     b_to_a(R, t, y, q);
     double p_next[3];
@@ -95,6 +92,16 @@ mutually_closest_points(const Eigen::Vector3d& ha_, const Eigen::Vector3d& hb_, 
     }
     y_fits = !jump_on_b(ha, hb, R, t, p, y);
   }
+}
+
+/// As above, starting from A's point closest to B's centre (~99 % of random separated pairs converge).
+inline bool mutually_closest_points(const Eigen::Vector3d& ha, const Eigen::Vector3d& hb,
+                                    const RelativePose& rel, double scale2, double* p, double* q) {
+  using namespace mutual_projections_detail;
+  double y[3];
+  closest_in_a(ha.data(), rel.t.data(), p);
+  closest_in_b(rel.R.data(), rel.t.data(), hb.data(), p, y);
+  return mutually_closest_points_from(ha, hb, rel, scale2, p, y, q);
 }
 
 }  // namespace cellmap::collision

@@ -84,21 +84,27 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
     const Vector3d gap = g.point_b - g.point_a;
     const double distance2 = gap.squaredNorm();
     if (!g.intersecting && distance2 > 0.0) {
-      return separated_in_cell(a, g.point_a.data(), g.point_b.data(), gap.data(), distance2);
+      return separated_in_cell(a, g.point_a.data(), gap.data(), distance2);
     }
   }
   // Touching (within rounding) or overlapping: the separating axes give the exact depth and its normal.
   return penetration_witnesses(a, b, rel, std::max(-axis.gap, 0.0), axis.axis);
 }
 
-// The full alternating projections (with jumps), then the separating axes and GJK.
-SignedDistance signed_distance_iterated(const Obb& a, const Obb& b, const RelativePose& rel) {
-  const double scale2 = scale2_of(a.half_extents, b.half_extents, rel);
-  double p[3], q[3];
-  if (mutually_closest_points(a.half_extents, b.half_extents, rel, scale2, p, q)) {
+// The alternating projections (with jumps) from where project_twice left them, then the separating axes and
+// GJK.
+SignedDistance signed_distance_iterated(const Obb& a, const Obb& b,
+                                        const ProjectionLanes<double>& projection) {
+  RelativePose rel;
+  std::copy(projection.R, projection.R + 9, rel.R.data());
+  std::copy(projection.t, projection.t + 3, rel.t.data());
+  double p[3] = {projection.p[0], projection.p[1], projection.p[2]};
+  double y[3] = {projection.y[0], projection.y[1], projection.y[2]};
+  double q[3];
+  if (mutually_closest_points_from(a.half_extents, b.half_extents, rel, projection.scale2, p, y, q)) {
     const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
     const double distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
-    if (distance2 > kClearlySeparated2 * scale2) return separated_in_cell(a, p, q, gap, distance2);
+    if (distance2 > kClearlySeparated2 * projection.scale2) return separated_in_cell(a, p, gap, distance2);
   }
   return signed_distance_by_axes(a, b, rel);
 }
@@ -106,16 +112,10 @@ SignedDistance signed_distance_iterated(const Obb& a, const Obb& b, const Relati
 }  // namespace
 
 SignedDistance signed_distance(const Obb& a, const Obb& b) {
-  BoxLanes<1> lane;
-  lane.set(0, b);
-  ProjectionLanes<1> projection;
-  relative_poses(a, lane, &projection);
-  project_twice(a.half_extents, lane, &projection);
-  if (projection.certified[0]) return separated_lane(a, projection, 0);
-  RelativePose rel;
-  for (int k = 0; k < 9; ++k) rel.R.data()[k] = projection.R[k][0];
-  for (int k = 0; k < 3; ++k) rel.t[k] = projection.t[k][0];
-  return signed_distance_iterated(a, b, rel);
+  ProjectionLanes<double> projection;
+  project_twice(view_of(a), view_of(b), &projection);
+  if (projection.certified[0]) return separated_in_cell(a, projection.p, projection.gap, projection.gap2);
+  return signed_distance_iterated(a, b, projection);
 }
 
 }  // namespace cellmap::collision
