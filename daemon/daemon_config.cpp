@@ -40,14 +40,17 @@ bool is_pose(const YAML::Node& map) {
   return map["position"] || map["translation"] || map["rotation"];
 }
 
-// Lays `overlay` over `base`: maps merge key by key, anything else (and a pose) replaces.
-YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay) {
+// Lays `overlay` over `base`: maps merge key by key, anything else (and a pose) replaces. Maps of the overlay
+// are checked as YamlMap checks them (plain keys), since it merges them before any YamlMap sees them.
+YAML::Node overlay_on(const YAML::Node& base, const YAML::Node& overlay, const std::string& path,
+                      const std::string& source) {
   if (!overlay || overlay.IsNull()) return YAML::Clone(base);
   if (!base.IsDefined() || !base.IsMap() || !overlay.IsMap() || is_pose(overlay)) return YAML::Clone(overlay);
+  const YamlMap checked(overlay, path, source);
   YAML::Node merged = YAML::Clone(base);
   for (const auto& entry : overlay) {
-    const std::string key = entry.first.as<std::string>();
-    merged[key] = overlay_on(base[key], entry.second);
+    const std::string key = entry.first.Scalar();
+    merged[key] = overlay_on(base[key], entry.second, checked.key_path(key), source);
   }
   return merged;
 }
@@ -134,7 +137,7 @@ std::vector<SourceConfig> read_sources(YamlMap& root, const YamlMap& user, const
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string path = "sources[" + std::to_string(i) + "]";
     if (!list[i].IsMap()) root.fail(path, "must be a map (kind, sensor, mount, ...)");
-    const YAML::Node entry = overlay_on(defaults.node()["source"], list[i]);
+    const YAML::Node entry = overlay_on(defaults.node()["source"], list[i], path, root.source());
     sources.push_back(read_source(YamlMap(entry, path, root.source()), sweep_period, base_dir));
   }
   check_sources(sources, root, "sources");
@@ -172,7 +175,7 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
                                  const std::filesystem::path& base_dir) {
   const YamlMap defaults = YamlMap::parse(default_config_yaml(), "built-in config/cellmapd.yaml");
   const YamlMap user = YamlMap::parse(yaml, source);
-  YamlMap root(overlay_on(defaults.node(), user.node()), "", source);
+  YamlMap root(overlay_on(defaults.node(), user.node(), "", source), "", source);
   DaemonConfig c;
   c.cell = root.get<std::string>("cell", c.cell);
   if (c.cell.empty()) root.fail("cell", "must not be empty");

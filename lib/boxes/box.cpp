@@ -5,6 +5,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap {
 namespace {
@@ -87,8 +88,8 @@ BoxSet box_set_from_json(const std::string& text, const std::string& source) {
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw Error(source + ": not valid JSON (" + e.what() + ")");
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers beyond a double
+    throw Error(source + ": not valid JSON (" + single_line(e.what()) + ")");
   }
   BoxSet set;
   set.version = reader.count(reader.field(doc, "version", "document"), "version");

@@ -22,6 +22,13 @@ std::vector<std::string> split(const std::string& line, char separator) {
   return items;
 }
 
+std::string single_line(std::string text) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return text;
+}
+
 double parse_finite(const std::string& text, const std::string& where) {
   std::size_t used = 0;
   double value = 0;

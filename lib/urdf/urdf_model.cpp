@@ -112,9 +112,14 @@ Robot UrdfModel::chain(const std::string& tool_link, const Eigen::Isometry3d& X_
   urdf::LinkConstSharedPtr link = model_->getLink(tool_link);
   if (!link) throw Error(source_ + ": tool link '" + tool_link + "' is not in the URDF");
   try {
-    // Walk from the tool up to the root, then list the joints root first.
+    // Walk from the tool up to the root, then list the joints root first. urdfdom accepts joints that close a
+    // loop away from the root, so a walk longer than the model has links is a loop.
     std::vector<Robot::ChainJoint> joints;
-    for (; link->getParent(); link = link->getParent()) joints.push_back(chain_joint(*link));
+    for (; link->getParent(); link = link->getParent()) {
+      if (joints.size() == model_->links_.size())
+        throw Error("the links from '" + tool_link + "' up to the root form a loop");
+      joints.push_back(chain_joint(*link));
+    }
     return Robot::serial(link->name, {joints.rbegin(), joints.rend()}, X_C_root);
   } catch (const Error& e) {
     throw Error(source_ + ": " + e.what());

@@ -89,5 +89,21 @@ TEST(YamlMapTest, PoseErrorsNameTheKey) {
   EXPECT_EQ(error_of([&] { (void)root.pose("typo"); }), "cfg.yaml: typo.positon: unknown key");
 }
 
+// Found by fuzzing (fuzz_daemon_config): a key that is a map or a list made the readers throw yaml-cpp's
+// conversion error instead of ours.
+TEST(YamlMapTest, KeysMustBePlainNames) {
+  EXPECT_EQ(error_of([] { (void)YamlMap::parse("a: 1\n? [x, y]\n: 2\n", "cfg.yaml"); }),
+            "cfg.yaml: document: the key at line 2 is not a plain name");
+  YamlMap root = YamlMap::parse("sub:\n  ? {k: 1}\n  : 2\n", "cfg.yaml");
+  EXPECT_EQ(error_of([&] { (void)root.child("sub"); }),
+            "cfg.yaml: sub: the key at line 2 is not a plain name");
+}
+
+// A key is echoed in messages; whatever it holds, the message stays one line.
+TEST(YamlMapTest, MessagesStayOneLine) {
+  YamlMap root = YamlMap::parse("\"a\\nb\": 1\n", "cfg.yaml");
+  EXPECT_EQ(error_of([&] { root.expect_all_read(); }), "cfg.yaml: a?b: unknown key");
+}
+
 }  // namespace
 }  // namespace cellmap

@@ -52,6 +52,19 @@ TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {
       << error_of("segment: {neighbours: {kk: 3}}\n");
 }
 
+// Found by fuzzing: a complex key (`? gap: 0.04`) in a section merged over the defaults made the overlay
+// throw yaml-cpp's conversion error, which would have ended cellmapd with an uncaught exception.
+TEST(DaemonConfigTest, FuzzFindingsAreRefusedWithOneLine) {
+  const std::string file = CELLMAP_SOURCE_DIR "/fuzz/regressions/daemon_config/complex_key.yaml";
+  try {
+    (void)DaemonConfig::load(file);
+    FAIL() << file << " was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              file + ": segment.region_growing: the key at line 19 is not a plain name");
+  }
+}
+
 TEST(DaemonConfigTest, SimIsTheDefaultAndCameraSettingsAreStillChecked) {
   const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
   EXPECT_FALSE(c.sources[0].is_camera());

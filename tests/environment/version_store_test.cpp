@@ -145,6 +145,23 @@ TEST(VersionStoreTest, EveryCorruptSnapshotMeansEmptyButVersionsGoOn) {
   EXPECT_EQ(store.next_version(), 3u);
 }
 
+// Found by fuzzing (fuzz_version_store): a number beyond a double made the JSON parser throw an exception the
+// store did not catch, so the daemon would have died at start instead of skipping the snapshot.
+TEST(VersionStoreTest, FuzzFindingsAreSkippedAsCorrupt) {
+  test::TempDir dir;
+  fs::copy_file(test::fuzz_regression("version_store", "number_overflow.json"),
+                dir.path() / "environment-00000000000000000007.json");
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment.version(), 0u);
+  ASSERT_EQ(store.recovered().problems.size(), 1u);
+  const std::string& problem = store.recovered().problems[0];
+  EXPECT_NE(problem.find("environment-00000000000000000007.json: not valid JSON ("), std::string::npos)
+      << problem;
+  EXPECT_NE(problem.find("number overflow"), std::string::npos) << problem;
+  EXPECT_EQ(problem.find('\n'), std::string::npos) << problem;
+  EXPECT_EQ(store.next_version(), 8u);
+}
+
 TEST(VersionStoreTest, ForeignAndOutOfRangeNamesAreLeftAlone) {
   test::TempDir dir;
   std::ofstream(dir.path() / "environment-99999999999999999999.json") << "{}";

@@ -7,6 +7,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "scenes.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap {
 namespace {
@@ -240,6 +241,16 @@ TEST(SegmentConfig, WorkspaceCropsAndCountsTheDrop) {
       EXPECT_EQ(result.box_of_point[i], -1);
     }
   }
+}
+
+// Found by fuzzing (fuzz_segment_config): yaml-cpp's message for a bad escape quotes the character, a newline
+// here, and the refusal took two lines.
+TEST(SegmentConfig, FuzzFindingsAreRefusedWithOneLine) {
+  const std::string file = test::fuzz_regression("segment_config", "unknown_escape.yaml");
+  EXPECT_EQ(test::one_line_error_of([&] {
+              (void)load_segment_config(file);
+            }).rfind(file + ": YAML syntax error at line 21, column 1: unknown escape character", 0),
+            0u);
 }
 
 }  // namespace

@@ -60,5 +60,14 @@ TEST(DepthIoTest, IntrinsicsYamlIsStrict) {
   EXPECT_THROW((void)read_intrinsics_yaml(dir / "nofx.yaml"), Error);
 }
 
+// Found by fuzzing (fuzz_intrinsics): the YAML syntax error quoted a newline and took two lines.
+TEST(DepthIoTest, FuzzFindingsAreRefusedWithOneLine) {
+  const std::string file = test::fuzz_regression("intrinsics", "unknown_escape.yaml");
+  EXPECT_EQ(test::one_line_error_of([&] {
+              (void)read_intrinsics_yaml(file);
+            }).rfind(file + ": YAML syntax error at line 8, column 1: unknown escape character", 0),
+            0u);
+}
+
 }  // namespace
 }  // namespace cellmap

@@ -144,5 +144,32 @@ TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {
   EXPECT_NE(no_intrinsics.status().reason.find("no intrinsics"), std::string::npos);
 }
 
+// A PCD frame whose header claims what the file cannot hold (here a COUNT past 32 bits, which once made the
+// reader spin) stops the replay at that frame with the loader's one-line reason; an all-NaN frame is a frame.
+TEST(ReplaySourceTest, PcdFramesGoThroughTheHardenedLoader) {
+  Recording recording;
+  ReplayConfig config;
+  config.directory = recording.dir.path().string();
+  config.playback = ReplayConfig::Playback::kFastest;
+  Cloud nothing;
+  nothing.push_back(pcl::PointXYZ(std::nanf(""), 0.f, 0.f));
+  pcl::io::savePCDFileBinary(recording.dir / "f1.pcd", nothing);
+  write_file_atomically(recording.dir / "f2.pcd",
+                        "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 4294967297\nWIDTH 1\n"
+                        "HEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  recording.entries[1].file = "f1.pcd";
+  write_replay_poses(recording.dir / "poses.csv", recording.entries);
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected);
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(100)).has_value());
+  const std::optional<Frame> empty = source.next(std::chrono::milliseconds(100));
+  ASSERT_TRUE(empty.has_value());
+  EXPECT_TRUE(empty->points_S.empty());
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(100)).has_value());
+  EXPECT_EQ(source.status().state, SourceState::kError);
+  EXPECT_EQ(source.status().reason,
+            recording.dir / "f2.pcd" + ": COUNT: '4294967297' is not an integer in [0, 65536]");
+}
+
 }  // namespace
 }  // namespace cellmap

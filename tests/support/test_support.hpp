@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -46,6 +48,20 @@ inline std::string error_of(const std::function<void()>& f) {
     return e.what();
   }
   return "";
+}
+
+/// An input with which a fuzzer (fuzz/) found a bug, kept as a regression input:
+/// fuzz/regressions/<target>/<name> of the source tree.
+inline std::string fuzz_regression(const std::string& target, const std::string& name) {
+  return std::string(CELLMAP_SOURCE_DIR) + "/fuzz/regressions/" + target + "/" + name;
+}
+
+/// The message of the cellmap::Error that `f` throws, checked to be one line (gtest failure otherwise); "" if
+/// it throws none.
+inline std::string one_line_error_of(const std::function<void()>& f) {
+  const std::string message = error_of(f);
+  if (message.find('\n') != std::string::npos) ADD_FAILURE() << "not one line: " << message;
+  return message;
 }
 
 }  // namespace cellmap::test

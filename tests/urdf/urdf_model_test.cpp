@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cellmap/common/error.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap {
 namespace {
@@ -69,6 +70,17 @@ TEST(UrdfModelTest, ErrorsNameTheSource) {
     EXPECT_STREQ(e.what(), "bad.urdf: not a valid URDF robot description");
   }
   EXPECT_THROW((void)UrdfModel::load("/nonexistent/arm.urdf").chain("flange"), Error);
+}
+
+// Found while fuzzing (fuzz_urdf): urdfdom accepts joints that close a loop away from the root, and the walk
+// from the tool link up to the root never ended; a link that is its own parent is refused by urdfdom.
+TEST(UrdfModelTest, LoopsAreRefused) {
+  const std::string loop = test::fuzz_regression("urdf", "loop_away_from_root.urdf");
+  EXPECT_EQ(test::one_line_error_of([&] { (void)UrdfModel::load(loop).chain("tool0"); }),
+            loop + ": the links from 'tool0' up to the root form a loop");
+  const std::string self = test::fuzz_regression("urdf", "self_parented_link.urdf");
+  EXPECT_EQ(test::one_line_error_of([&] { (void)UrdfModel::load(self).chain("tool0"); }),
+            self + ": not a valid URDF robot description");
 }
 
 }  // namespace

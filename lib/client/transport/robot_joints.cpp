@@ -11,6 +11,32 @@
 
 namespace cellmap::transport {
 
+RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& joint_names) {
+  const std::string where =
+      std::string(kRobotJointsTopic) + " '" + joints.cell + "' at " + std::to_string(joints.stamp_ns);
+  if (joints.positions.size() != joint_names.size()) {
+    throw Error(where + ": " + std::to_string(joints.positions.size()) + " positions, the robot has " +
+                std::to_string(joint_names.size()) + " joints");
+  }
+  if (joints.names.empty()) {
+    joints.names = joint_names;
+    return joints;
+  }
+  std::vector<double> ordered(joint_names.size());
+  std::vector<bool> seen(joint_names.size(), false);
+  for (std::size_t i = 0; i < joints.names.size(); ++i) {
+    const auto it = std::find(joint_names.begin(), joint_names.end(), joints.names[i]);
+    if (it == joint_names.end()) throw Error(where + ": unknown joint '" + joints.names[i] + "'");
+    const auto k = static_cast<std::size_t>(it - joint_names.begin());
+    if (seen[k]) throw Error(where + ": joint '" + joints.names[i] + "' given twice");
+    seen[k] = true;
+    ordered[k] = joints.positions[i];
+  }
+  joints.names = joint_names;
+  joints.positions = std::move(ordered);
+  return joints;
+}
+
 RobotJointsWriter::RobotJointsWriter(const dds::Participant& participant)
     : topic_(participant, &cellmap_msg_RobotJoints_desc, kRobotJointsTopic),
       writer_(participant, topic_, robot_joints_qos()) {}
@@ -55,32 +81,6 @@ RobotJointsReader::~RobotJointsReader() {
   }
 }
 
-RobotJoints RobotJointsReader::in_robot_order(RobotJoints joints) const {
-  const std::string where =
-      std::string(kRobotJointsTopic) + " '" + joints.cell + "' at " + std::to_string(joints.stamp_ns);
-  if (joints.positions.size() != joint_names_.size()) {
-    throw Error(where + ": " + std::to_string(joints.positions.size()) + " positions, the robot has " +
-                std::to_string(joint_names_.size()) + " joints");
-  }
-  if (joints.names.empty()) {
-    joints.names = joint_names_;
-    return joints;
-  }
-  std::vector<double> ordered(joint_names_.size());
-  std::vector<bool> seen(joint_names_.size(), false);
-  for (std::size_t i = 0; i < joints.names.size(); ++i) {
-    const auto it = std::find(joint_names_.begin(), joint_names_.end(), joints.names[i]);
-    if (it == joint_names_.end()) throw Error(where + ": unknown joint '" + joints.names[i] + "'");
-    const auto k = static_cast<std::size_t>(it - joint_names_.begin());
-    if (seen[k]) throw Error(where + ": joint '" + joints.names[i] + "' given twice");
-    seen[k] = true;
-    ordered[k] = joints.positions[i];
-  }
-  joints.names = joint_names_;
-  joints.positions = std::move(ordered);
-  return joints;
-}
-
 std::vector<RobotJoints> RobotJointsReader::take(std::chrono::nanoseconds timeout) {
   if (timeout.count() > 0) waitset_.wait(timeout);
   std::vector<RobotJoints> samples;
@@ -91,7 +91,7 @@ std::vector<RobotJoints> RobotJointsReader::take(std::chrono::nanoseconds timeou
     try {
       RobotJoints joints = wire::from_wire(msg);
       check_limits(joints, limits_, now_ns);
-      samples.push_back(in_robot_order(std::move(joints)));
+      samples.push_back(in_robot_order(std::move(joints), joint_names_));
     } catch (const Error& e) {
       ++rejected_;
       if (on_refused_) on_refused_(e.what());

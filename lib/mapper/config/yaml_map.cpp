@@ -4,16 +4,23 @@
 #include <sstream>
 
 #include "cellmap/common/atomic_file.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap {
 
 YamlMap::YamlMap(YAML::Node node, std::string path, std::string source)
     : node_(std::move(node)), path_(std::move(path)), source_(std::move(source)) {
+  const std::string where = (source_.empty() ? "" : source_ + ": ") + (path_.empty() ? "document" : path_);
   if (!node_ || node_.IsNull()) {
     node_ = YAML::Node(YAML::NodeType::Map);
   } else if (!node_.IsMap()) {
-    const std::string where = source_.empty() ? "" : source_ + ": ";
-    throw Error(where + (path_.empty() ? std::string("document") : path_) + ": must be a mapping of keys");
+    throw Error(where + ": must be a mapping of keys");
+  }
+  for (const auto& entry : node_) {
+    if (!entry.first.IsScalar()) {
+      throw Error(where + ": the key at line " + std::to_string(entry.first.Mark().line + 1) +
+                  " is not a plain name");
+    }
   }
 }
 
@@ -23,7 +30,7 @@ YamlMap YamlMap::parse(const std::string& text, const std::string& source) {
   } catch (const YAML::ParserException& e) {
     std::ostringstream msg;
     msg << source << ": YAML syntax error at line " << e.mark.line + 1 << ", column " << e.mark.column + 1
-        << ": " << e.msg;
+        << ": " << single_line(e.msg);
     throw Error(msg.str());
   }
 }
@@ -114,7 +121,8 @@ void YamlMap::expect_all_read() const {
 
 void YamlMap::fail(const std::string& key, const std::string& reason) const {
   const std::string where = source_.empty() ? "" : source_ + ": ";
-  throw Error(where + key_path(key) + ": " + reason);
+  // Keys come from the file: keep the message on one line whatever they hold.
+  throw Error(where + single_line(key_path(key)) + ": " + reason);
 }
 
 std::string YamlMap::key_path(const std::string& key) const {

@@ -240,7 +240,9 @@ class Joiner {
     std::size_t joins = 0;
     while (!pairs_.empty()) {
       const auto cheapest = std::min_element(pairs_.begin(), pairs_.end());
-      const auto [cost, a, b] = *cheapest;
+      // Plain variables, not a structured binding: C++17 lambdas cannot capture bindings (clang refuses).
+      const std::size_t a = std::get<1>(*cheapest);
+      const std::size_t b = std::get<2>(*cheapest);
       join(a, b);
       ++joins;
       pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),

@@ -1,7 +1,5 @@
 #include "cellmap/sensor/replay_source.hpp"
 
-#include <pcl/io/pcd_io.h>
-
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -11,6 +9,7 @@
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/text.hpp"
+#include "cellmap/io/cloud_file.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 
 namespace cellmap {
@@ -157,16 +156,9 @@ Frame ReplaySource::load(std::size_t index) const {
   frame.sensor = config_.name;
   frame.stamp = entry.stamp;
   if (lower_extension(path) == ".pcd") {
-    pcl::PointCloud<pcl::PointXYZ> cloud;
-    pcl::PCDReader reader;
-    if (reader.read(path, cloud) < 0) throw Error(path + ": cannot read PCD");
-    frame.points_S.reserve(cloud.size());
-    for (const pcl::PointXYZ& p : cloud) {
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) frame.points_S.push_back(p);
-    }
-    frame.points_S.width = static_cast<std::uint32_t>(frame.points_S.size());
-    frame.points_S.height = 1;
-    frame.points_S.is_dense = true;
+    CloudFileOptions options;
+    options.require_finite_points = false;  // a frame that saw nothing is still a frame
+    frame.points_S = std::move(load_cloud_file(path, options).points);
     return frame;
   }
   RawDepth raw = read_depth_image(path);

@@ -1,5 +1,6 @@
 #pragma once
-// Parsing of the small text formats cellmap reads (CSV pose files, comma lists on the command line).
+// Parsing of the small text formats cellmap reads (CSV pose files, comma lists on the command line), and the
+// quoting of input in messages.
 
 #include <string>
 #include <vector>
@@ -11,6 +12,10 @@ namespace cellmap {
 
 /// Splits at `separator`; every item is trimmed; a trailing separator gives a last empty item.
 [[nodiscard]] std::vector<std::string> split(const std::string& line, char separator);
+
+/// `text` with every control character (newline included) replaced by '?': for messages that quote input,
+/// which must stay one line.
+[[nodiscard]] std::string single_line(std::string text);
 
 /// The whole of `text` as a finite number. @throws Error "<where>: '<text>' is not a finite number".
 [[nodiscard]] double parse_finite(const std::string& text, const std::string& where);

@@ -32,6 +32,11 @@ class RobotJointsWriter final {
   dds::Writer writer_;
 };
 
+/// `joints` with names = `joint_names` and positions in that order (what RobotJointsReader::take returns).
+/// @throws Error "cellmap/robot_joints '<cell>' at <stamp>: <reason>" if the names are not exactly the
+/// robot's joints (unknown or repeated) or the positions' count is not the robot's.
+[[nodiscard]] RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& joint_names);
+
 /// Receives joint states for one cell and one robot (cellmapd's side). `participant` must outlive it. Not
 /// thread-safe.
 class RobotJointsReader final {
@@ -56,8 +61,6 @@ class RobotJointsReader final {
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
 
  private:
-  [[nodiscard]] RobotJoints in_robot_order(RobotJoints joints) const;
-
   std::string cell_;
   std::vector<std::string> joint_names_;
   InputLimits limits_;

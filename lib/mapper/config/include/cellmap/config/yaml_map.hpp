@@ -23,7 +23,7 @@ class YamlMap {
   /// @param node  a YAML mapping, or a null node (treated as an empty map: every key takes its default).
   /// @param path  dotted key path of this map inside its document ("" for the root), used in messages.
   /// @param source  file name or other origin, used as the message prefix ("" for none).
-  /// @throws Error if `node` is neither null nor a mapping.
+  /// @throws Error if `node` is neither null nor a mapping, or has a key that is not a scalar.
   YamlMap(YAML::Node node, std::string path, std::string source = "");
 
   /// Parses a whole YAML document. @throws Error with the parser's line and column on a syntax error.

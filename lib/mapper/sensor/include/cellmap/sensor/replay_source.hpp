@@ -11,7 +11,8 @@
 //             - a depth image: single-channel 16-bit grayscale PNG (.png) or TIFF (.tif, .tiff), raw sensor
 //               units (0 = no return), converted with the intrinsics below;
 //             - a point cloud (.pcd, any PCL point type with x y z) already in the sensor frame (metres,
-//               x right, y down, z forward); NaN points are skipped.
+//               x right, y down, z forward), read by load_cloud_file (cellmap/io/cloud_file.hpp), which
+//               refuses a malformed or absurd file before allocating for it; NaN points are skipped.
 //     stamp   seconds, strictly increasing, any epoch (frames keep it as Frame::stamp)
 //     x,y,z   position of the END-EFFECTOR (tool) in the cell frame, metres: X_CE
 //     qw..qz  its orientation, unit quaternion [w, x, y, z]
