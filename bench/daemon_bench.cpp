@@ -84,27 +84,12 @@ int run_subscriber(std::uint32_t domain) {
 // The subscriber in a process of its own; its arrivals are collected on a thread.
 class SubscriberProcess {
  public:
-  explicit SubscriberProcess(int domain) {
-    int fds[2];
-    if (::pipe(fds) != 0) throw std::runtime_error("pipe failed");
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], STDOUT_FILENO);
-      ::close(fds[0]);
-      ::close(fds[1]);
-      const std::string domain_text = std::to_string(domain);
-      ::execl("/proc/self/exe", "cellmap-bench-daemon", "--subscriber", domain_text.c_str(), nullptr);
-      std::_Exit(127);
-    }
-    ::close(fds[1]);
-    in_ = fds[0];
-    reader_ = std::thread([this] { collect(); });
-  }
+  explicit SubscriberProcess(int domain)
+      : child_({"cellmap-bench-daemon", "--subscriber", std::to_string(domain)}),
+        reader_([this] { collect(); }) {}
   ~SubscriberProcess() {
-    ::kill(pid_, SIGKILL);
-    ::waitpid(pid_, nullptr, 0);
+    child_.stop();  // collect() sees the pipe close
     reader_.join();
-    ::close(in_);
   }
   // The first arrival of each version.
   [[nodiscard]] std::map<std::uint64_t, std::int64_t> arrivals() const {
@@ -115,16 +100,15 @@ class SubscriberProcess {
  private:
   void collect() {
     Arrival arrival{};
-    while (::read(in_, &arrival, sizeof arrival) == sizeof arrival) {
+    while (::read(child_.in_fd(), &arrival, sizeof arrival) == sizeof arrival) {
       std::lock_guard<std::mutex> lock(mutex_);
       arrivals_.emplace(arrival.version, arrival.received_ns);
     }
   }
-  pid_t pid_ = -1;
-  int in_ = -1;
-  std::thread reader_;
   mutable std::mutex mutex_;
   std::map<std::uint64_t, std::int64_t> arrivals_;
+  bench::ReportingChild child_;
+  std::thread reader_;  // after child_ and arrivals_: started last, by the constructor
 };
 
 // --- the recordings

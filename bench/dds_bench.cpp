@@ -156,41 +156,21 @@ int run_snapshot_subscriber(std::uint32_t domain) {
 class SubscriberProcess {
  public:
   /// With a security directory, the subscriber joins as its planner.
-  SubscriberProcess(const char* mode, std::uint32_t domain, const std::string& security_directory = "") {
-    int fds[2];
-    if (::pipe(fds) != 0) std::abort();
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], STDOUT_FILENO);
-      ::close(fds[0]);
-      ::close(fds[1]);
-      const std::string domain_text = std::to_string(domain);
-      ::execl("/proc/self/exe", "cellmap-bench-dds", "--subscriber", mode, domain_text.c_str(),
-              security_directory.c_str(), nullptr);
-      std::_Exit(127);
-    }
-    ::close(fds[1]);
-    in_ = fds[0];
-  }
-  ~SubscriberProcess() {
-    ::kill(pid_, SIGKILL);
-    ::waitpid(pid_, nullptr, 0);
-    ::close(in_);
-  }
+  SubscriberProcess(const char* mode, std::uint32_t domain, const std::string& security_directory = "")
+      : child_({"cellmap-bench-dds", "--subscriber", mode, std::to_string(domain), security_directory}) {}
   /// The next arrival at or past `version`, or nullopt after 10 s.
   std::optional<Arrival> wait_for(std::uint64_t version) {
     for (;;) {
-      pollfd p{in_, POLLIN, 0};
+      pollfd p{child_.in_fd(), POLLIN, 0};
       if (::poll(&p, 1, 10'000) <= 0) return std::nullopt;
       Arrival arrival;
-      if (::read(in_, &arrival, sizeof arrival) != sizeof arrival) return std::nullopt;
+      if (::read(child_.in_fd(), &arrival, sizeof arrival) != sizeof arrival) return std::nullopt;
       if (arrival.version >= version) return arrival;
     }
   }
 
  private:
-  pid_t pid_ = -1;
-  int in_ = -1;
+  bench::ReportingChild child_;
 };
 
 // p50 and p99 one-way latency (us) of each benchmark, kept for the ratio lines printed after the run:
