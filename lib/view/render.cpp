@@ -56,16 +56,129 @@ std::array<Eigen::Vector3d, 8> corners(const Box& box) {
   return out;
 }
 
-// The scene: every box corner and the floor (z = 0) under them.
-Bounds scene_bounds(const std::vector<Box>& boxes) {
-  Bounds bounds;
-  for (const Box& box : boxes) {
-    for (const Eigen::Vector3d& c : corners(box)) {
-      bounds.add(c);
-      bounds.add({c.x(), c.y(), 0.0});
-    }
+// The six faces of a box: corner indices (counter-clockwise seen from outside) and the local normal.
+constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                              {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+const Eigen::Vector3d kNormals[6] = {-Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX(),
+                                     -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY(),
+                                     -Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};
+
+// A flat piece of a robot's or an obstacle's surface in the cell frame.
+struct Facet {
+  std::vector<Eigen::Vector3d> corners_C;
+  Eigen::Vector3d outward =
+      Eigen::Vector3d::Zero();  // out of a closed solid; zero: a mesh triangle, two-sided
+  std::array<double, 3> rgb{};
+};
+
+constexpr int kRoundSegments = 24;  // around a cylinder or a sphere
+constexpr int kSphereRings = 12;    // pole to pole
+
+// The unit normal of a planar polygon (Newell's method), pointing away from `centre` if `closed`.
+Eigen::Vector3d normal_of(const std::vector<Eigen::Vector3d>& corners, const Eigen::Vector3d& centre,
+                          bool closed) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    n += corners[i].cross(corners[(i + 1) % corners.size()]);
+    mid += corners[i] / static_cast<double>(corners.size());
   }
-  if (boxes.empty()) {
+  if (n.norm() == 0) return n;
+  n.normalize();
+  return closed && n.dot(mid - centre) < 0 ? Eigen::Vector3d(-n) : n;
+}
+
+// The surface of a shape in its frame G as polygons; `closed` is false for meshes (their winding varies).
+std::vector<std::vector<Eigen::Vector3d>> surface_in_G(const LinkGeometry& geometry, bool& closed) {
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  closed = true;
+  const auto ring = [](double radius, double z, int i) {
+    const double a = 2 * M_PI * i / kRoundSegments;
+    return Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), z);
+  };
+  if (const auto* box = std::get_if<BoxShape>(&geometry)) {
+    std::array<Eigen::Vector3d, 8> c;
+    for (int i = 0; i < 8; ++i)
+      c[i] = Eigen::Vector3d((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1)
+                 .cwiseProduct(box->half_extents);
+    for (const auto& face : kFaces) out.push_back({c[face[0]], c[face[1]], c[face[2]], c[face[3]]});
+  } else if (const auto* cylinder = std::get_if<CylinderShape>(&geometry)) {
+    std::vector<Eigen::Vector3d> bottom, top;
+    for (int i = 0; i < kRoundSegments; ++i) {
+      const double r = cylinder->radius, h = cylinder->half_length;
+      out.push_back({ring(r, -h, i), ring(r, -h, i + 1), ring(r, h, i + 1), ring(r, h, i)});
+      bottom.push_back(ring(r, -h, i));
+      top.push_back(ring(r, h, i));
+    }
+    out.push_back(bottom);
+    out.push_back(top);
+  } else if (const auto* sphere = std::get_if<SphereShape>(&geometry)) {
+    for (int k = 0; k < kSphereRings; ++k) {
+      const double a0 = M_PI * k / kSphereRings - M_PI / 2, a1 = M_PI * (k + 1) / kSphereRings - M_PI / 2;
+      const double r0 = sphere->radius * std::cos(a0), r1 = sphere->radius * std::cos(a1);
+      const double z0 = sphere->radius * std::sin(a0), z1 = sphere->radius * std::sin(a1);
+      for (int i = 0; i < kRoundSegments; ++i) {
+        if (k == 0)
+          out.push_back({ring(r0, z0, i), ring(r1, z1, i + 1), ring(r1, z1, i)});
+        else if (k == kSphereRings - 1)
+          out.push_back({ring(r0, z0, i), ring(r0, z0, i + 1), ring(r1, z1, i)});
+        else
+          out.push_back({ring(r0, z0, i), ring(r0, z0, i + 1), ring(r1, z1, i + 1), ring(r1, z1, i)});
+      }
+    }
+  } else {
+    const TriangleMesh& mesh = *std::get<MeshShape>(geometry).mesh;
+    mesh.validate("render: robot mesh");
+    closed = false;
+    for (const Eigen::Vector3i& t : mesh.triangles)
+      out.push_back({mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]});
+  }
+  return out;
+}
+
+std::vector<Facet> facets(const Solid& solid, const std::array<double, 3>& rgb) {
+  bool closed = true;
+  std::vector<Facet> out;
+  for (std::vector<Eigen::Vector3d>& polygon : surface_in_G(solid.geometry, closed)) {
+    Facet facet;
+    for (Eigen::Vector3d& p : polygon) p = solid.X_CG * p;
+    facet.outward = normal_of(polygon, solid.X_CG.translation(), closed);
+    if (!closed) facet.outward.setZero();
+    facet.corners_C = std::move(polygon);
+    facet.rgb = rgb;
+    out.push_back(std::move(facet));
+  }
+  return out;
+}
+
+// The boxes and, as facets, the overlays: everything a picture's panels fit and draw.
+struct Contents {
+  const std::vector<Box>& boxes;
+  std::vector<Facet> facets;
+  bool translucent_boxes = false;
+};
+
+Contents contents_of(const std::vector<Box>& boxes, const Overlays& overlays) {
+  Contents contents{boxes, {}, !overlays.obstacles.empty()};
+  for (const Solid& solid : overlays.obstacles)
+    for (Facet& f : facets(solid, obstacle_colour())) contents.facets.push_back(std::move(f));
+  for (const Solid& solid : overlays.robot)
+    for (Facet& f : facets(solid, robot_colour(solid.carried))) contents.facets.push_back(std::move(f));
+  return contents;
+}
+
+// Every box corner, every facet corner and the floor (z = 0) under them.
+Bounds scene_bounds(const Contents& contents) {
+  Bounds bounds;
+  const auto add = [&](const Eigen::Vector3d& c) {
+    bounds.add(c);
+    bounds.add({c.x(), c.y(), 0.0});
+  };
+  for (const Box& box : contents.boxes)
+    for (const Eigen::Vector3d& c : corners(box)) add(c);
+  for (const Facet& facet : contents.facets)
+    for (const Eigen::Vector3d& c : facet.corners_C) add(c);
+  if (contents.boxes.empty() && contents.facets.empty()) {
     bounds.add(Eigen::Vector3d::Zero());
     bounds.add(Eigen::Vector3d::Ones());
   }
@@ -130,13 +243,6 @@ Fit fit(const Camera& cam, const Bounds& bounds, const Panel& panel) {
   return f;
 }
 
-// The six faces of a box: corner indices (counter-clockwise seen from outside) and the local normal.
-constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
-                              {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
-const Eigen::Vector3d kNormals[6] = {-Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX(),
-                                     -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY(),
-                                     -Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};
-
 using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
 using ContextPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
 
@@ -145,15 +251,15 @@ struct Projection {
   Fit fit;
 };
 
-Projection projection(const std::vector<Box>& boxes, View view, const Panel& panel) {
-  const Bounds bounds = scene_bounds(boxes);
+Projection projection(const Contents& contents, View view, const Panel& panel) {
+  const Bounds bounds = scene_bounds(contents);
   const Camera cam = camera(view, bounds);
   return {cam, fit(cam, bounds, panel)};
 }
 
-void draw_grid(cairo_t* cr, const std::vector<Box>& boxes, View view, const Panel& panel) {
-  const Bounds bounds = scene_bounds(boxes);
-  const Projection p = projection(boxes, view, panel);
+void draw_grid(cairo_t* cr, const Contents& contents, View view, const Panel& panel) {
+  const Bounds bounds = scene_bounds(contents);
+  const Projection p = projection(contents, view, panel);
   cairo_set_source_rgb(cr, 0.80, 0.82, 0.85);
   cairo_set_line_width(cr, 1.0);
   const auto line = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -171,17 +277,92 @@ void draw_grid(cairo_t* cr, const std::vector<Box>& boxes, View view, const Pane
   cairo_stroke(cr);
 }
 
-void draw_faces(cairo_t* cr, const std::vector<Face>& faces) {
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  cairo_set_line_width(cr, 0.8);
-  for (const Face& face : faces) {
+// The light comes from over the camera's left shoulder.
+Eigen::Vector3d light_of(const Camera& cam) {
+  return (-cam.forward + 0.6 * cam.up - 0.4 * cam.right).normalized();
+}
+
+double depth_of(const Camera& cam, const Eigen::Vector3d& centre) {
+  return cam.perspective ? (centre - cam.eye).norm() : cam.project(centre).z();
+}
+
+// The faces of `boxes` that face the camera, unsorted.
+std::vector<Face> project_faces(const std::vector<Box>& boxes, const Projection& p) {
+  const Eigen::Vector3d light = light_of(p.cam);
+  std::vector<Face> faces;
+  for (const Box& box : boxes) {
+    const std::array<Eigen::Vector3d, 8> c = corners(box);
+    const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+    for (int f = 0; f < 6; ++f) {
+      const Eigen::Vector3d normal = R * kNormals[f];
+      const Eigen::Vector3d centre =
+          0.25 * (c[kFaces[f][0]] + c[kFaces[f][1]] + c[kFaces[f][2]] + c[kFaces[f][3]]);
+      if (!p.cam.faces(normal, centre)) continue;
+      Face face;
+      face.box_id = box.id;
+      for (int i = 0; i < 4; ++i) face.corners_px[i] = p.fit.pixel(p.cam.project(c[kFaces[f][i]]));
+      face.depth = depth_of(p.cam, centre);
+      face.shade = 0.45 + 0.55 * std::max(0.0, normal.dot(light));
+      faces.push_back(face);
+    }
+  }
+  return faces;
+}
+
+// A polygon as painted: pixels, depth (larger = farther), shaded colour; boxes' faces get a dark outline,
+// facets of robots and obstacles an outline of their own colour (so tessellation seams do not show).
+struct Polygon {
+  std::vector<Eigen::Vector2d> corners_px;
+  double depth = 0;
+  std::array<double, 3> rgb{};
+  double alpha = 1;
+  bool box_face = false;
+};
+
+std::vector<Polygon> polygons(const Contents& contents, View view, const Panel& panel) {
+  const Projection p = projection(contents, view, panel);
+  std::vector<Polygon> out;
+  for (const Face& face : project_faces(contents.boxes, p)) {
     const std::array<double, 3> rgb = box_colour(face.box_id);
-    cairo_move_to(cr, face.corners_px[0].x(), face.corners_px[0].y());
-    for (int i = 1; i < 4; ++i) cairo_line_to(cr, face.corners_px[i].x(), face.corners_px[i].y());
+    out.push_back({{face.corners_px.begin(), face.corners_px.end()},
+                   face.depth,
+                   {rgb[0] * face.shade, rgb[1] * face.shade, rgb[2] * face.shade},
+                   contents.translucent_boxes ? 0.45 : 1.0,
+                   true});
+  }
+  const Eigen::Vector3d light = light_of(p.cam);
+  for (const Facet& facet : contents.facets) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& c : facet.corners_C)
+      centre += c / static_cast<double>(facet.corners_C.size());
+    const bool two_sided = facet.outward.isZero();
+    if (!two_sided && !p.cam.faces(facet.outward, centre)) continue;
+    const Eigen::Vector3d normal =
+        two_sided ? normal_of(facet.corners_C, centre, false) : Eigen::Vector3d(facet.outward);
+    const double shade =
+        0.45 + 0.55 * (two_sided ? std::abs(normal.dot(light)) : std::max(0.0, normal.dot(light)));
+    Polygon polygon{{}, depth_of(p.cam, centre), {}, 1.0, false};
+    for (const Eigen::Vector3d& c : facet.corners_C)
+      polygon.corners_px.push_back(p.fit.pixel(p.cam.project(c)));
+    for (int i = 0; i < 3; ++i) polygon.rgb[i] = facet.rgb[i] * shade;
+    out.push_back(std::move(polygon));
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Polygon& a, const Polygon& b) { return a.depth > b.depth; });
+  return out;
+}
+
+void draw_polygons(cairo_t* cr, const std::vector<Polygon>& polygons) {
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  for (const Polygon& polygon : polygons) {
+    cairo_move_to(cr, polygon.corners_px[0].x(), polygon.corners_px[0].y());
+    for (std::size_t i = 1; i < polygon.corners_px.size(); ++i)
+      cairo_line_to(cr, polygon.corners_px[i].x(), polygon.corners_px[i].y());
     cairo_close_path(cr);
-    cairo_set_source_rgb(cr, rgb[0] * face.shade, rgb[1] * face.shade, rgb[2] * face.shade);
+    cairo_set_source_rgba(cr, polygon.rgb[0], polygon.rgb[1], polygon.rgb[2], polygon.alpha);
     cairo_fill_preserve(cr);
-    cairo_set_source_rgba(cr, 0.1, 0.1, 0.15, 0.55);
+    cairo_set_line_width(cr, polygon.box_face ? 0.8 : 0.5);
+    if (polygon.box_face) cairo_set_source_rgba(cr, 0.1, 0.1, 0.15, 0.55);
     cairo_stroke(cr);
   }
 }
@@ -195,8 +376,8 @@ void draw_text(cairo_t* cr, double x, double y, double size, const std::string& 
 }
 
 // A bar of one grid step in an orthographic panel, so distances can be read off.
-void draw_scale_bar(cairo_t* cr, const std::vector<Box>& boxes, View view, const Panel& panel) {
-  const double length = projection(boxes, view, panel).fit.scale * kGridStep;
+void draw_scale_bar(cairo_t* cr, const Contents& contents, View view, const Panel& panel) {
+  const double length = projection(contents, view, panel).fit.scale * kGridStep;
   const double x = panel.x + 12;
   const double y = panel.y + panel.height - 12;
   cairo_set_source_rgb(cr, 0.15, 0.17, 0.2);
@@ -209,7 +390,7 @@ void draw_scale_bar(cairo_t* cr, const std::vector<Box>& boxes, View view, const
   draw_text(cr, x + length + 6, y + 4, 11, label.str());
 }
 
-void draw_panel(cairo_t* cr, const std::vector<Box>& boxes, View view, const Panel& panel,
+void draw_panel(cairo_t* cr, const Contents& contents, View view, const Panel& panel,
                 const std::string& name) {
   cairo_save(cr);
   cairo_rectangle(cr, panel.x, panel.y, panel.width, panel.height);
@@ -219,9 +400,9 @@ void draw_panel(cairo_t* cr, const std::vector<Box>& boxes, View view, const Pan
   cairo_set_line_width(cr, 1);
   cairo_stroke_preserve(cr);
   cairo_clip(cr);
-  draw_grid(cr, boxes, view, panel);
-  draw_faces(cr, project(boxes, view, panel));
-  if (view != View::kPerspective) draw_scale_bar(cr, boxes, view, panel);
+  draw_grid(cr, contents, view, panel);
+  draw_polygons(cr, polygons(contents, view, panel));
+  if (view != View::kPerspective) draw_scale_bar(cr, contents, view, panel);
   draw_text(cr, panel.x + 10, panel.y + 20, 13, name);
   cairo_restore(cr);
 }
@@ -249,29 +430,20 @@ void check(cairo_status_t status, const std::filesystem::path& out) {
 }  // namespace
 
 std::vector<Face> project(const std::vector<Box>& boxes, View view, const Panel& panel) {
-  const Projection p = projection(boxes, view, panel);
-  // The light comes from over the camera's left shoulder.
-  const Eigen::Vector3d light = (-p.cam.forward + 0.6 * p.cam.up - 0.4 * p.cam.right).normalized();
-  std::vector<Face> faces;
-  for (const Box& box : boxes) {
-    const std::array<Eigen::Vector3d, 8> c = corners(box);
-    const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
-    for (int f = 0; f < 6; ++f) {
-      const Eigen::Vector3d normal = R * kNormals[f];
-      const Eigen::Vector3d centre =
-          0.25 * (c[kFaces[f][0]] + c[kFaces[f][1]] + c[kFaces[f][2]] + c[kFaces[f][3]]);
-      if (!p.cam.faces(normal, centre)) continue;
-      Face face;
-      face.box_id = box.id;
-      for (int i = 0; i < 4; ++i) face.corners_px[i] = p.fit.pixel(p.cam.project(c[kFaces[f][i]]));
-      face.depth = p.cam.perspective ? (centre - p.cam.eye).norm() : p.cam.project(centre).z();
-      face.shade = 0.45 + 0.55 * std::max(0.0, normal.dot(light));
-      faces.push_back(face);
-    }
-  }
+  std::vector<Face> faces = project_faces(boxes, projection(contents_of(boxes, {}), view, panel));
   std::stable_sort(faces.begin(), faces.end(),
                    [](const Face& a, const Face& b) { return a.depth > b.depth; });
   return faces;
+}
+
+std::array<double, 3> robot_colour(bool carried) {
+  // The page's ROBOT_COLOUR 0xf07818 and PAYLOAD_COLOUR 0x8a5a2b.
+  return carried ? std::array<double, 3>{0x8a / 255.0, 0x5a / 255.0, 0x2b / 255.0}
+                 : std::array<double, 3>{0xf0 / 255.0, 0x78 / 255.0, 0x18 / 255.0};
+}
+
+std::array<double, 3> obstacle_colour() {
+  return {0.62, 0.63, 0.66};
 }
 
 std::array<double, 3> box_colour(std::uint64_t id) {
@@ -296,7 +468,8 @@ std::array<Panel, 3> layout(const RenderOptions& options) {
           Panel{2 * gap + left_w, top + gap, w - 3 * gap - left_w, h - 2 * gap}};
 }
 
-void render(const Environment& env, const std::filesystem::path& out, const RenderOptions& options) {
+void render(const Environment& env, const std::filesystem::path& out, const RenderOptions& options,
+            const Overlays& overlays) {
   const std::string ext = out.extension().string();
   if (ext != ".png" && ext != ".svg")
     throw Error("render: " + out.string() + ": the picture must be a .png or an .svg");
@@ -312,9 +485,10 @@ void render(const Environment& env, const std::filesystem::path& out, const Rend
   cairo_paint(cr.get());
   draw_text(cr.get(), 14, 29, 18, options.title.empty() ? heading(env) : options.title);
   const std::array<Panel, 3> panels = layout(options);
-  draw_panel(cr.get(), env.boxes(), View::kTop, panels[0], "top (x right, y up)");
-  draw_panel(cr.get(), env.boxes(), View::kSide, panels[1], "side (from -y: x right, z up)");
-  draw_panel(cr.get(), env.boxes(), View::kPerspective, panels[2], "perspective");
+  const Contents contents = contents_of(env.boxes(), overlays);
+  draw_panel(cr.get(), contents, View::kTop, panels[0], "top (x right, y up)");
+  draw_panel(cr.get(), contents, View::kSide, panels[1], "side (from -y: x right, z up)");
+  draw_panel(cr.get(), contents, View::kPerspective, panels[2], "perspective");
   check(cairo_status(cr.get()), out);
   if (ext == ".png") check(cairo_surface_write_to_png(surface.get(), out.c_str()), out);
   cairo_surface_finish(surface.get());

@@ -117,6 +117,70 @@ TEST(RenderTest, PngShowsTheBoxWhereItsTopFaceProjects) {
   cairo_surface_destroy(image);
 }
 
+// The pixel of p_C in the top panel of a default picture whose scene spans x ∈ [x0, x1], y ∈ [y0, y1]: the
+// extent fitted with a 6 % margin at a uniform scale, centred (layout() and project()'s contract).
+Eigen::Vector2d top_pixel(const Eigen::Vector3d& p_C, double x0, double x1, double y0, double y1) {
+  const Panel top = layout(RenderOptions{})[0];
+  const double scale = std::min(top.width * 0.88 / (x1 - x0), top.height * 0.88 / (y1 - y0));
+  return {top.x + top.width / 2 + scale * (p_C.x() - (x0 + x1) / 2),
+          top.y + top.height / 2 - scale * (p_C.y() - (y0 + y1) / 2)};
+}
+
+// Faces turned straight up, lit from over the top view's camera's left shoulder: (-0.4, 0.6, 1) normalised.
+const double kTopShade = 0.45 + 0.55 / std::sqrt(0.16 + 0.36 + 1.0);
+
+void expect_colour(cairo_surface_t* image, const Eigen::Vector2d& at, const std::array<double, 3>& rgb,
+                   const std::string& what) {
+  const auto got = pixel(image, static_cast<int>(at.x()), static_cast<int>(at.y()));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[i], 255 * rgb[i], 2.5) << what << " channel " << i;
+}
+
+TEST(RenderTest, RobotShapesAreDrawnInTheRobotColourWhereTheyStand) {
+  test::TempDir dir;
+  Overlays overlays;
+  // A column (cylinder r 0.2 m, 1 m high) at (3, 2) and, lying at z 0.2, a triangle of a mesh wound
+  // clockwise seen from above: meshes are drawn from both sides.
+  overlays.robot.push_back({Eigen::Isometry3d(Eigen::Translation3d(3, 2, 0.5)), CylinderShape{0.2, 0.5}});
+  auto mesh = std::make_shared<TriangleMesh>();
+  mesh->vertices = {{2.0, 1.8, 0.2}, {2.0, 2.2, 0.2}, {2.4, 1.8, 0.2}};
+  mesh->triangles = {{0, 1, 2}};
+  overlays.robot.push_back({Eigen::Isometry3d::Identity(), MeshShape{mesh}, true});
+  render(Environment("cell-1", 1, 0, {kTableBox}), dir.path() / "robot.png", {}, overlays);
+  cairo_surface_t* image = cairo_image_surface_create_from_png((dir.path() / "robot.png").c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  // The scene spans the box (x 0.5..1.5, y 1.75..2.25) and the column (x 2.8..3.2).
+  const auto at = [](double x, double y) { return top_pixel({x, y, 0}, 0.5, 3.2, 1.75, 2.25); };
+  const auto shaded = [](std::array<double, 3> rgb) {
+    for (double& c : rgb) c *= kTopShade;
+    return rgb;
+  };
+  expect_colour(image, at(3.0, 2.0), shaded(robot_colour(false)), "the column's top");
+  expect_colour(image, at(2.1333, 1.9333), shaded(robot_colour(true)), "the carried triangle");
+  expect_colour(image, at(1.0, 2.1), shaded(box_colour(kTableBox.id)), "the box, opaque without obstacles");
+  cairo_surface_destroy(image);
+}
+
+TEST(RenderTest, TrueObstaclesShowThroughTranslucentBoxes) {
+  test::TempDir dir;
+  Overlays overlays;
+  overlays.obstacles.push_back(
+      {Eigen::Isometry3d(Eigen::Translation3d(1, 2, 0.4)), BoxShape{{0.3, 0.2, 0.4}}});
+  render(Environment("cell-1", 1, 0, {kTableBox}), dir.path() / "truth.png", {}, overlays);
+  cairo_surface_t* image = cairo_image_surface_create_from_png((dir.path() / "truth.png").c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  const auto at = [](double x, double y) { return top_pixel({x, y, 0}, 0.5, 1.5, 1.75, 2.25); };
+  const std::array<double, 3> box = box_colour(kTableBox.id);
+  const std::array<double, 3> grey = obstacle_colour();
+  std::array<double, 3> over_obstacle{}, over_floor{};
+  for (int i = 0; i < 3; ++i) {
+    over_obstacle[i] = 0.45 * box[i] * kTopShade + 0.55 * grey[i] * kTopShade;
+    over_floor[i] = 0.45 * box[i] * kTopShade + 0.55;  // the panel's white under the box
+  }
+  expect_colour(image, at(1.1, 2.1), over_obstacle, "the box over the obstacle's top");
+  expect_colour(image, at(1.4, 2.1), over_floor, "the box beside the obstacle");
+  cairo_surface_destroy(image);
+}
+
 // Every path of the SVG as its list of points ("M x y L x y ... Z").
 std::vector<std::vector<Eigen::Vector2d>> svg_paths(const std::string& svg) {
   std::vector<std::vector<Eigen::Vector2d>> paths;

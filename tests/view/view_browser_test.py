@@ -182,7 +182,7 @@ class ViewTest(unittest.TestCase):
 
     def daemon_snapshot(self):
         """(version, boxes) of the daemon's current snapshot, read by `cellmap render --domain`."""
-        out = run_tool('render', '--domain', str(LIVE_DOMAIN), '--timeout', '60', '-o',
+        out = run_tool('render', '--domain', str(LIVE_DOMAIN), '--no-robot', '--timeout', '60', '-o',
                        os.path.join(self.dir, 'render.png'))
         match = re.match(r'^wrote .*: cell cell-view, version (\d+), (\d+) boxes$', out)
         self.assertIsNotNone(match, out)
@@ -425,10 +425,24 @@ class ViewTest(unittest.TestCase):
         moved = [b - a for a, b in zip(tool(first), tool(second))]
         self.log(f'sweeps {first["sweep"]} -> {second["sweep"]}: link_6 moved by '
                  f'({moved[0]:.3f}, {moved[1]:.3f}, {moved[2]:.3f}) m, drawn at its place each time')
+        self.check_rendered_robot(int(logged.group(1)))
         self.browser.find_element(By.ID, 'layer-robot').click()
         wait_for(lambda: 'layer robot: no reader' in daemon.log_text(), 'the daemon to stop publishing')
         self.assertEqual(daemon.stop(), 0)
         self.log('arm cell daemon stopped')
+
+    def check_rendered_robot(self, shapes):
+        """`cellmap render --domain` draws the arm cell's robot from its layer: every shape, in the robot's
+        colour, next to the boxes."""
+        png = os.path.join(self.dir, 'arm.png')
+        out = run_tool('render', '--domain', str(LIVE_DOMAIN), '--cell', 'arm-view', '--timeout', '60', '-o', png)
+        match = re.match(r'^wrote .*: cell arm-view, version \d+, \d+ boxes, the robot \((\d+) shapes\)$', out)
+        self.assertIsNotNone(match, out)
+        self.assertEqual(int(match.group(1)), shapes)
+        image = Image.open(png).convert('RGB')
+        orange = sum(1 for p in image.getdata() if is_robot_colour(p))
+        self.log(f'cellmap render drew the robot: {shapes} shapes, {orange} pixels in its colour')
+        self.assertGreater(orange, 2000)
 
     def canvas(self):
         """The robot as in the last frame the page drew, and that frame (read together, in one script)."""
