@@ -1,5 +1,5 @@
 // The daemon's layers: written after a sweep only while read, only when they changed or a reader joined
-// (real participants on loopback, domain 223); sensor views from real frames through the sweep stage.
+// (real participants on loopback, one domain per test); sensor views from real frames through the sweep stage.
 #include "layer_publisher.hpp"
 
 #include <gtest/gtest.h>
@@ -21,7 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using transport::Layer;
 constexpr auto kPatience = 30s;
-constexpr std::uint32_t kDomain = test::domain::kLayerPublisher;
 
 class LayerPublisherTest : public ::testing::Test {
  protected:
@@ -59,8 +58,8 @@ void wait_until_read(const dds::Participant& participant, Layer layer, std::uint
 }
 
 TEST_F(LayerPublisherTest, VoxelsGoOutWhenTheyChangeOrAReaderJoins) {
-  dds::Participant daemon(kDomain);
-  dds::Participant viewer(kDomain);
+  dds::Participant daemon(test::domain::kVoxelLayerPublisher);
+  dds::Participant viewer(test::domain::kVoxelLayerPublisher);
   LayerPublisher layers(daemon, "cell-1");
   OccupancyMap map;
   map.integrate(floor_sweep(5, 3));
@@ -91,8 +90,8 @@ TEST_F(LayerPublisherTest, VoxelsGoOutWhenTheyChangeOrAReaderJoins) {
 }
 
 TEST_F(LayerPublisherTest, ChangeRegionsGoOutForSweepsThatConfirmedSome) {
-  dds::Participant daemon(kDomain);
-  dds::Participant viewer(kDomain);
+  dds::Participant daemon(test::domain::kRegionLayerPublisher);
+  dds::Participant viewer(test::domain::kRegionLayerPublisher);
   LayerPublisher layers(daemon, "cell-1");
   OccupancyMap map;
   transport::LayerReader reader(viewer, Layer::kChangeRegions);
@@ -132,8 +131,8 @@ std::vector<Frame> camera_and_scanner_frames() {
 }
 
 TEST_F(LayerPublisherTest, SensorViewsGoOutAfterEachSweepWhileRead) {
-  dds::Participant daemon(kDomain);
-  dds::Participant viewer(kDomain);
+  dds::Participant daemon(test::domain::kSensorLayerPublisher);
+  dds::Participant viewer(test::domain::kSensorLayerPublisher);
   LayerPublisher layers(daemon, "cell-1");
   const OccupancyMap map;
   FrameSweep sweep;
@@ -227,8 +226,8 @@ TEST_F(LayerPublisherTest, RobotShapesFollowTheJointsOfEachSweep) {
 }
 
 TEST_F(LayerPublisherTest, NoRobotLayerWithoutARobotModel) {
-  dds::Participant daemon(test::domain::kRobotLayerPublisher);
-  dds::Participant viewer(test::domain::kRobotLayerPublisher);
+  dds::Participant daemon(test::domain::kNoRobotLayerPublisher);
+  dds::Participant viewer(test::domain::kNoRobotLayerPublisher);
   const Robot robot = Robot::gantry({0, 0, -0.6}, {3, 2, 0});
   LayerPublisher layers(daemon, "cell-2");  // show_robot() never called
   transport::LayerReader reader(viewer, Layer::kRobot);

@@ -69,8 +69,12 @@ inline constexpr int kArmBothCoverage = 166;
 // daemon_test: the daemon's parts in process.
 inline constexpr int kKeeper = 186;
 inline constexpr int kSimAcquisition = 187;
-inline constexpr int kLayerPublisher = 223;
+// layer_publisher_test: one domain per test, since ctest runs them side by side.
+inline constexpr int kVoxelLayerPublisher = 223;
+inline constexpr int kRegionLayerPublisher = 224;
+inline constexpr int kSensorLayerPublisher = 225;
 inline constexpr int kRobotLayerPublisher = 137;
+inline constexpr int kNoRobotLayerPublisher = 226;
 
 // faults_e2e_test.
 inline constexpr int kFirstVersionFault = 188;
