@@ -1,5 +1,5 @@
 // The boxes of cellmapd's first version on the default simulated cell, scored by volume against the scene's
-// true solids, and the trade-off between box count and blocked free space (scripts/box_study).
+// true solids; scripts/box_tradeoff runs it over a grid of `segment` settings.
 //
 //   cellmap-box-study [--out DIR] [--exact] [--config FILE] [--boxes FILE] [--cloud FILE] [--inject]
 //                     [--sweeps N] [--max-depth-jump X]
