@@ -91,102 +91,140 @@ const char* split_method_name(SplitMethod method) {
   return "supervoxels";
 }
 
+// The indices of the points inside the configured workspace (all without one).
+std::vector<int> workspace_index(const Cloud& points, const SegmentConfig& config) {
+  if (config.workspace) return crop_to_workspace(points, *config.workspace);
+  std::vector<int> index(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) index[i] = static_cast<int>(i);
+  return index;
+}
+
+// The region-growing gap widened to gap_floor_factor × the median neighbour distance where the cloud is
+// sparser than the configured gap assumes.
+double widened_gap(const SegmentConfig& config, const Neighbourhoods& nb) {
+  if (nb.size() == 0) return config.region_growing.gap;
+  std::vector<float> d = nb.mean_distance;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return std::max(config.region_growing.gap, config.gap_floor_factor * d[d.size() / 2]);
+}
+
+// One box per non-empty segment, ids 1, 2, ... in segment order; `index` maps cloud points to the input's.
+void fit_boxes(const Cloud& cloud, const Segments& segments, const std::vector<int>& index,
+               const SegmentConfig& config, SegmentResult& result) {
+  for (const std::vector<int>& members : segments.members()) {
+    if (members.empty()) continue;
+    Box box = fit_box(cloud, members, config.box_kind, config.voxel);
+    box.id = result.boxes.boxes.size() + 1;
+    for (int i : members) result.box_of_point[index[i]] = static_cast<int>(result.boxes.boxes.size());
+    result.boxes.boxes.push_back(box);
+  }
+}
+
+// The readers of segment_config_from_yaml's sections: each reads its keys into `c` and refuses any other.
+void read_neighbours(YamlMap m, SegmentConfig& c) {
+  c.k = static_cast<int>(m.integer("k", c.k, 3, 200));
+  m.expect_all_read();
+}
+
+void read_outliers(YamlMap m, SegmentConfig& c) {
+  const std::string mode = m.get<std::string>("mode", "two_sided");
+  if (mode == "two_sided") {
+    c.outlier_mode = OutlierMode::kTwoSided;
+  } else if (mode == "one_sided") {
+    c.outlier_mode = OutlierMode::kOneSided;
+  } else if (mode == "off") {
+    c.outlier_mode = OutlierMode::kOff;
+  } else {
+    m.fail("mode", "must be two_sided, one_sided or off, got '" + mode + "'");
+  }
+  c.outlier_u = m.number("u", c.outlier_u, 0.0, 100.0);
+  m.expect_all_read();
+}
+
+void read_region_growing(YamlMap m, SegmentConfig& c) {
+  RegionGrowingParams& r = c.region_growing;
+  r.gap = m.number("gap", r.gap, 1e-4, 1.0);
+  r.max_curvature = m.number("max_curvature", r.max_curvature, 0.0, 1.0 / 3.0);
+  r.max_angle = m.number("max_angle", r.max_angle, 0.0, kPi);
+  r.min_cluster_size = static_cast<int>(m.integer("min_cluster_size", r.min_cluster_size, 1, 100000000));
+  c.gap_floor_factor = m.number("gap_floor_factor", c.gap_floor_factor, 0.0, 100.0);
+  m.expect_all_read();
+}
+
+void read_leftovers(YamlMap m, SegmentConfig& c) {
+  c.leftover_min_points = static_cast<int>(m.integer("min_points", c.leftover_min_points, 1, 1000000));
+  m.expect_all_read();
+}
+
+void read_merge(YamlMap m, SegmentConfig& c) {
+  ConvexMergeParams& p = c.merge_params;
+  c.merge = m.get<bool>("enabled", c.merge);
+  p.patch_radius = m.number("patch_radius", p.patch_radius, 1e-4, 1.0);
+  p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, kPi);
+  p.min_boundary_points =
+      static_cast<int>(m.integer("min_boundary_points", p.min_boundary_points, 1, 1000000));
+  p.samples_per_boundary =
+      static_cast<int>(m.integer("samples_per_boundary", p.samples_per_boundary, 1, 100000));
+  m.expect_all_read();
+}
+
+void read_split(YamlMap m, SegmentConfig& c) {
+  const std::string method = m.get<std::string>("method", split_method_name(c.split_method));
+  if (method == "free_space") {
+    c.split_method = SplitMethod::kFreeSpace;
+  } else if (method == "supervoxels") {
+    c.split_method = SplitMethod::kSupervoxels;
+  } else if (method == "off") {
+    c.split_method = SplitMethod::kOff;
+  } else {
+    m.fail("method", "must be free_space, supervoxels or off, got '" + method + "'");
+  }
+  c.split_min_gain = m.number("min_gain", c.split_min_gain, 1e-3, 1.0);
+  SplitParams& s = c.split;
+  s.max_extent = m.number("max_extent", s.max_extent, 1e-3, 1e3);
+  s.voxel_resolution = m.number("voxel_resolution", s.voxel_resolution, 1e-4, 1.0);
+  s.seed_resolution = m.number("seed_resolution", s.seed_resolution, 1e-3, 10.0);
+  if (s.seed_resolution < s.voxel_resolution) m.fail("seed_resolution", "must be >= voxel_resolution");
+  m.expect_all_read();
+}
+
+void read_join(YamlMap m, SegmentConfig& c) {
+  c.join_max_growth = m.number("max_growth", c.join_max_growth, 0.0, 0.99);
+  if (c.join_max_growth >= c.split_min_gain && c.split_method == SplitMethod::kFreeSpace) {
+    m.fail("max_growth", "must be below split.min_gain (a join must not undo a split)");
+  }
+  m.expect_all_read();
+}
+
+void read_boxes(YamlMap m, SegmentConfig& c) {
+  const std::string kind = m.get<std::string>("kind", to_string(c.box_kind));
+  c.box_kind = box_kind_from_string(kind, (m.source().empty() ? "" : m.source() + ": ") + m.key_path("kind"));
+  c.voxel = m.number("voxel", c.voxel, 0.0, 1.0);
+  m.expect_all_read();
+}
+
+void read_workspace(YamlMap m, SegmentConfig& c) {
+  const Eigen::Vector3d lower = vector3(m, "lower");
+  const Eigen::Vector3d upper = vector3(m, "upper");
+  const double envelope = m.number("envelope", 0.0, 0.0, 100.0);
+  if ((lower.array() > upper.array()).any()) m.fail("upper", "must be >= lower on every axis");
+  c.workspace = Workspace::box(lower.array() - envelope, upper.array() + envelope);
+  m.expect_all_read();
+}
+
 }  // namespace
 
 SegmentConfig segment_config_from_yaml(YamlMap root) {
   SegmentConfig c;
-  {
-    YamlMap m = root.child("neighbours");
-    c.k = static_cast<int>(m.integer("k", c.k, 3, 200));
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("outliers");
-    const std::string mode = m.get<std::string>("mode", "two_sided");
-    if (mode == "two_sided") {
-      c.outlier_mode = OutlierMode::kTwoSided;
-    } else if (mode == "one_sided") {
-      c.outlier_mode = OutlierMode::kOneSided;
-    } else if (mode == "off") {
-      c.outlier_mode = OutlierMode::kOff;
-    } else {
-      m.fail("mode", "must be two_sided, one_sided or off, got '" + mode + "'");
-    }
-    c.outlier_u = m.number("u", c.outlier_u, 0.0, 100.0);
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("region_growing");
-    RegionGrowingParams& r = c.region_growing;
-    r.gap = m.number("gap", r.gap, 1e-4, 1.0);
-    r.max_curvature = m.number("max_curvature", r.max_curvature, 0.0, 1.0 / 3.0);
-    r.max_angle = m.number("max_angle", r.max_angle, 0.0, kPi);
-    r.min_cluster_size = static_cast<int>(m.integer("min_cluster_size", r.min_cluster_size, 1, 100000000));
-    c.gap_floor_factor = m.number("gap_floor_factor", c.gap_floor_factor, 0.0, 100.0);
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("leftovers");
-    c.leftover_min_points = static_cast<int>(m.integer("min_points", c.leftover_min_points, 1, 1000000));
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("merge");
-    ConvexMergeParams& p = c.merge_params;
-    c.merge = m.get<bool>("enabled", c.merge);
-    p.patch_radius = m.number("patch_radius", p.patch_radius, 1e-4, 1.0);
-    p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, kPi);
-    p.min_boundary_points =
-        static_cast<int>(m.integer("min_boundary_points", p.min_boundary_points, 1, 1000000));
-    p.samples_per_boundary =
-        static_cast<int>(m.integer("samples_per_boundary", p.samples_per_boundary, 1, 100000));
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("split");
-    const std::string method = m.get<std::string>("method", split_method_name(c.split_method));
-    if (method == "free_space") {
-      c.split_method = SplitMethod::kFreeSpace;
-    } else if (method == "supervoxels") {
-      c.split_method = SplitMethod::kSupervoxels;
-    } else if (method == "off") {
-      c.split_method = SplitMethod::kOff;
-    } else {
-      m.fail("method", "must be free_space, supervoxels or off, got '" + method + "'");
-    }
-    c.split_min_gain = m.number("min_gain", c.split_min_gain, 1e-3, 1.0);
-    SplitParams& s = c.split;
-    s.max_extent = m.number("max_extent", s.max_extent, 1e-3, 1e3);
-    s.voxel_resolution = m.number("voxel_resolution", s.voxel_resolution, 1e-4, 1.0);
-    s.seed_resolution = m.number("seed_resolution", s.seed_resolution, 1e-3, 10.0);
-    if (s.seed_resolution < s.voxel_resolution) m.fail("seed_resolution", "must be >= voxel_resolution");
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("join");
-    c.join_max_growth = m.number("max_growth", c.join_max_growth, 0.0, 0.99);
-    if (c.join_max_growth >= c.split_min_gain && c.split_method == SplitMethod::kFreeSpace) {
-      m.fail("max_growth", "must be below split.min_gain (a join must not undo a split)");
-    }
-    m.expect_all_read();
-  }
-  {
-    YamlMap m = root.child("boxes");
-    const std::string kind = m.get<std::string>("kind", to_string(c.box_kind));
-    c.box_kind =
-        box_kind_from_string(kind, (m.source().empty() ? "" : m.source() + ": ") + m.key_path("kind"));
-    c.voxel = m.number("voxel", c.voxel, 0.0, 1.0);
-    m.expect_all_read();
-  }
-  if (root.has("workspace")) {
-    YamlMap m = root.child("workspace");
-    const Eigen::Vector3d lower = vector3(m, "lower");
-    const Eigen::Vector3d upper = vector3(m, "upper");
-    const double envelope = m.number("envelope", 0.0, 0.0, 100.0);
-    if ((lower.array() > upper.array()).any()) m.fail("upper", "must be >= lower on every axis");
-    c.workspace = Workspace::box(lower.array() - envelope, upper.array() + envelope);
-    m.expect_all_read();
-  }
+  read_neighbours(root.child("neighbours"), c);
+  read_outliers(root.child("outliers"), c);
+  read_region_growing(root.child("region_growing"), c);
+  read_leftovers(root.child("leftovers"), c);
+  read_merge(root.child("merge"), c);
+  read_split(root.child("split"), c);
+  read_join(root.child("join"), c);  // after split: checked against split.min_gain
+  read_boxes(root.child("boxes"), c);
+  if (root.has("workspace")) read_workspace(root.child("workspace"), c);
   c.merge_params.gap = c.region_growing.gap;
   root.expect_all_read();
   return c;
@@ -205,14 +243,8 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   result.boxes.frame = "cell";
   Stopwatch clock;
 
-  // Crop. `index` maps the current working cloud back to the input.
-  std::vector<int> index;
-  if (config.workspace) {
-    index = crop_to_workspace(points, *config.workspace);
-  } else {
-    index.resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) index[i] = static_cast<int>(i);
-  }
+  // `index` maps the current working cloud back to the input.
+  std::vector<int> index = workspace_index(points, config);
   stats.outside_workspace = points.size() - index.size();
   Cloud cropped = subset(points, index);
   stats.t_crop = clock.lap();
@@ -235,10 +267,8 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
 
   RegionGrowingParams growing = config.region_growing;
   ConvexMergeParams merging = config.merge_params;
-  if (config.gap_floor_factor > 0.0 && nb.size() > 0) {
-    std::vector<float> d = nb.mean_distance;
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    growing.gap = std::max(growing.gap, config.gap_floor_factor * d[d.size() / 2]);
+  if (config.gap_floor_factor > 0.0) {
+    growing.gap = widened_gap(config, nb);
     merging.gap = std::max(merging.gap, growing.gap);
   }
   stats.gap = growing.gap;
@@ -266,13 +296,7 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   }
   stats.t_join = clock.lap();
 
-  for (const std::vector<int>& members : segments.members()) {
-    if (members.empty()) continue;
-    Box box = fit_box(cloud, members, config.box_kind, config.voxel);
-    box.id = result.boxes.boxes.size() + 1;
-    for (int i : members) result.box_of_point[index[i]] = static_cast<int>(result.boxes.boxes.size());
-    result.boxes.boxes.push_back(box);
-  }
+  fit_boxes(cloud, segments, index, config, result);
   stats.boxes = result.boxes.boxes.size();
   stats.t_boxes = clock.lap();
   return result;
