@@ -1,8 +1,9 @@
 // The daemon's simulated arm cell and cell pipeline driven sweep by sweep (each sweep one second of the
 // motion, so sweep numbers are the motion's seconds): pick and place, people walking through, joint stamps
-// that are late. Noise on. The arm cell's config (config/arm-cell.yaml) with the post camera only. CI runs
-// the late joint stamps for 20 sweeps; CELLMAP_LONG_TESTS=1 adds pick and place and the walkers (46 and 48
-// sweeps) and runs the late stamps for 60.
+// that are late. Noise on. The arm cell's config (config/arm-cell.yaml) with the post camera only; and the
+// arm cell as that file has it (both cameras, 0.5 s sweeps) through the daemon's mailbox while processing
+// stalls. CI runs the late joint stamps for 20 sweeps; CELLMAP_LONG_TESTS=1 adds pick and place and the
+// walkers (46 and 48 sweeps), the stall (twice 60 sweeps) and runs the late stamps for 60.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -224,9 +225,10 @@ int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stal
 TEST(WorkingCellTest, AStalledProcessingThreadCatchesUpAndTheUnchangingArmCellMakesOneVersion) {
   if (!long_tests()) GTEST_SKIP() << "twice 60 sweeps of the arm cell: CELLMAP_LONG_TESTS=1 runs it";
   // Stalled for 7 sweeps right after the first version (sweep 33), as the first segmentation stalled a
-  // daemon at load 12. Each sweep's free space keeps voxels free that the wrist camera's noisy views of the
-  // table mark in other phases of the arm's path; with the newest sweep only (a backlog of 1), 3.5 s of it
-  // are missing, voxels above the table flip to occupied a round later and back the round after: versions.
+  // daemon at load 12; the default backlog holds them all. Each sweep's free space keeps voxels free that the
+  // wrist camera's noisy views of the table mark in other phases of the arm's path; with the newest sweep
+  // only (a backlog of 1), 3.5 s of it are missing: 53 voxels above the table are boxed 7 sweeps later and
+  // removed 5 after that, 3 versions.
   EXPECT_EQ(arm_cell_versions_with_a_stall(DaemonConfig{}.sweep_backlog, 34, 40, 60), 1);
   EXPECT_GT(arm_cell_versions_with_a_stall(1, 34, 40, 60), 1) << "the stall made no difference";
 }
