@@ -286,7 +286,7 @@ class CameraAcquisition final : public Acquisition {
     }
     for (FrameSweep& sweep : sweeps) {
       // A replay played as fast as processed must lose no sweep: wait for the processing thread.
-      while (lossless_ && !stop && !output_.mailbox.wait_taken(milliseconds(100))) {
+      while (lossless_ && !stop && !output_.mailbox.wait_for_room(milliseconds(100))) {
       }
       output_.mailbox.put(std::move(sweep));
       if (max_sweeps > 0 && ++delivered_ >= max_sweeps) return true;
@@ -301,7 +301,7 @@ class CameraAcquisition final : public Acquisition {
   double pose_tolerance_;
   std::optional<Robot> robot_model_;
   std::optional<RobotInput> robot_;  // live cameras only
-  bool lossless_ = false;  // replays played as fast as processed: no sweep is replaced in the mailbox
+  bool lossless_ = false;  // replays played as fast as processed: no sweep is dropped from the mailbox
   std::vector<std::unique_ptr<CameraLoop>> loops_;
 };
 

@@ -1,6 +1,6 @@
 #pragma once
 // cellmapd's acquisition: sweeps from the configured sensors (the simulated cell's, or the cameras' posed
-// frames grouped into sweeps) into the processing thread's latest-wins mailbox.
+// frames grouped into sweeps) into the processing thread's mailbox (a bounded backlog).
 
 #include <atomic>
 #include <cstdint>

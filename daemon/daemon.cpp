@@ -73,6 +73,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
                 publisher_.publish(env, delta);
                 watch.add_to(publish_cost_);
               }),
+      mailbox_(config_.sweep_backlog),
       health_(config_.cell, sensor_names(config_)),
       refusals_([](const std::string& line) { spdlog::warn("{}", line); }) {
   log_dds_security(participant_, config_.domain);
@@ -147,7 +148,7 @@ void Daemon::process() {
       handle(*sweep, ++processed);
       if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
     } else if (stop_ || acquisition_was_done) {
-      // With --sweeps, acquisition ends after N sweeps; some may have been replaced in the mailbox, so
+      // With --sweeps, acquisition ends after N sweeps; some may have been dropped from the mailbox, so
       // processing ends when the mailbox is empty, not only after N.
       stop_ = true;
       break;

@@ -1,8 +1,9 @@
 #pragma once
 // cellmapd's wiring: the state directory, the cell pipeline, DDS, the sweep source and the threads.
 //
-// Threads: acquisition (sweeps from the source → a latest-wins mailbox), processing (cell pipeline → version
-// kept, saved and published → status), and the caller's (signals: SIGTERM/SIGINT stop, SIGHUP reloads).
+// Threads: acquisition (sweeps from the source → a bounded mailbox, oldest taken first), processing (cell
+// pipeline → version kept, saved and published → status), and the caller's (signals: SIGTERM/SIGINT stop,
+// SIGHUP reloads).
 
 #include <atomic>
 #include <cstdint>

@@ -1,6 +1,7 @@
 #pragma once
 // cellmapd's configuration: one YAML file, each stage's section read by that stage's own reader.
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -63,6 +64,8 @@ struct DaemonConfig final {
   std::filesystem::path state_dir = "state";  ///< `state_dir` (--state-dir overrides); relative to the cwd
   double sweep_period = 0.5;   ///< `sweep_period`: seconds between sweep starts (0 = as fast as processed)
   double status_period = 1.0;  ///< `status_period`: seconds between status messages
+  /// `sweep_backlog`: sweeps that wait for the processing thread; when it is full the oldest is dropped.
+  std::size_t sweep_backlog = 8;
   std::uint32_t delta_depth = 16;  ///< `delta_depth`: deltas kept for late joiners
   std::string log_level = "info";  ///< `log_level`: trace | debug | info | warn | error
   /// `security` section (`directory`, `role`; --security, --role override): DDS Security with the credentials

@@ -241,14 +241,14 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
 }
 
 // sweep_period 0: the simulated cell sweeps as fast as it renders, while fusing a sweep into a 1 cm grid
-// takes seconds. The latest-wins mailbox replaces the waiting sweep: every sweep is processed or counted as
-// dropped, in the per-sweep log line and in the status's dropped_frames. (Measured: 8 sweeps rendered, 2
-// processed.)
+// takes seconds. With `sweep_backlog: 1` the mailbox keeps only the newest sweep: every sweep is processed or
+// counted as dropped, in the per-sweep log line and in the status's dropped_frames. (Measured: 8 sweeps
+// rendered, 2 processed.)
 TEST(CellmapdStatusE2eTest, SweepsArrivingFasterThanProcessedAreDroppedAndCounted) {
   constexpr std::uint64_t kSweeps = 8;
   test::ServiceFixture service("mailbox");
   std::ofstream(service.config_file(), std::ios::trunc)
-      << "cell: mailbox\nsweep_period: 0\nstatus_period: 0.2\nsource: {noise: false}\n"
+      << "cell: mailbox\nsweep_period: 0\nsweep_backlog: 1\nstatus_period: 0.2\nsource: {noise: false}\n"
          "occupancy: {resolution: 0.01}\n";
   auto daemon = service.start_daemon(test::domain::kMailbox, /*log_on_stdout=*/true, kSweeps);
   test::DaemonLog log(*daemon);
@@ -269,6 +269,47 @@ TEST(CellmapdStatusE2eTest, SweepsArrivingFasterThanProcessedAreDroppedAndCounte
   EXPECT_NE(last_sweep.find("; " + std::to_string(stopped->dropped_frames) + " sweeps dropped"),
             std::string::npos)
       << last_sweep;
+}
+
+// A change confirmed and waiting in the gather window (change.gather_sweeps) when the daemon is killed: the
+// restarted daemon resumes from the last version, whose map predates the change, so it finds the change
+// again and publishes it once: one version above the resumed one, one box holding it.
+TEST(CellmapdStateE2eTest, AChangeWaitingToBeGatheredWhenKilledComesOutOnceAfterTheRestart) {
+  test::ServiceFixture service("gather", "change: {settle_sweeps: 2, gather_sweeps: 10}\n");
+  const int domain = test::domain::kGatherRestart;
+  const Eigen::Vector3d centre(2.12, 0.45, 0.9);  // on a free part of the table, as above
+  const std::vector<std::string> add_box{"add-box", "--center", "2.12,0.45,0.9", "--half-extents",
+                                         "0.1,0.1,0.15"};
+  {
+    auto daemon = service.start_daemon(domain, /*log_on_stdout=*/true);
+    test::DaemonLog log(*daemon);
+    ASSERT_TRUE(log.wait_for("version 1: ").has_value()) << "no first version";
+    EXPECT_FALSE(service.inject(domain, add_box).empty());
+    // The sweep that confirms the box: its change now waits 10 sweeps (2 s) to be published.
+    std::optional<std::string> confirmed;
+    while ((confirmed = log.wait_for(" change regions")) &&
+           confirmed->find(" 0 change regions") != std::string::npos) {
+    }
+    ASSERT_TRUE(confirmed.has_value()) << "the injected box was never confirmed";
+    daemon->signal(SIGKILL);
+    daemon->wait();
+    log.drain();
+    ASSERT_EQ(log.count("version 2: "), 0u) << "the change went out before the kill: " << *confirmed;
+  }
+
+  auto daemon = service.start_daemon(domain);
+  const dds::Participant participant = service.participant(domain);
+  transport::EnvironmentSubscriber planner(participant, "gather");
+  ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "the restarted daemon announced nothing";
+  const std::uint64_t resumed = planner.environment()->version();
+  EXPECT_FALSE(service.inject(domain, add_box).empty());  // the simulated cell starts from its scene again
+  ASSERT_TRUE(test::wait_until_boxed(planner, centre)) << "the waiting change never came out";
+  const Environment after = settled(planner, 3s);
+  const auto holds_box = [&](const Box& box) { return box.contains(centre); };
+  EXPECT_EQ(std::count_if(after.boxes().begin(), after.boxes().end(), holds_box), 1);
+  EXPECT_EQ(after.version(), resumed + 1) << "the change came out in more than one version";
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
 }
 
 // cellmapd started on a state directory whose newest snapshot JSON is truncated: it resumes from the previous

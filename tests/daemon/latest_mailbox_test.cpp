@@ -35,7 +35,7 @@ TEST(LatestMailboxTest, TakeWaitsForAProducer) {
 
 TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
   LatestMailbox<int> box;
-  EXPECT_TRUE(box.wait_taken(milliseconds(0)));  // empty from the start
+  EXPECT_TRUE(box.wait_for_room(milliseconds(0)));  // empty from the start
   std::vector<int> got;
   std::thread consumer([&] {
     while (got.size() < 50) {
@@ -43,7 +43,7 @@ TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
     }
   });
   for (int i = 0; i < 50; ++i) {
-    ASSERT_TRUE(box.wait_taken(milliseconds(10000)));
+    ASSERT_TRUE(box.wait_for_room(milliseconds(10000)));
     box.put(i);
   }
   consumer.join();
@@ -51,7 +51,7 @@ TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
   ASSERT_EQ(got.size(), 50u);
   for (int i = 0; i < 50; ++i) EXPECT_EQ(got[i], i);
   box.put(7);
-  EXPECT_FALSE(box.wait_taken(milliseconds(1)));  // nobody takes it
+  EXPECT_FALSE(box.wait_for_room(milliseconds(1)));  // nobody takes it
 }
 
 TEST(LatestMailboxTest, CloseWakesWaitingConsumers) {
@@ -112,6 +112,19 @@ TEST(LatestMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
   EXPECT_EQ(taken + box.dropped(), 2000u);
   // The consumer rests 1 ms per item while the producer puts 2000 at once: items were replaced, not queued.
   EXPECT_GT(box.dropped(), 0u);
+}
+
+TEST(LatestMailboxTest, AStalledConsumerCatchesUpOnItsBacklogInOrderThenTheOldestAreDropped) {
+  LatestMailbox<int> box(4);
+  for (int i = 0; i < 4; ++i) box.put(i);
+  EXPECT_FALSE(box.wait_for_room(milliseconds(0)));
+  EXPECT_EQ(box.dropped(), 0u);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(box.take(milliseconds(0)), i);
+  EXPECT_TRUE(box.wait_for_room(milliseconds(0)));
+  for (int i = 4; i < 10; ++i) box.put(i);
+  EXPECT_EQ(box.dropped(), 2u);  // 4 and 5
+  for (int i = 6; i < 10; ++i) EXPECT_EQ(box.take(milliseconds(0)), i);
+  EXPECT_EQ(box.take(milliseconds(0)), std::nullopt);
 }
 
 }  // namespace
