@@ -110,7 +110,8 @@ void Daemon::run(const Signals& signals) {
     const std::optional<int> signal = signals.wait_for(milliseconds(200));
     if (!signal) continue;
     if (*signal == SIGHUP) {
-      const std::optional<double> period = reload_config(options_.config_file, config_.simulated());
+      const std::optional<double> period =
+          reload_config(options_.config_file, config_.simulated(), config_.security);
       if (period) acquisition_->set_sweep_period(*period);
     } else {
       spdlog::info("signal {}: stopping", *signal);
