@@ -10,7 +10,7 @@
 //   - what reaches the planners of the other cells: the samples of foreign cells their client library
 //     received and ignored (TrackerStats::other_cells), per change and at joining, with their payload bytes
 //     (the serialized size of those samples, wire_size),
-//   - RSS per daemon and per planner, and the load average.
+//   - RSS per daemon and per planner, UDP datagrams dropped for full receive buffers, and the load average.
 // cell-1 sweeps every --change-sweep-period seconds so that a change is seen soon; the other cells sweep
 // every --sweep-period (long: they only keep the machine busy as a plant would).
 // Run it in a network namespace of its own (its domain's ports are fixed): scripts/plant N.
@@ -33,6 +33,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -113,6 +114,20 @@ double rss_mib(pid_t pid) {
     if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
   }
   return NAN;
+}
+
+// UDP datagrams this network namespace dropped because a socket's receive buffer was full (/proc/net/snmp).
+std::uint64_t udp_receive_drops() {
+  std::ifstream in("/proc/net/snmp");
+  std::string names, values;
+  while (std::getline(in, names) && std::getline(in, values)) {
+    if (names.rfind("Udp:", 0) != 0) continue;
+    std::istringstream name_fields(names), value_fields(values);
+    std::string name, value;
+    while (name_fields >> name && value_fields >> value)
+      if (name == "RcvbufErrors") return std::stoull(value);
+  }
+  return 0;
 }
 
 std::string load_average() {
@@ -315,6 +330,7 @@ int run(const Options& options, const std::string& self) {
       options.cells, options.domain, options.sensor.c_str(), options.change_sweep_period,
       options.sweep_period, load_average().c_str());
   std::fflush(stdout);
+  const std::uint64_t drops_at_start = udp_receive_drops();
   const std::int64_t launched_ns = now_ns();
   std::vector<std::unique_ptr<Daemon>> daemons;
   for (int i = 0; i < options.cells; ++i) {
@@ -329,6 +345,7 @@ int run(const Options& options, const std::string& self) {
   std::printf("every cell's first version at the monitor %.1f s after the daemons' start\n",
               static_cast<double>(now_ns() - launched_ns) / 1e9);
 
+  const std::uint64_t drops_before_planners = udp_receive_drops();
   Planners planners(options, self);
   std::vector<double> discovery_ms;
   for (int i = 0; i < options.cells; ++i) {
@@ -346,6 +363,7 @@ int run(const Options& options, const std::string& self) {
       "within %.0f ms of the first start\n",
       percentile(discovery_ms, 0.5), percentile(discovery_ms, 1.0), options.cells,
       static_cast<double>(now_ns() - planners.started_ns(0)) / 1e6);
+  const std::uint64_t drops_after_planners = udp_receive_drops();
 
   // Foreign samples at joining: what the other planners had received once they held their snapshot.
   std::this_thread::sleep_for(std::chrono::seconds(1));  // lets the last foreign counts be reported
@@ -385,6 +403,12 @@ int run(const Options& options, const std::string& self) {
   for (int i = 0; i < options.cells; ++i) planner_rss.push_back(rss_mib(planners.pid(i)));
   print_rss("daemon", daemon_rss);
   print_rss("planner", planner_rss);
+  std::printf(
+      "UDP datagrams dropped, receive buffer full: %llu while the daemons started, %llu while the "
+      "planners joined, %llu during the changes\n",
+      static_cast<unsigned long long>(drops_before_planners - drops_at_start),
+      static_cast<unsigned long long>(drops_after_planners - drops_before_planners),
+      static_cast<unsigned long long>(udp_receive_drops() - drops_after_planners));
   std::printf("load average at the end: %s\n", load_average().c_str());
   daemons.clear();
   fs::remove_all(dir);
