@@ -244,6 +244,7 @@ std::uint64_t latest(const std::vector<PlannerReport>& reports, PlannerReport::K
 struct MonitorView {
   std::map<std::string, std::uint64_t> version;
   std::vector<std::size_t> snapshot_bytes, delta_bytes;  // in arrival order
+  std::vector<std::string> delta_cells;                  // the cell of each of delta_bytes
 
   void take(transport::EnvironmentMonitor& monitor, double timeout_s) {
     const auto timeout =
@@ -256,6 +257,7 @@ struct MonitorView {
         const auto& delta = std::get<EnvironmentDelta>(message);
         version[delta.cell] = std::max(version[delta.cell], delta.to_version);
         delta_bytes.push_back(transport::wire_size(delta));
+        delta_cells.push_back(delta.cell);
       }
     }
   }
@@ -318,35 +320,40 @@ void print_rss(const char* what, const std::vector<double>& rss) {
               percentile(rss, 0.0), percentile(rss, 1.0), rss.size());
 }
 
-int run(const Options& options, const std::string& self) {
-  const fs::path program = fs::path(self).parent_path() / "cellmapd";
-  if (!fs::exists(program)) throw Error(program.string() + " is not built");
-  char dir_template[] = "/tmp/cellmap-plant-XXXXXX";
-  if (::mkdtemp(dir_template) == nullptr) throw Error("cannot create a temporary directory");
-  const fs::path dir(dir_template);
-  std::printf(
-      "plant: %d cells on DDS domain %d (%s, cell-1 sweeps every %.2f s, the others every %.1f s); "
-      "load average %s\n",
-      options.cells, options.domain, options.sensor.c_str(), options.change_sweep_period,
-      options.sweep_period, load_average().c_str());
-  std::fflush(stdout);
-  const std::uint64_t drops_at_start = udp_receive_drops();
-  const std::int64_t launched_ns = now_ns();
+// A temporary directory, removed with everything in it when this goes (after the daemons that use it).
+class TemporaryDirectory {
+ public:
+  TemporaryDirectory() {
+    char name[] = "/tmp/cellmap-plant-XXXXXX";
+    if (::mkdtemp(name) == nullptr) throw Error("cannot create a temporary directory");
+    path_ = name;
+  }
+  ~TemporaryDirectory() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::vector<std::unique_ptr<Daemon>> start_daemons(const Options& options, const fs::path& program,
+                                                   const fs::path& dir) {
   std::vector<std::unique_ptr<Daemon>> daemons;
   for (int i = 0; i < options.cells; ++i) {
     daemons.push_back(std::make_unique<Daemon>(program, dir / cell_name(i), cell_name(i),
                                                i == 0 ? options.change_sweep_period : options.sweep_period,
                                                options));
   }
-  const dds::Participant participant(static_cast<std::uint32_t>(options.domain));
-  transport::EnvironmentMonitor monitor(participant);
-  MonitorView view;
-  wait_for_every_cell(monitor, view, options);
-  std::printf("every cell's first version at the monitor %.1f s after the daemons' start\n",
-              static_cast<double>(now_ns() - launched_ns) / 1e9);
+  return daemons;
+}
 
-  const std::uint64_t drops_before_planners = udp_receive_drops();
-  Planners planners(options, self);
+// Waits for every planner's first version and prints the times from its start; returns the foreign samples
+// each had received by then.
+std::vector<std::uint64_t> measure_discovery(const Options& options, Planners& planners) {
   std::vector<double> discovery_ms;
   for (int i = 0; i < options.cells; ++i) {
     if (!planners.wait(i, options.timeout, [](const std::vector<PlannerReport>& reports) {
@@ -363,55 +370,94 @@ int run(const Options& options, const std::string& self) {
       "within %.0f ms of the first start\n",
       percentile(discovery_ms, 0.5), percentile(discovery_ms, 1.0), options.cells,
       static_cast<double>(now_ns() - planners.started_ns(0)) / 1e6);
-  const std::uint64_t drops_after_planners = udp_receive_drops();
-
-  // Foreign samples at joining: what the other planners had received once they held their snapshot.
-  std::this_thread::sleep_for(std::chrono::seconds(1));  // lets the last foreign counts be reported
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // lets the planners report their last counts
   std::vector<std::uint64_t> joined(options.cells);
-  for (int i = 1; i < options.cells; ++i) joined[i] = latest(planners.reports(i), PlannerReport::kOtherCells);
+  for (int i = 0; i < options.cells; ++i) joined[i] = latest(planners.reports(i), PlannerReport::kOtherCells);
+  return joined;
+}
 
-  const transport::SceneEditWriter writer(participant);
-  if (!writer.wait_for_reader(std::chrono::seconds(static_cast<int>(options.timeout))))
-    throw Error("no daemon's scene-edit reader matched");
-  const std::size_t deltas_before = view.delta_bytes.size();
-  const Latencies latencies = inject_changes(options, planners, monitor, view, writer);
-  std::this_thread::sleep_for(std::chrono::seconds(1));
-  view.take(monitor, 0.1);
-  const std::size_t deltas = view.delta_bytes.size() - deltas_before;
-
+void print_latencies(const Latencies& latencies) {
   std::printf(
       "delta latency at cell-1's planner (%zu changes): version stamp to planner p50 %.1f ms, p99 %.1f "
       "ms; inject to planner (sweeps included) p50 %.0f ms, p99 %.0f ms\n",
       latencies.from_stamp_ms.size(), percentile(latencies.from_stamp_ms, 0.5),
       percentile(latencies.from_stamp_ms, 0.99), percentile(latencies.from_inject_ms, 0.5),
       percentile(latencies.from_inject_ms, 0.99));
-  std::vector<double> foreign_per_delta, foreign_at_join;
+}
+
+// What reached the planners of cells 2..N: foreign samples per delta of another cell since `deltas_before`
+// (other cells may make a version meanwhile too), and at joining.
+void print_foreign(const Options& options, Planners& planners, const MonitorView& view,
+                   const std::vector<std::uint64_t>& joined, std::size_t deltas_before) {
+  std::vector<double> per_delta, at_join;
   for (int i = 1; i < options.cells; ++i) {
     const std::uint64_t total = latest(planners.reports(i), PlannerReport::kOtherCells);
-    foreign_per_delta.push_back(deltas ? static_cast<double>(total - joined[i]) / static_cast<double>(deltas)
-                                       : NAN);
-    foreign_at_join.push_back(static_cast<double>(joined[i]));
+    const auto foreign_deltas =
+        std::count_if(view.delta_cells.begin() + static_cast<std::ptrdiff_t>(deltas_before),
+                      view.delta_cells.end(), [&](const std::string& cell) { return cell != cell_name(i); });
+    per_delta.push_back(
+        foreign_deltas ? static_cast<double>(total - joined[i]) / static_cast<double>(foreign_deltas) : NAN);
+    at_join.push_back(static_cast<double>(joined[i]));
   }
   std::printf(
-      "at a planner of another cell: %.2f foreign samples per change (%zu deltas on the domain, "
+      "at a planner of another cell: %.2f foreign samples per foreign delta (%zu deltas on the domain, "
       "%.0f B payload each), %.0f foreign samples at joining (snapshots %.0f B, deltas %.0f B "
       "payload on average)\n",
-      percentile(foreign_per_delta, 0.5), deltas, mean_bytes(view.delta_bytes, deltas_before),
-      percentile(foreign_at_join, 0.5), mean_bytes(view.snapshot_bytes), mean_bytes(view.delta_bytes));
+      percentile(per_delta, 0.5), view.delta_bytes.size() - deltas_before,
+      mean_bytes(view.delta_bytes, deltas_before), percentile(at_join, 0.5), mean_bytes(view.snapshot_bytes),
+      mean_bytes(view.delta_bytes));
+}
+
+void print_memory(const std::vector<std::unique_ptr<Daemon>>& daemons, const Planners& planners, int cells) {
   std::vector<double> daemon_rss, planner_rss;
   for (const auto& d : daemons) daemon_rss.push_back(rss_mib(d->pid()));
-  for (int i = 0; i < options.cells; ++i) planner_rss.push_back(rss_mib(planners.pid(i)));
+  for (int i = 0; i < cells; ++i) planner_rss.push_back(rss_mib(planners.pid(i)));
   print_rss("daemon", daemon_rss);
   print_rss("planner", planner_rss);
+}
+
+int run(const Options& options, const std::string& self) {
+  const fs::path program = fs::path(self).parent_path() / "cellmapd";
+  if (!fs::exists(program)) throw Error(program.string() + " is not built");
+  const TemporaryDirectory dir;
+  std::printf(
+      "plant: %d cells on DDS domain %d (%s, cell-1 sweeps every %.2f s, the others every %.1f s); "
+      "load average %s\n",
+      options.cells, options.domain, options.sensor.c_str(), options.change_sweep_period,
+      options.sweep_period, load_average().c_str());
+  std::fflush(stdout);
+  std::vector<std::uint64_t> drops{udp_receive_drops()};  // at each phase's start
+  const std::int64_t launched_ns = now_ns();
+  const auto daemons = start_daemons(options, program, dir.path());
+  const dds::Participant participant(static_cast<std::uint32_t>(options.domain));
+  transport::EnvironmentMonitor monitor(participant);
+  MonitorView view;
+  wait_for_every_cell(monitor, view, options);
+  std::printf("every cell's first version at the monitor %.1f s after the daemons' start\n",
+              static_cast<double>(now_ns() - launched_ns) / 1e9);
+
+  drops.push_back(udp_receive_drops());
+  Planners planners(options, self);
+  const std::vector<std::uint64_t> joined = measure_discovery(options, planners);
+
+  drops.push_back(udp_receive_drops());
+  const transport::SceneEditWriter writer(participant);
+  if (!writer.wait_for_reader(std::chrono::seconds(static_cast<int>(options.timeout))))
+    throw Error("no daemon's scene-edit reader matched");
+  const std::size_t deltas_before = view.delta_bytes.size();
+  print_latencies(inject_changes(options, planners, monitor, view, writer));
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // lets the planners report their last counts
+  view.take(monitor, 0.1);
+  print_foreign(options, planners, view, joined, deltas_before);
+  print_memory(daemons, planners, options.cells);
+  drops.push_back(udp_receive_drops());
   std::printf(
       "UDP datagrams dropped, receive buffer full: %llu while the daemons started, %llu while the "
       "planners joined, %llu during the changes\n",
-      static_cast<unsigned long long>(drops_before_planners - drops_at_start),
-      static_cast<unsigned long long>(drops_after_planners - drops_before_planners),
-      static_cast<unsigned long long>(udp_receive_drops() - drops_after_planners));
+      static_cast<unsigned long long>(drops[1] - drops[0]),
+      static_cast<unsigned long long>(drops[2] - drops[1]),
+      static_cast<unsigned long long>(drops[3] - drops[2]));
   std::printf("load average at the end: %s\n", load_average().c_str());
-  daemons.clear();
-  fs::remove_all(dir);
   return 0;
 }
 
