@@ -8,8 +8,8 @@
 //   - discovery: the time from a planner's start until it holds its cell's snapshot (p50, max),
 //   - delta latency to cell-1's planner, from the version's stamp (the daemon made it) and from the inject,
 //   - what reaches the planners of the other cells: the samples of foreign cells their client library
-//     received and ignored (TrackerStats::other_cells), per change and at joining, with their payload bytes
-//     (the serialized size of those samples, wire_size),
+//     received and ignored (TrackerStats::other_cells), per delta of another cell and at joining, with their
+//     payload bytes (the serialized size of those samples, wire_size),
 //   - RSS per daemon and per planner, UDP datagrams dropped for full receive buffers, and the load average.
 // cell-1 sweeps every --change-sweep-period seconds so that a change is seen soon; the other cells sweep
 // every --sweep-period (long: they only keep the machine busy as a plant would).
@@ -21,7 +21,6 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
