@@ -71,6 +71,8 @@ class ReportingChild {
   ReportingChild& operator=(const ReportingChild&) = delete;
 
   [[nodiscard]] int in_fd() const { return in_; }
+  /// The child's process id (-1 once stopped).
+  [[nodiscard]] pid_t pid() const { return pid_; }
   /// Ends the child (once): a reader of in_fd() then sees end of file.
   void stop() {
     if (pid_ <= 0) return;

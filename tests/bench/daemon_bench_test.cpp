@@ -2,36 +2,18 @@
 // of both cameras and its subscriber receives the versions it publishes. Speed is not asserted here.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <regex>
 #include <string>
 
+#include "bench/bench_run.hpp"
 #include "support/dds_domains.hpp"
-#include "support/test_support.hpp"
 
 namespace {
 
-struct BenchRun {
-  int exit_code = -1;
-  std::string output;
-};
+using cellmap::test::BenchRun;
+using cellmap::test::number_after;
 
 BenchRun run_bench(const std::string& arguments) {
-  const std::string command = std::string(CELLMAP_BENCH_DAEMON) + " " + arguments + " 2>&1";
-  BenchRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) run.output += buffer;
-  run.exit_code = cellmap::test::exit_code(::pclose(pipe));
-  return run;
-}
-
-// The number after `label` in `text`, or -1.
-long number_after(const std::string& text, const std::string& label) {
-  std::smatch match;
-  if (!std::regex_search(text, match, std::regex(label + " *([0-9]+)"))) return -1;
-  return std::stol(match[1]);
+  return cellmap::test::run_bench(CELLMAP_BENCH_DAEMON, arguments);
 }
 
 TEST(DaemonBenchTest, FusesEveryFrameOfBothCamerasAtALowRate) {

@@ -94,4 +94,8 @@ inline constexpr int kRobotLayer = 136;
 // daemon_bench_test: `cellmap bench daemon` at a low rate (its subscriber in a process of its own).
 inline constexpr int kBenchDaemon = 230;
 
+// plant_bench_test: `cellmap bench plant` with two cells (218 is also the benchmark's default; 219 is kept
+// for a second plant run beside it).
+inline constexpr int kBenchPlant = 219;
+
 }  // namespace cellmap::test::domain

@@ -51,8 +51,12 @@ TEST(EnvironmentTrackerTest, OldDuplicateAndForeignSamplesAreIgnored) {
   EXPECT_TRUE(tracker.on_snapshot(h.versions[2]).empty());
   EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty());
   EXPECT_TRUE(tracker.on_snapshot(Environment("cell-b", 9, 0, {})).empty());
+  EnvironmentDelta foreign = h.deltas[3];
+  foreign.cell = "cell-b";
+  EXPECT_TRUE(tracker.on_delta(foreign).empty());
   EXPECT_EQ(tracker.environment()->version(), 3u);
   EXPECT_FALSE(tracker.needs_snapshot());
+  EXPECT_EQ(tracker.stats().other_cells, 2u);  // the foreign snapshot and delta, not the old own samples
 }
 
 TEST(EnvironmentTrackerTest, GapHoldsDeltasUntilASnapshotResyncs) {

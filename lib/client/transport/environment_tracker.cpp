@@ -15,7 +15,10 @@ EnvironmentTracker::EnvironmentTracker(std::string cell) : cell_(std::move(cell)
 
 std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment& snapshot) {
   std::vector<EnvironmentUpdate> updates;
-  if (snapshot.cell() != cell_) return updates;
+  if (snapshot.cell() != cell_) {
+    ++stats_.other_cells;
+    return updates;
+  }
   if (current_ && (snapshot.version() < current_->version() ||
                    (snapshot.version() == current_->version() && !out_of_sync_))) {
     return updates;
@@ -33,7 +36,11 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment
 
 std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDelta& delta) {
   std::vector<EnvironmentUpdate> updates;
-  if (delta.cell != cell_ || delta.to_version <= delta.from_version) return updates;
+  if (delta.cell != cell_) {
+    ++stats_.other_cells;
+    return updates;
+  }
+  if (delta.to_version <= delta.from_version) return updates;
   if (delta.from_version == 0 && current_) {
     // From nothing: the whole environment (a restarted publisher's first version). Without a local copy yet
     // it is held like any delta: the snapshot topic brings the current version, not a replay of history.

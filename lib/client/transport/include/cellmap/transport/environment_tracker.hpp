@@ -25,6 +25,7 @@ struct TrackerStats final {
   std::uint64_t snapshots_applied = 0;  ///< the first copy plus every resync
   std::uint64_t gaps = 0;               ///< deltas that did not start at the local version (missed versions)
   std::uint64_t rejected = 0;           ///< deltas that did not fit the local copy (apply() threw)
+  std::uint64_t other_cells = 0;        ///< snapshots and deltas of other cells, received and ignored
 };
 
 /// Keeps a local copy of `cell`. Deltas are applied in version order; a delta that does not start at the
