@@ -91,21 +91,25 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
   return penetration_witnesses(a, b, rel, std::max(-axis.gap, 0.0), axis.axis);
 }
 
-// The alternating projections (with jumps) from where project_twice left them, then the separating axes and
-// GJK.
-SignedDistance signed_distance_iterated(const Obb& a, const Obb& b,
-                                        const ProjectionLanes<double>& projection) {
-  RelativePose rel;
-  std::copy(projection.R, projection.R + 9, rel.R.data());
-  std::copy(projection.t, projection.t + 3, rel.t.data());
+// The pairs project_twice leaves open: the rounds of projections from where it left them (mostly one round:
+// crossing edges in closed form), then the separating axes and GJK.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+SignedDistance
+signed_distance_open(const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
   double p[3] = {projection.p[0], projection.p[1], projection.p[2]};
   double y[3] = {projection.y[0], projection.y[1], projection.y[2]};
   double q[3];
-  if (mutually_closest_points_from(a.half_extents, b.half_extents, rel, projection.scale2, p, y, q)) {
+  if (mutually_closest_points_from(a.half_extents.data(), b.half_extents.data(), projection.R, projection.t,
+                                   projection.scale2, p, y, q)) {
     const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
     const double distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
     if (distance2 > kClearlySeparated2 * projection.scale2) return separated_in_cell(a, p, gap, distance2);
   }
+  RelativePose rel;
+  std::copy(projection.R, projection.R + 9, rel.R.data());
+  std::copy(projection.t, projection.t + 3, rel.t.data());
   return signed_distance_by_axes(a, b, rel);
 }
 
@@ -115,7 +119,7 @@ SignedDistance signed_distance(const Obb& a, const Obb& b) {
   ProjectionLanes<double> projection;
   project_twice(view_of(a), view_of(b), &projection);
   if (projection.certified[0]) return separated_in_cell(a, projection.p, projection.gap, projection.gap2);
-  return signed_distance_iterated(a, b, projection);
+  return signed_distance_open(a, b, projection);
 }
 
 }  // namespace cellmap::collision
