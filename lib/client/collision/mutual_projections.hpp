@@ -49,8 +49,10 @@ inline constexpr int kEdgeDirection[8] = {-1, 0,  1,  -1,
                                           2,  -1, -1, -1};            // the free coordinate of an edge point
 inline constexpr int kFaceNormal[8] = {-1, -1, -1, 2, -1, 1, 0, -1};  // the fixed coordinate of a face point
 
-// Below this |cos| (resp. sin^2) an edge counts as parallel to a face (resp. an edge): the closest points are
-// then not unique and the projections settle on one pair by themselves.
+// Below this |cos| (resp. sin^2) an edge counts as parallel to a face (resp. an edge). An edge parallel to a
+// face projects onto it in one step. Two nearly parallel edges do not: the projections creep along them by
+// steps of the order of the angle, too small for the certificate to tell from convergence, so such pairs are
+// left to the separating axes.
 inline constexpr double kParallel = 1e-9;
 
 // x_k on an edge of its box (free coordinate k, half extent h) facing the other box's face, whose outward
@@ -92,11 +94,13 @@ namespace mutual_projections_detail {
 // those edges, p on an edge facing B's face (or y on an edge facing A's face) to the edge's end nearest that
 // face; y follows p as B's point closest to it. Then p' = A's point closest to y (q = y in A's frame) and y'
 // = B's point closest to p'. Mutually closest when y is B's point closest to p and p' repeats p, or y'
-// repeats y: returns true with p' in p and q. Else p = p', y = y' for the next round.
+// repeats y: returns kMutuallyClosest with p' in p and q. Else p = p', y = y' for the next round, or
+// kParallelEdges.
+enum class Round { kMutuallyClosest, kNext, kParallelEdges };
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
-inline bool
+inline Round
 projection_round(const double* ha, const double* hb, const double* R, const double* t, double tolerance2,
                  double* p, double* y, double* q) {
   const int p_free = free_coordinates(p, ha);
@@ -105,7 +109,8 @@ projection_round(const double* ha, const double* hb, const double* R, const doub
   const int j = kEdgeDirection[y_free];
   bool y_fits = true;  // y is B's point closest to p
   if (i >= 0 && j >= 0) {
-    if (move_to_crossing_edges(ha, hb, R, t, i, j, p, y)) closest_in_b(R, t, hb, p, y);
+    if (!move_to_crossing_edges(ha, hb, R, t, i, j, p, y)) return Round::kParallelEdges;
+    closest_in_b(R, t, hb, p, y);
   } else if (i >= 0 && kFaceNormal[y_free] >= 0) {
     const int face = kFaceNormal[y_free];  // B's face normal in A's frame: sign(y_face) R.col(face)
     if (y[face] != 0.0 && step_to_edge_end(y[face] > 0.0 ? R[i + 3 * face] : -R[i + 3 * face], ha[i], &p[i]))
@@ -118,13 +123,13 @@ projection_round(const double* ha, const double* hb, const double* R, const doub
   b_to_a(R, t, y, q);
   double p_next[3];
   closest_in_a(ha, q, p_next);
-  if (y_fits && distance2(p_next, p) <= tolerance2) return true;
+  if (y_fits && distance2(p_next, p) <= tolerance2) return Round::kMutuallyClosest;
   std::copy(p_next, p_next + 3, p);
   double y_next[3];
   closest_in_b(R, t, hb, p, y_next);
-  const bool y_repeats = distance2(y_next, y) <= tolerance2;
-  if (!y_repeats) std::copy(y_next, y_next + 3, y);
-  return y_repeats;
+  if (distance2(y_next, y) <= tolerance2) return Round::kMutuallyClosest;
+  std::copy(y_next, y_next + 3, y);
+  return Round::kNext;
 }
 
 }  // namespace mutual_projections_detail
@@ -144,7 +149,9 @@ mutually_closest_points_from(const double* ha, const double* hb, const double* R
                              double scale2, double* p, double* y, double* q) {
   constexpr int kRounds = 4;
   for (int round = 0; round < kRounds; ++round) {
-    if (mutual_projections_detail::projection_round(ha, hb, R, t, 1e-26 * scale2, p, y, q)) return true;
+    using mutual_projections_detail::Round;
+    const Round outcome = mutual_projections_detail::projection_round(ha, hb, R, t, 1e-26 * scale2, p, y, q);
+    if (outcome != Round::kNext) return outcome == Round::kMutuallyClosest;
   }
   return false;
 }
