@@ -45,9 +45,9 @@ inline double distance2(const double* u, const double* v) {
 inline int free_coordinates(const double* x, const double* h) {
   return int(std::abs(x[0]) < h[0]) | int(std::abs(x[1]) < h[1]) << 1 | int(std::abs(x[2]) < h[2]) << 2;
 }
-inline constexpr int kEdgeDirection[8] = {-1, 0,  1,  -1,
-                                          2,  -1, -1, -1};            // the free coordinate of an edge point
-inline constexpr int kFaceNormal[8] = {-1, -1, -1, 2, -1, 1, 0, -1};  // the fixed coordinate of a face point
+// The free coordinate of an edge point, the fixed coordinate of a face point (-1: not that feature).
+inline constexpr int kEdgeDirection[8] = {-1, 0, 1, -1, 2, -1, -1, -1};
+inline constexpr int kFaceNormal[8] = {-1, -1, -1, 2, -1, 1, 0, -1};
 
 // Below this |cos| (resp. sin^2) an edge counts as parallel to a face (resp. an edge). An edge parallel to a
 // face projects onto it in one step. Two nearly parallel edges do not: the projections creep along them by
@@ -84,10 +84,6 @@ inline bool move_to_crossing_edges(const double* ha, const double* hb, const dou
   y[j] = clamp(dr + p[i] * c, hb[j]);
   return true;
 }
-
-}  // namespace mutual_projections_detail
-
-namespace mutual_projections_detail {
 
 // One round from A's point p and B's point y closest to it (B's coordinates). First the jumps, in closed
 // form, where plain projections would zig-zag: p and y on two crossing edges move to the closest points of
