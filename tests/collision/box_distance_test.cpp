@@ -132,6 +132,73 @@ TEST(BoxDistanceTest, EdgeEdgeCrossed) {
   }
 }
 
+// A bar along x turned 45 degrees about its length (an edge up, at z = sqrt(1/2)) and a bar above it along
+// (cos angle, sin angle, 0) turned the same way (an edge down), its centre above the point (0.3, 0): the two
+// edges are skew lines `gap` apart in z, closest at (0.3, 0).
+void expect_crossing_edges(double angle, double gap, bool check_points) {
+  const double reach = std::sqrt(0.5);
+  const Obb a(Vector3d::Zero(), Vector3d(2, 0.5, 0.5), rotation(M_PI / 4, Vector3d::UnitX()));
+  const Obb b(Vector3d(0.3, 0, 2 * reach + gap), Vector3d(1.5, 0.5, 0.5),
+              rotation(angle, Vector3d::UnitZ()) * rotation(M_PI / 4, Vector3d::UnitX()));
+  expect_in_all_frames(a, b, {gap, {0.3, 0, reach}, {0.3, 0, reach + gap}, check_points});
+}
+
+TEST(BoxDistanceTest, EdgeEdgeAtAnglesDownToParallel) {
+  for (const double angle : {1.2, 0.3, 1e-2, 1e-3}) {
+    for (const double gap : {0.7, 1e-3, 1e-9, 1e-12, 0.0}) {
+      SCOPED_TRACE(testing::Message() << "angle " << angle << " gap " << gap);
+      expect_crossing_edges(angle, gap, true);
+    }
+  }
+  // Nearly parallel (sin^2 of the angle at or below 1e-9) and parallel: the closest points are not unique
+  // (or barely), the distance is. The projections creep along such edges; they must not stop early.
+  for (const double angle : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 0.0}) {
+    for (const double gap : {0.7, 1e-3, 1e-6}) {
+      SCOPED_TRACE(testing::Message() << "angle " << angle << " gap " << gap);
+      expect_crossing_edges(angle, gap, false);
+    }
+  }
+  // Touching, down to 1e-6 rad: nearer to parallel the separating axes that give the depth lose up to ~1e-8 m
+  // (a nearly degenerate edge-edge axis).
+  for (const double angle : {1e-4, 1e-5, 1e-6, 0.0}) {
+    SCOPED_TRACE(testing::Message() << "angle " << angle);
+    expect_crossing_edges(angle, 0.0, false);
+  }
+}
+
+TEST(BoxDistanceTest, DegenerateThinBoxesCrossing) {
+  // Boxes with zero half extents: segments (one free coordinate, all edge) and a plate.
+  const Obb along_x(Vector3d::Zero(), Vector3d(2, 0, 0));
+  for (const double angle : {M_PI / 2, 0.4, 1e-3}) {
+    SCOPED_TRACE(angle);
+    const Obb segment(Vector3d(0.3, 0, 1.0), Vector3d(1, 0, 0), rotation(angle, Vector3d::UnitZ()));
+    expect_in_all_frames(along_x, segment, {1.0, {0.3, 0, 0}, {0.3, 0, 1.0}, true});
+    const Obb touching(Vector3d(0.3, 0, 0), Vector3d(1, 0, 0), rotation(angle, Vector3d::UnitZ()));
+    expect_in_all_frames(along_x, touching, {0.0, {}, {}, false});
+  }
+  // A plate (zero thickness) under a tilted segment whose low end lies over the plate.
+  const Obb plate(Vector3d::Zero(), Vector3d(1, 1, 0));
+  const Matrix3d tilt = rotation(std::atan2(0.5, 2.0), -Vector3d::UnitY());  // along (2, 0, 0.5)/|.|
+  const Obb tilted(Vector3d(1.0, 0.2, 0.3), Vector3d(std::hypot(2.0, 0.5) / 2, 0, 0), tilt);
+  // The segment runs from (0, 0.2, 0.05) to (2, 0.2, 0.55): its low end lies over the plate at 0.05.
+  expect_in_all_frames(plate, tilted, {0.05, {0, 0.2, 0}, {0, 0.2, 0.05}, true});
+}
+
+TEST(BoxDistanceTest, BarEndTowardsAFace) {
+  // A bar turned 45 degrees about its length, then tilted by 0.2 rad about y, above a wide slab: its lowest
+  // point is the end of its lowest edge, the vertex (hx, -hy, -hz), hx sin(0.2) + sqrt(2) hy cos(0.2) below
+  // its centre.
+  const Obb slab(Vector3d(0, 0, -0.5), Vector3d(3, 3, 0.5));
+  const Matrix3d R = rotation(0.2, Vector3d::UnitY()) * rotation(M_PI / 4, Vector3d::UnitX());
+  const double drop = 1.0 * std::sin(0.2) + std::sqrt(2.0) * 0.1 * std::cos(0.2);
+  for (const double gap : {0.4, 1e-9, 0.0}) {
+    SCOPED_TRACE(gap);
+    const Obb bar(Vector3d(0.1, -0.3, drop + gap), Vector3d(1.0, 0.1, 0.1), R);
+    const Vector3d lowest = bar.center + R * Vector3d(1.0, -0.1, -0.1);
+    expect_in_all_frames(slab, bar, {gap, {lowest.x(), lowest.y(), 0.0}, lowest, true});
+  }
+}
+
 TEST(BoxDistanceTest, IdenticalBoxesPenetrateByTheirSmallestWidth) {
   const Obb a(Vector3d(1, 2, 3), Vector3d(0.3, 0.1, 0.7), rotation(0.4, Vector3d(1, 2, 3)));
   expect_in_all_frames(a, a, {-0.2, {}, {}, false});

@@ -184,6 +184,36 @@ TEST(FclCrossCheckTest, HundredThousandRandomBoxPairs) {
   EXPECT_GT(overlapping, kPairs / 5);
 }
 
+TEST(FclCrossCheckTest, CrossingEdgesDownToParallelAgainstTheReferee) {
+  // Two bars turned so that an edge of each faces the other, at angles from crossing to parallel, offset so
+  // that the closest points fall inside the edges, at their ends or past them, from far apart to touching.
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Matrix3d edge_up = Eigen::AngleAxisd(M_PI / 4, Vector3d::UnitX()).matrix();
+  int compared = 0;
+  double worst = 0.0;
+  for (int i = 0; i < 4000; ++i) {
+    const double angle = std::pow(10.0, -10.0 * std::abs(u(rng))) * (i % 2 ? 1.0 : -1.0);
+    const double reach = std::sqrt(0.5) * 0.5;
+    const Obb a(Vector3d::Zero(), Vector3d(1.0, 0.25, 0.25), edge_up);
+    const double gap = std::pow(10.0, -12.0 * std::abs(u(rng)));
+    const Eigen::Matrix3d tilt =
+        Eigen::AngleAxisd(0.05 * u(rng), Vector3d(u(rng), u(rng), u(rng)).normalized()).matrix();
+    const Obb b(Vector3d(1.5 * u(rng), 0.3 * u(rng), 2 * reach + gap), Vector3d(0.8, 0.25, 0.25),
+                tilt * Eigen::AngleAxisd(angle, Vector3d::UnitZ()).matrix() * edge_up);
+    const SignedDistance ours = signed_distance(a, b);
+    ASSERT_TRUE(std::isfinite(ours.distance) && ours.point_a.allFinite() && ours.point_b.allFinite() &&
+                ours.normal.allFinite());
+    if (ours.distance <= 0.0) continue;
+    const double referee = brute_force_distance(a, b);
+    worst = std::max(worst, std::abs(ours.distance - referee));
+    ASSERT_NEAR(ours.distance, referee, 1e-9) << "pair " << i;
+    ++compared;
+  }
+  std::printf("crossing edges: %d separated pairs, worst against the referee %.3g\n", compared, worst);
+  EXPECT_GT(compared, 2000);
+}
+
 TEST(FclCrossCheckTest, KnownFclLibccdBug508) {
   // Unit cubes 4 apart on y: the answer is 3. FCL's default libccd solver answers sqrt(10) = 3.16228
   // (fcl#508); GST_INDEP gets it right. Should a later FCL fix it, the libccd answer becomes 3 and this still

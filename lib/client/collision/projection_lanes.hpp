@@ -162,7 +162,8 @@ project_twice(const BoxView<T>& a, const BoxView<T>& b, ProjectionLanes<T>* io) 
   }
   io->gap2 = gap2;
   const T tolerance2 = 1e-26 * io->scale2;
-  const auto certified = ((moved_p <= tolerance2) | (moved_y <= tolerance2)) & (gap2 > 1e-24 * io->scale2);
+  // Nearer pairs (1e-3 of the scene size) need the check of signed_distance.cpp's certified_apart.
+  const auto certified = ((moved_p <= tolerance2) | (moved_y <= tolerance2)) & (gap2 > 1e-6 * io->scale2);
   for (int l = 0; l < ProjectionLanes<T>::kLanes; ++l) {
     io->certified[l] = projection_lanes_detail::mask_lane(certified, l);
   }

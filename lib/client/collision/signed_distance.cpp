@@ -17,20 +17,51 @@ double scale2_of(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel
   return ha.squaredNorm() + hb.squaredNorm() + rel.t.squaredNorm();
 }
 
-// Separations below this (squared, relative to scale2) count as touching: the direction between the points
-// is then rounding, and the separating axes decide instead.
-constexpr double kClearlySeparated2 = 1e-24;
+// The separation of the boxes along the unit direction n (A's frame), a lower bound of their distance:
+// n.t minus the reach of A and of B along n.
+double separation_along(const double* ha, const double* hb, const double* R, const double* t,
+                        const double* n) {
+  double separation = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
+  for (int k = 0; k < 3; ++k) {
+    separation -= ha[k] * std::abs(n[k]) +
+                  hb[k] * std::abs(R[3 * k] * n[0] + R[3 * k + 1] * n[1] + R[3 * k + 2] * n[2]);
+  }
+  return separation;
+}
+
+// A's point p and B's point q (A's frame), certified mutually closest by the projections, as a closest pair
+// `distance2` apart. The projections certify to their step tolerance only: between nearly parallel features
+// they creep by steps of the order of the angle, and the pair can then be off by up to ~1e-13 scale^2 /
+// distance. So pairs nearer than kClearlySeparated (relative to the scene size, where that stays below
+// ~1e-11 m) must also reach the separation along their own direction; nearer than kTouching the direction
+// is rounding, and the separating axes decide instead.
+constexpr double kClearlySeparated2 = 1e-6;
+constexpr double kTouching2 = 1e-24;
+bool near_pair_certified(const double* ha, const double* hb, const double* R, const double* t, double scale2,
+                         const double* gap, double distance2) {
+  if (!(distance2 > kTouching2 * scale2)) return false;
+  const double distance = std::sqrt(distance2);
+  const double n[3] = {gap[0] / distance, gap[1] / distance, gap[2] / distance};
+  return distance - separation_along(ha, hb, R, t, n) <= 1e-10 * std::sqrt(scale2);
+}
+inline bool certified_apart(const double* ha, const double* hb, const double* R, const double* t,
+                            double scale2, const double* gap, double* distance2) {
+  *distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
+  return *distance2 > kClearlySeparated2 * scale2 ||
+         near_pair_certified(ha, hb, R, t, scale2, gap, *distance2);
+}
 
 }  // namespace
 
 bool clearly_separated(const Vector3d& ha, const Vector3d& hb, const RelativePose& rel, GjkResult* result) {
   const double scale2 = scale2_of(ha, hb, rel);
-  double p[3], q[3];
+  double p[3], q[3], distance2;
   if (!mutually_closest_points(ha, hb, rel, scale2, p, q)) return false;
+  const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  if (!certified_apart(ha.data(), hb.data(), rel.R.data(), rel.t.data(), scale2, gap, &distance2))
+    return false;
   result->point_a = Vector3d(p[0], p[1], p[2]);
   result->point_b = Vector3d(q[0], q[1], q[2]);
-  const double distance2 = (result->point_b - result->point_a).squaredNorm();
-  if (!(distance2 > kClearlySeparated2 * scale2)) return false;
   result->distance = std::sqrt(distance2);
   return true;
 }
@@ -91,21 +122,28 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
   return penetration_witnesses(a, b, rel, std::max(-axis.gap, 0.0), axis.axis);
 }
 
-// The alternating projections (with jumps) from where project_twice left them, then the separating axes and
-// GJK.
-SignedDistance signed_distance_iterated(const Obb& a, const Obb& b,
-                                        const ProjectionLanes<double>& projection) {
-  RelativePose rel;
-  std::copy(projection.R, projection.R + 9, rel.R.data());
-  std::copy(projection.t, projection.t + 3, rel.t.data());
+// The pairs project_twice leaves open: the rounds of projections from where it left them (mostly one round:
+// crossing edges in closed form), then the separating axes and GJK.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+SignedDistance
+signed_distance_open(const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
   double p[3] = {projection.p[0], projection.p[1], projection.p[2]};
   double y[3] = {projection.y[0], projection.y[1], projection.y[2]};
   double q[3];
-  if (mutually_closest_points_from(a.half_extents, b.half_extents, rel, projection.scale2, p, y, q)) {
+  const double* ha = a.half_extents.data();
+  const double* hb = b.half_extents.data();
+  if (mutually_closest_points_from(ha, hb, projection.R, projection.t, projection.scale2, p, y, q)) {
     const double gap[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-    const double distance2 = gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2];
-    if (distance2 > kClearlySeparated2 * projection.scale2) return separated_in_cell(a, p, gap, distance2);
+    double distance2;
+    if (certified_apart(ha, hb, projection.R, projection.t, projection.scale2, gap, &distance2)) {
+      return separated_in_cell(a, p, gap, distance2);
+    }
   }
+  RelativePose rel;
+  std::copy(projection.R, projection.R + 9, rel.R.data());
+  std::copy(projection.t, projection.t + 3, rel.t.data());
   return signed_distance_by_axes(a, b, rel);
 }
 
@@ -115,7 +153,7 @@ SignedDistance signed_distance(const Obb& a, const Obb& b) {
   ProjectionLanes<double> projection;
   project_twice(view_of(a), view_of(b), &projection);
   if (projection.certified[0]) return separated_in_cell(a, projection.p, projection.gap, projection.gap2);
-  return signed_distance_iterated(a, b, projection);
+  return signed_distance_open(a, b, projection);
 }
 
 }  // namespace cellmap::collision
