@@ -163,7 +163,7 @@ void Daemon::process() {
   }
 }
 
-void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
+void Daemon::handle(FrameSweep& sweep, std::uint64_t number) {
   SweepTrace trace;
   trace.number = number;
   trace.sweep = &sweep;
@@ -175,7 +175,7 @@ void Daemon::handle(const FrameSweep& sweep, std::uint64_t number) {
   options_.on_sweep(trace);
 }
 
-std::optional<SweepReport> Daemon::run_pipeline(const FrameSweep& sweep, std::uint64_t number) {
+std::optional<SweepReport> Daemon::run_pipeline(FrameSweep& sweep, std::uint64_t number) {
   try {
     SweepReport report = pipeline_.process(sweep);
     health_.sweep_processed(number, wall_clock_ns());
