@@ -66,9 +66,9 @@ class Daemon final {
  private:
   void acquire();
   void process();
-  void handle(const FrameSweep& sweep, std::uint64_t number);
+  void handle(FrameSweep& sweep, std::uint64_t number);
   // Runs the pipeline on the sweep and logs what it did; nullopt if the sweep failed (logged, reported).
-  std::optional<SweepReport> run_pipeline(const FrameSweep& sweep, std::uint64_t number);
+  std::optional<SweepReport> run_pipeline(FrameSweep& sweep, std::uint64_t number);
   // Saves and publishes what the sweep changed: keeper_.flush(), its cost split into saving and publishing.
   void flush(SweepTrace& trace);
   // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the

@@ -29,6 +29,29 @@ TEST(SweepTest, ToScanMovesPointsIntoTheCellAndKeepsTheOrigin) {
   EXPECT_TRUE(scan.points_C[1].getVector3fMap().isApprox(Eigen::Vector3f(0, 2, 5), 1e-6f));
 }
 
+// The frame's own points become the scan's: the same scan as to_scan, bit for bit, and the frame keeps
+// everything but its points.
+TEST(SweepTest, MoveToScanEqualsToScanAndEmptiesTheFramesPoints) {
+  Frame frame = frame_at({1, 2, 3}, 0.3, 0.5);
+  for (int i = 0; i < 1000; ++i) frame.points_S.push_back(pcl::PointXYZ(0.01f * i, 1.0f - 0.002f * i, 2.5f));
+  const Scan copied = to_scan(frame);
+  const pcl::PointXYZ* storage = frame.points_S.points.data();
+  const Scan moved = move_to_scan(frame);
+  EXPECT_EQ(moved.points_C.points.data(), storage);  // transformed where they lay
+  EXPECT_EQ(moved.origin_C, copied.origin_C);
+  ASSERT_EQ(moved.points_C.size(), copied.points_C.size());
+  EXPECT_EQ(moved.points_C.width, copied.points_C.width);
+  EXPECT_EQ(moved.points_C.height, 1u);
+  EXPECT_TRUE(moved.points_C.is_dense);
+  for (std::size_t i = 0; i < moved.points_C.size(); ++i) {
+    EXPECT_EQ(moved.points_C[i].getVector3fMap(), copied.points_C[i].getVector3fMap()) << "point " << i;
+  }
+  EXPECT_TRUE(frame.points_S.empty());
+  EXPECT_EQ(frame.points_S.width, 0u);
+  EXPECT_EQ(frame.sensor, "cam");
+  EXPECT_EQ(frame.stamp, 0.5);
+}
+
 TEST(SweepTest, MergeFramesKeepsOrderAndStampsTheLastFrame) {
   const Sweep sweep = merge_frames({frame_at({0, 0, 1}, 0, 1.0), frame_at({1, 0, 1}, 0, 1.2)});
   ASSERT_EQ(sweep.scans.size(), 2u);

@@ -109,14 +109,15 @@ void CellPipeline::filter_robot(const Robot& robot) {
   filter_ = std::make_unique<SelfFilter>(robot, config_.self_filter);
 }
 
-SweepReport CellPipeline::process(const FrameSweep& frames) {
+SweepReport CellPipeline::process(FrameSweep& frames) {
   Sweep sweep;
   sweep.stamp = frames.stamp;
   std::size_t robot_points = 0, no_return_rays = 0;
   const StageClock filter_clock;
-  for (const SweepFrame& f : frames.frames) {
+  sweep.scans.reserve(frames.frames.size());
+  for (SweepFrame& f : frames.frames) {
     if (!filter_ || !f.robot || !config_.self_filter.enabled) {
-      sweep.scans.push_back(to_scan(f.frame));
+      sweep.scans.push_back(move_to_scan(f.frame));
     } else {
       SelfFilterResult filtered = filter_->filter(f.frame, *f.robot);
       robot_points += filtered.removed;

@@ -7,6 +7,10 @@
 #include <map>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/parallel.hpp"
 
@@ -346,59 +350,92 @@ void run_parallel(int threads, std::size_t n, Fn&& fn) {
 constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
 // OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
-// resolution) + the tree's key offset. new_key() remembers the last voxel as a range of coordinates per axis,
-// because neighbouring pixels mostly share one and six float comparisons are cheaper than the conversion.
+// resolution) + the tree's key offset. Branch-free, so that a run of points costs the same whether or not
+// neighbouring points share a voxel (a branch on that is mispredicted at every voxel border); on SSE2 (every
+// x86-64) a point's three coordinates are converted together.
 class KeyConverter {
  public:
   explicit KeyConverter(const octomap::OcTree& grid)
-      : factor_(1.0 / grid.getResolution()),
-        resolution_(grid.getResolution()),
-        max_val_(int(grid.coordToKey(0.0))) {}
+      : factor_(1.0 / grid.getResolution()), max_val_(int(grid.coordToKey(0.0))) {}
 
   // The packed key of (x, y, z), or kNoKey if a coordinate is not finite or outside the key range.
-  [[nodiscard]] std::uint64_t key(float x, float y, float z) {
+  [[nodiscard]] std::uint64_t key(float x, float y, float z) const {
     const double scaled[3] = {factor_ * double(x), factor_ * double(y), factor_ * double(z)};
-    int floored[3];
-    for (int i = 0; i < 3; ++i) {
-      // floor(s) is in [-max_val, max_val) exactly when s is (max_val is an integer); NaN and infinity fail.
-      if (!(scaled[i] >= -max_val_ && scaled[i] < max_val_)) return kNoKey;
-      const int truncated = int(scaled[i]);
-      floored[i] = truncated - (double(truncated) > scaled[i]);  // floor, without a libm call
-    }
+    const double max_val = max_val_;
+    bool inside = true;
     std::uint64_t packed = 0;
     for (int i = 0; i < 3; ++i) {
-      remember(i, floored[i]);
-      packed |= std::uint64_t(floored[i] + max_val_) << (16 * i);
+      // floor(s) is in [-max_val, max_val) exactly when s is (max_val is an integer); NaN and infinity fail.
+      const bool in_range = (scaled[i] >= -max_val) & (scaled[i] < max_val);
+      inside &= in_range;
+      const double s = in_range ? scaled[i] : 0.0;  // keeps the conversion defined
+      const int truncated = int(s);
+      const int floored = truncated - (double(truncated) > s);  // floor, without a libm call
+      packed |= std::uint64_t(std::uint32_t(floored + max_val_) & 0xffff) << (16 * i);
     }
-    return packed;
+    return inside ? packed : kNoKey;
   }
-  // As key(), but also kNoKey when the point lies in the voxel of the last key returned.
-  [[nodiscard]] std::uint64_t new_key(float x, float y, float z) {
-    // NaN fails every comparison.
-    if ((x >= lo_[0]) & (x < hi_[0]) & (y >= lo_[1]) & (y < hi_[1]) & (z >= lo_[2]) & (z < hi_[2]))
-      return kNoKey;
-    return key(x, y, z);
+
+  // key(p.x, p.y, p.z), bit for bit.
+  [[nodiscard]] std::uint64_t key(const pcl::PointXYZ& p) const {
+#if defined(__SSE2__)
+    const __m128d factor = _mm_set1_pd(factor_);
+    const __m128d low = _mm_set1_pd(-double(max_val_));
+    const __m128d high = _mm_set1_pd(double(max_val_));
+    const __m128 xyzw = _mm_loadu_ps(p.data);  // the fourth lane is PCL's padding, ignored
+    const __m128d xy = _mm_mul_pd(_mm_cvtps_pd(xyzw), factor);
+    const __m128d zw = _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(xyzw, xyzw)), factor);
+    const __m128d xy_in = _mm_and_pd(_mm_cmpge_pd(xy, low), _mm_cmplt_pd(xy, high));
+    const __m128d zw_in = _mm_and_pd(_mm_cmpge_pd(zw, low), _mm_cmplt_pd(zw, high));
+    const bool inside = (_mm_movemask_pd(xy_in) == 3) & ((_mm_movemask_pd(zw_in) & 1) == 1);
+    const __m128i floored = _mm_unpacklo_epi64(floor(_mm_and_pd(xy, xy_in)), floor(_mm_and_pd(zw, zw_in)));
+    const __m128i keys = _mm_add_epi32(floored, _mm_set1_epi32(max_val_));  // x, y, z, (padding)
+    const auto xy_keys = std::uint64_t(_mm_cvtsi128_si64(keys));
+    const auto z_key = std::uint64_t(std::uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(keys, 8))));
+    const std::uint64_t packed =
+        (xy_keys & 0xffff) | ((xy_keys >> 16) & 0xffff0000) | ((z_key & 0xffff) << 32);
+    return inside ? packed : kNoKey;
+#else
+    return key(p.x, p.y, p.z);
+#endif
   }
 
  private:
-  // Coordinates [lo, hi) of voxel `floored` on `axis`, narrowed by 1e-6 of their size (≥ 8 float rounding
-  // steps): every float inside is certainly in that voxel; one just inside the true border goes through
-  // key().
-  void remember(int axis, int floored) {
-    const float lo = static_cast<float>(floored * resolution_);
-    const float hi = static_cast<float>((floored + 1) * resolution_);
-    lo_[axis] = lo + std::fabs(lo) * 1e-6f;
-    hi_[axis] = hi - std::fabs(hi) * 1e-6f;
+#if defined(__SSE2__)
+  // floor() of two doubles in int32 lanes 0 and 1 (lanes 2 and 3 are not used).
+  static __m128i floor(__m128d s) {
+    const __m128i truncated = _mm_cvttpd_epi32(s);
+    const __m128i rounded_up = _mm_castpd_si128(_mm_cmpgt_pd(_mm_cvtepi32_pd(truncated), s));
+    return _mm_add_epi32(truncated, _mm_shuffle_epi32(rounded_up, _MM_SHUFFLE(3, 3, 2, 0)));  // -1 there
   }
+#endif
 
   double factor_;
-  double resolution_;
   int max_val_;
-  float lo_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
-                  std::numeric_limits<float>::quiet_NaN()};
-  float hi_[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
-                  std::numeric_limits<float>::quiet_NaN()};
 };
+
+// Appends to `keys` the packed keys of `points` [begin, end), skipping invalid points and repeats of the
+// previous key (neighbouring pixels mostly share a voxel), and extends `box` by them. Compacts block by
+// block through a small buffer, so that no frame-sized memory is written twice.
+void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator<pcl::PointXYZ>>& points,
+                       std::size_t begin, std::size_t end, const KeyConverter& converter,
+                       std::vector<std::uint64_t>& keys, KeyBox& box) {
+  constexpr std::size_t kBlock = 256;
+  std::uint64_t block[kBlock];
+  std::uint64_t last = kNoKey;
+  for (std::size_t block_begin = begin; block_begin < end; block_begin += kBlock) {
+    const std::size_t block_end = std::min(end, block_begin + kBlock);
+    std::size_t n = 0;
+    for (std::size_t i = block_begin; i < block_end; ++i) {
+      const std::uint64_t packed = converter.key(points[i]);
+      block[n] = packed;
+      n += std::size_t((packed != last) & (packed != kNoKey));
+      last = packed == kNoKey ? last : packed;
+    }
+    for (std::size_t i = 0; i < n; ++i) box.extend(unpack(block[i]));
+    keys.insert(keys.end(), block, block + n);
+  }
+}
 
 // The packed endpoint keys of one scan, per thread chunk of its points (consecutive repeats dropped), and
 // of its clear-only ray ends, with the box of all of them.
@@ -410,20 +447,13 @@ struct ScanKeys {
 
 ScanKeys scan_keys(const Scan& scan, const octomap::OcTree& grid, int threads) {
   const auto& points = scan.points_C.points;
+  const KeyConverter converter(grid);
   ScanKeys out;
   out.points.resize(static_cast<std::size_t>(threads));
   std::vector<KeyBox> boxes(static_cast<std::size_t>(threads));
   run_parallel(threads, points.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
-    KeyConverter converter(grid);
-    std::vector<std::uint64_t>& keys = out.points[t];
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::uint64_t packed = converter.new_key(points[i].x, points[i].y, points[i].z);
-      if (packed == kNoKey) continue;
-      keys.push_back(packed);
-      boxes[t].extend(unpack(packed));
-    }
+    append_point_keys(points, begin, end, converter, out.points[t], boxes[t]);
   });
-  KeyConverter converter(grid);
   for (const pcl::PointXYZ& p : scan.clear_C.points) {
     const std::uint64_t packed = converter.key(p.x, p.y, p.z);
     if (packed == kNoKey) continue;

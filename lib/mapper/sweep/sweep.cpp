@@ -17,6 +17,25 @@ std::size_t Sweep::point_count() const {
   return n;
 }
 
+namespace {
+
+bool finite(const pcl::PointXYZ& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+pcl::PointXYZ to_cell(const Eigen::Isometry3f& X_CS, const pcl::PointXYZ& p_S) {
+  const Eigen::Vector3f p_C = X_CS * p_S.getVector3fMap();
+  return {p_C.x(), p_C.y(), p_C.z()};
+}
+
+void set_unorganized(Cloud& cloud) {
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+}
+
+}  // namespace
+
 Scan to_scan(const Frame& frame) {
   Scan scan;
   scan.origin_C = frame.X_CS.translation();
@@ -24,13 +43,25 @@ Scan to_scan(const Frame& frame) {
   auto& points_C = scan.points_C.points;  // filled directly: the cloud's push_back also rewrites its size
   points_C.reserve(frame.points_S.size());
   for (const pcl::PointXYZ& p : frame.points_S) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-    const Eigen::Vector3f p_C = X_CS * p.getVector3fMap();
-    points_C.emplace_back(p_C.x(), p_C.y(), p_C.z());
+    if (finite(p)) points_C.push_back(to_cell(X_CS, p));
   }
-  scan.points_C.width = static_cast<std::uint32_t>(scan.points_C.size());
-  scan.points_C.height = 1;
-  scan.points_C.is_dense = true;
+  set_unorganized(scan.points_C);
+  return scan;
+}
+
+Scan move_to_scan(Frame& frame) {
+  Scan scan;
+  scan.origin_C = frame.X_CS.translation();
+  const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
+  auto& points = frame.points_S.points;
+  std::size_t kept = 0;
+  for (const pcl::PointXYZ& p : points) {
+    if (finite(p)) points[kept++] = to_cell(X_CS, p);
+  }
+  points.resize(kept);
+  scan.points_C.points.swap(points);
+  set_unorganized(scan.points_C);
+  frame.points_S.clear();
   return scan;
 }
 

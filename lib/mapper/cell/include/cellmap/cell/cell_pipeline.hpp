@@ -128,8 +128,13 @@ class CellPipeline final {
                         const std::optional<std::string>& map_state = std::nullopt);
 
   /// Cuts the robot out of every frame that comes with one (SelfFilter, once filter_robot() was called and
-  /// `self_filter.enabled`), then process(Sweep) on the scans. @throws Error as SelfFilter::filter.
-  SweepReport process(const FrameSweep& sweep);
+  /// `self_filter.enabled`), then process(Sweep) on the scans. The frames that pass unfiltered give their
+  /// points to their scans (move_to_scan: transformed where they lie, not copied), so those frames'
+  /// points_S are empty afterwards; every frame keeps its pose, stamp and depth image for the caller.
+  /// @throws Error as SelfFilter::filter.
+  SweepReport process(FrameSweep& sweep);
+  /// process(sweep) for a sweep nobody reads afterwards.
+  SweepReport process(FrameSweep&& sweep) { return process(sweep); }
   /// The robot the self filter cuts out of the frames from now on (its shapes padded once, here).
   /// @throws Error if the self-filter config is invalid.
   void filter_robot(const Robot& robot);
@@ -143,8 +148,8 @@ class CellPipeline final {
   SweepReport process(const Sweep& sweep);
 
   /// Takes one cloud (metres, cell frame) as the settled map instead of fused sweeps: every voxel holding one
-  /// of its points occupied (OccupancyMap::mark_occupied), normals facing its `sensor_origin_`, settling over.
-  /// resegment_everything() then makes of it exactly what the first version makes of a settled map: the
+  /// of its points occupied (OccupancyMap::mark_occupied), normals facing its `sensor_origin_`, settling
+  /// over. resegment_everything() then makes of it exactly what the first version makes of a settled map: the
   /// batch tool's path (cloud_boxes.hpp). @return the points outside the map's key range (skipped).
   std::size_t settle_on(const Cloud& points_C);
 

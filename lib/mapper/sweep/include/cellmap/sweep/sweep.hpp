@@ -36,6 +36,11 @@ struct Sweep final {
 /// simulated — goes through this one function.
 [[nodiscard]] Scan to_scan(const Frame& frame);
 
+/// to_scan(frame) without copying the points: the frame's points are transformed where they lie and move
+/// into the scan, leaving `frame.points_S` empty (the frame keeps its pose, stamp and depth image). What
+/// the cell pipeline does with a sweep's frames, so that a frame's points are not held twice.
+[[nodiscard]] Scan move_to_scan(Frame& frame);
+
 /// The sweep of `frames`, in the order given: one Scan per frame (to_scan), stamp = the last frame's stamp
 /// (0 when there are no frames).
 [[nodiscard]] Sweep merge_frames(const std::vector<Frame>& frames);
