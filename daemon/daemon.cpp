@@ -1,6 +1,5 @@
 #include "daemon.hpp"
 
-#include <malloc.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -16,18 +15,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
-
-// A sweep's frames are hundreds of megabytes at native camera modes (each frame's depth image and points,
-// allocated by the camera threads and freed after the sweep is fused). By default glibc maps such blocks
-// for themselves or trims its heaps once they are free, so every sweep faults its memory in afresh (page
-// faults were 17 % of a 30 Hz run). Keeping freed memory for the next sweep instead: RSS stays at the
-// largest sweep's, which it reaches anyway.
-void keep_freed_memory() {
-  constexpr int kLargestHeapBlock = 32 << 20;  // glibc's upper bound for M_MMAP_THRESHOLD on 64-bit
-  constexpr int kKeptFreeMemory = 1 << 30;
-  if (mallopt(M_MMAP_THRESHOLD, kLargestHeapBlock) != 1 || mallopt(M_TRIM_THRESHOLD, kKeptFreeMemory) != 1)
-    spdlog::warn("malloc settings refused: frame memory is faulted in again every sweep");
-}
 
 // Once, at start: who may talk to this daemon.
 void log_dds_security(const dds::Participant& participant, int domain) {
@@ -117,7 +104,6 @@ void Daemon::use_self_filter() {
 }
 
 void Daemon::run(const Signals& signals) {
-  keep_freed_memory();
   std::thread acquisition([this] { acquire(); });
   std::thread processing([this] { process(); });
   while (!stop_) {
