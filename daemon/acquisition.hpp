@@ -13,13 +13,13 @@
 #include "daemon_config.hpp"
 #include "health.hpp"
 #include "input_refusals.hpp"
-#include "latest_mailbox.hpp"
+#include "bounded_mailbox.hpp"
 
 namespace cellmap::daemon {
 
 /// Where the acquisition thread delivers and reports; shared with the processing thread (all thread-safe).
 struct AcquisitionOutput {
-  LatestMailbox<FrameSweep>& mailbox;
+  BoundedMailbox<FrameSweep>& mailbox;
   Health& health;
   /// The DDS inputs the source refused (scene edits, robot poses): outside the limits or not applicable.
   InputRefusals& refusals;

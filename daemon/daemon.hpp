@@ -19,7 +19,7 @@
 #include "daemon_config.hpp"
 #include "health.hpp"
 #include "input_refusals.hpp"
-#include "latest_mailbox.hpp"
+#include "bounded_mailbox.hpp"
 #include "layer_publisher.hpp"
 #include "signals.hpp"
 #include "versions.hpp"
@@ -84,7 +84,7 @@ class Daemon final {
   LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
   CellPipeline pipeline_;
   VersionKeeper keeper_;
-  LatestMailbox<FrameSweep> mailbox_;
+  BoundedMailbox<FrameSweep> mailbox_;
   Health health_;
   InputRefusals refusals_;
   std::atomic<std::uint64_t> published_version_{0};  // for the acquisition thread's log lines

@@ -48,7 +48,7 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   DaemonConfig config =
       DaemonConfig::parse("cell: bench-7\nsweep_period: 0\nsource: {noise: false}\n", "test.yaml", ".");
   const dds::Participant participant(test::domain::kSimAcquisition);
-  LatestMailbox<FrameSweep> mailbox;
+  BoundedMailbox<FrameSweep> mailbox;
   Health health(config.cell, {config.sources[0].sensor});
   std::vector<std::string> refusal_lines;
   InputRefusals refusals([&](const std::string& line) { refusal_lines.push_back(line); });

@@ -18,7 +18,7 @@
 #include "cellmap/sim/simulator.hpp"
 #include "daemon/robot_surface.hpp"
 #include "daemon_config.hpp"
-#include "latest_mailbox.hpp"
+#include "bounded_mailbox.hpp"
 #include "simulated_cell.hpp"
 #include "support/test_support.hpp"
 
@@ -208,7 +208,7 @@ int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stal
   SimulatedCell cell(config.sources, config.robot);
   CellPipeline pipeline(config.pipeline);
   pipeline.filter_robot(cell.robot());
-  LatestMailbox<FrameSweep> mailbox(backlog);
+  BoundedMailbox<FrameSweep> mailbox(backlog);
   int versions = 0;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     mailbox.put(cell.next_sweep(sweep * config.sweep_period, config.sweep_period));

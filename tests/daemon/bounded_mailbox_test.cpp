@@ -1,4 +1,4 @@
-#include "latest_mailbox.hpp"
+#include "bounded_mailbox.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@ namespace {
 
 using std::chrono::milliseconds;
 
-TEST(LatestMailboxTest, NewestWinsAndDropsAreCounted) {
-  LatestMailbox<int> box;
+TEST(BoundedMailboxTest, NewestWinsAndDropsAreCounted) {
+  BoundedMailbox<int> box;
   box.put(1);
   box.put(2);
   box.put(3);
@@ -22,8 +22,8 @@ TEST(LatestMailboxTest, NewestWinsAndDropsAreCounted) {
   EXPECT_EQ(box.take(milliseconds(0)), std::nullopt);
 }
 
-TEST(LatestMailboxTest, TakeWaitsForAProducer) {
-  LatestMailbox<int> box;
+TEST(BoundedMailboxTest, TakeWaitsForAProducer) {
+  BoundedMailbox<int> box;
   std::thread producer([&] {
     std::this_thread::sleep_for(milliseconds(20));
     box.put(42);
@@ -33,8 +33,8 @@ TEST(LatestMailboxTest, TakeWaitsForAProducer) {
   EXPECT_EQ(box.dropped(), 0u);
 }
 
-TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
-  LatestMailbox<int> box;
+TEST(BoundedMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
+  BoundedMailbox<int> box;
   EXPECT_TRUE(box.wait_for_room(milliseconds(0)));  // empty from the start
   std::vector<int> got;
   std::thread consumer([&] {
@@ -54,8 +54,8 @@ TEST(LatestMailboxTest, AProducerThatWaitsUntilTakenLosesNothing) {
   EXPECT_FALSE(box.wait_for_room(milliseconds(1)));  // nobody takes it
 }
 
-TEST(LatestMailboxTest, CloseWakesWaitingConsumers) {
-  LatestMailbox<int> box;
+TEST(BoundedMailboxTest, CloseWakesWaitingConsumers) {
+  BoundedMailbox<int> box;
   std::thread closer([&] {
     std::this_thread::sleep_for(milliseconds(20));
     box.close();
@@ -66,11 +66,11 @@ TEST(LatestMailboxTest, CloseWakesWaitingConsumers) {
   closer.join();
 }
 
-TEST(LatestMailboxTest, BusyConsumerGetsOnlyTheNewestAndTheRestAreCountedDropped) {
+TEST(BoundedMailboxTest, BusyConsumerGetsOnlyTheNewestAndTheRestAreCountedDropped) {
   // The consumer takes item 0, then stays busy while items 1..2000 arrive: the mailbox holds only the newest,
   // so the consumer then gets item 2000 and the 1999 in between are counted as dropped. A queue would hand
   // over all 2001 items and drop none.
-  LatestMailbox<std::vector<int>> box;
+  BoundedMailbox<std::vector<int>> box;
   std::promise<void> took_first;
   std::promise<void> finish_work;
   std::vector<int> taken;
@@ -89,8 +89,8 @@ TEST(LatestMailboxTest, BusyConsumerGetsOnlyTheNewestAndTheRestAreCountedDropped
   EXPECT_EQ(box.dropped(), 1999u);
 }
 
-TEST(LatestMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
-  LatestMailbox<std::vector<int>> box;
+TEST(BoundedMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
+  BoundedMailbox<std::vector<int>> box;
   std::uint64_t taken = 0;
   std::atomic<bool> closed{false};
   std::thread consumer([&] {
@@ -114,8 +114,8 @@ TEST(LatestMailboxTest, FastProducerSlowConsumerKeepsOneItem) {
   EXPECT_GT(box.dropped(), 0u);
 }
 
-TEST(LatestMailboxTest, AStalledConsumerCatchesUpOnItsBacklogInOrderThenTheOldestAreDropped) {
-  LatestMailbox<int> box(4);
+TEST(BoundedMailboxTest, AStalledConsumerCatchesUpOnItsBacklogInOrderThenTheOldestAreDropped) {
+  BoundedMailbox<int> box(4);
   for (int i = 0; i < 4; ++i) box.put(i);
   EXPECT_FALSE(box.wait_for_room(milliseconds(0)));
   EXPECT_EQ(box.dropped(), 0u);

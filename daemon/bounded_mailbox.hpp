@@ -17,10 +17,10 @@ namespace cellmap::daemon {
 /// loses nothing it can catch up on, one that stays too slow gets the newest items, and memory never grows
 /// beyond `capacity` items. Thread-safe for any number of producers and consumers.
 template <typename T>
-class LatestMailbox {
+class BoundedMailbox {
  public:
   /// `capacity` ≥ 1 (0 is taken as 1): with 1, put() replaces any item not yet taken.
-  explicit LatestMailbox(std::size_t capacity = 1) : capacity_(capacity > 0 ? capacity : 1) {}
+  explicit BoundedMailbox(std::size_t capacity = 1) : capacity_(capacity > 0 ? capacity : 1) {}
 
   /// Appends `item`, dropping (and counting) the oldest item when `capacity` wait; wakes one waiting take().
   void put(T item) {
