@@ -86,6 +86,11 @@ TEST(SceneTest, BadFilesNameTheKey) {
       parse_error(replaced("model: kinect_v2", "model: kinect_v3")),
       "scene.yaml: sensors[0].model: unknown sensor model 'kinect_v3' (known: kinect_v2, realsense_d435, "
       "os32c)");
+  // A quoted value with line breaks (a folded YAML string, found by fuzz_scene) stays on one line.
+  EXPECT_EQ(
+      parse_error(replaced("model: kinect_v2", "model: \"kinect\\nv3\"")),
+      "scene.yaml: sensors[0].model: unknown sensor model 'kinect?v3' (known: kinect_v2, realsense_d435, "
+      "os32c)");
   EXPECT_EQ(parse_error(replaced("period: 0.5", "period: 0.5\n  speed: 2")),
             "scene.yaml: sweep.speed: unknown key");
   EXPECT_EQ(parse_error(replaced("name: ball", "name: drum")),

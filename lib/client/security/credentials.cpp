@@ -11,6 +11,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "documents.hpp"
 #include "openssl_util.hpp"
 
@@ -111,7 +112,7 @@ Role parse_role(const std::string& name) {
   for (Role role : all_roles()) {
     if (name == to_string(role)) return role;
   }
-  throw Error("role: '" + name + "' is not one of daemon, planner, robot, tool");
+  throw Error("role: '" + single_line(name) + "' is not one of daemon, planner, robot, tool");
 }
 
 const std::vector<Role>& all_roles() {

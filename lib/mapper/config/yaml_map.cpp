@@ -121,8 +121,8 @@ void YamlMap::expect_all_read() const {
 
 void YamlMap::fail(const std::string& key, const std::string& reason) const {
   const std::string where = source_.empty() ? "" : source_ + ": ";
-  // Keys come from the file: keep the message on one line whatever they hold.
-  throw Error(where + single_line(key_path(key)) + ": " + reason);
+  // Keys and the values a reason quotes come from the file: keep the message on one line whatever they hold.
+  throw Error(where + single_line(key_path(key)) + ": " + single_line(reason));
 }
 
 std::string YamlMap::key_path(const std::string& key) const {

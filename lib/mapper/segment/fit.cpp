@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "minimum_volume.hpp"
 
 namespace cellmap {
@@ -77,7 +78,7 @@ BoxKind box_kind_from_string(const std::string& text, const std::string& what) {
   if (text == "aabb") return BoxKind::kAxisAligned;
   if (text == "pca") return BoxKind::kPrincipalAxes;
   if (text == "obb") return BoxKind::kOriented;
-  throw Error(what + ": must be 'obb', 'pca' or 'aabb', got '" + text + "'");
+  throw Error(what + ": must be 'obb', 'pca' or 'aabb', got '" + single_line(text) + "'");
 }
 
 const char* to_string(BoxKind kind) {

@@ -8,6 +8,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/urdf/urdf_model.hpp"
 
@@ -434,7 +435,7 @@ SensorModel sensor_model_from_string(const std::string& name) {
   for (SensorModel m : {SensorModel::kKinectV2, SensorModel::kRealsenseD435, SensorModel::kOs32c}) {
     if (to_string(m) == name) return m;
   }
-  throw Error("unknown sensor model '" + name + "' (known: kinect_v2, realsense_d435, os32c)");
+  throw Error("unknown sensor model '" + single_line(name) + "' (known: kinect_v2, realsense_d435, os32c)");
 }
 
 void LineScanner::validate() const {
