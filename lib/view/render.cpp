@@ -66,27 +66,14 @@ const Eigen::Vector3d kNormals[6] = {-Eigen::Vector3d::UnitX(), Eigen::Vector3d:
 // A flat piece of a robot's or an obstacle's surface in the cell frame.
 struct Facet {
   std::vector<Eigen::Vector3d> corners_C;
-  Eigen::Vector3d outward =
-      Eigen::Vector3d::Zero();  // out of a closed solid; zero: a mesh triangle, two-sided
+  Eigen::Vector3d centre_C = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit; out of a closed solid
+  bool two_sided = false;                            // a mesh triangle: seen and lit from either side
   std::array<double, 3> rgb{};
 };
 
 constexpr int kRoundSegments = 24;  // around a cylinder or a sphere
 constexpr int kSphereRings = 12;    // pole to pole
-
-// The unit normal of a planar polygon (Newell's method), pointing away from `centre` if `closed`.
-Eigen::Vector3d normal_of(const std::vector<Eigen::Vector3d>& corners, const Eigen::Vector3d& centre,
-                          bool closed) {
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    n += corners[i].cross(corners[(i + 1) % corners.size()]);
-    mid += corners[i] / static_cast<double>(corners.size());
-  }
-  if (n.norm() == 0) return n;
-  n.normalize();
-  return closed && n.dot(mid - centre) < 0 ? Eigen::Vector3d(-n) : n;
-}
 
 // The surface of a shape in its frame G as polygons; `closed` is false for meshes (their winding varies).
 std::vector<std::vector<Eigen::Vector3d>> surface_in_G(const LinkGeometry& geometry, bool& closed) {
@@ -136,14 +123,22 @@ std::vector<std::vector<Eigen::Vector3d>> surface_in_G(const LinkGeometry& geome
   return out;
 }
 
+// The facets of `solid` in the cell frame: centres, unit normals (Newell's method; on a closed solid turned
+// away from the shape's centre, since the primitives' polygons are not wound consistently).
 std::vector<Facet> facets(const Solid& solid, const std::array<double, 3>& rgb) {
   bool closed = true;
   std::vector<Facet> out;
   for (std::vector<Eigen::Vector3d>& polygon : surface_in_G(solid.geometry, closed)) {
     Facet facet;
-    for (Eigen::Vector3d& p : polygon) p = solid.X_CG * p;
-    facet.outward = normal_of(polygon, solid.X_CG.translation(), closed);
-    if (!closed) facet.outward.setZero();
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+      polygon[i] = solid.X_CG * polygon[i];
+      facet.centre_C += polygon[i] / static_cast<double>(polygon.size());
+    }
+    for (std::size_t i = 0; i < polygon.size(); ++i)
+      facet.normal += polygon[i].cross(polygon[(i + 1) % polygon.size()]);
+    if (facet.normal.norm() > 0) facet.normal.normalize();
+    if (closed && facet.normal.dot(facet.centre_C - solid.X_CG.translation()) < 0) facet.normal *= -1;
+    facet.two_sided = !closed;
     facet.corners_C = std::move(polygon);
     facet.rgb = rgb;
     out.push_back(std::move(facet));
@@ -332,16 +327,10 @@ std::vector<Polygon> polygons(const Contents& contents, View view, const Panel& 
   }
   const Eigen::Vector3d light = light_of(p.cam);
   for (const Facet& facet : contents.facets) {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& c : facet.corners_C)
-      centre += c / static_cast<double>(facet.corners_C.size());
-    const bool two_sided = facet.outward.isZero();
-    if (!two_sided && !p.cam.faces(facet.outward, centre)) continue;
-    const Eigen::Vector3d normal =
-        two_sided ? normal_of(facet.corners_C, centre, false) : Eigen::Vector3d(facet.outward);
-    const double shade =
-        0.45 + 0.55 * (two_sided ? std::abs(normal.dot(light)) : std::max(0.0, normal.dot(light)));
-    Polygon polygon{{}, depth_of(p.cam, centre), {}, 1.0, false};
+    if (!facet.two_sided && !p.cam.faces(facet.normal, facet.centre_C)) continue;
+    const double lit = facet.normal.dot(light);
+    const double shade = 0.45 + 0.55 * (facet.two_sided ? std::abs(lit) : std::max(0.0, lit));
+    Polygon polygon{{}, depth_of(p.cam, facet.centre_C), {}, 1.0, false};
     for (const Eigen::Vector3d& c : facet.corners_C)
       polygon.corners_px.push_back(p.fit.pixel(p.cam.project(c)));
     for (int i = 0; i < 3; ++i) polygon.rgb[i] = facet.rgb[i] * shade;
