@@ -51,8 +51,9 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   const dds::Participant participant = service_->participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber planner(participant, "e2e", std::ref(recorder));
+  transport::StatusReader status(participant);
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "no first version from the daemon";
-  const Environment before = settled(planner, 5s);
+  const Environment before = settled(planner, status, "e2e", test::kLongQuietSweeps);
   ASSERT_FALSE(before.boxes().empty());
 
   // A box standing on a free part of the table (top at z = 0.75) between the fixture and the drum.
@@ -68,7 +69,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   const Box box = added.added[0];
   EXPECT_TRUE(box.contains(centre)) << "the new box does not hold the injected obstacle";
   EXPECT_TRUE(box.contains(centre + Eigen::Vector3d(0.09, 0.09, 0.14)));
-  const Environment with_box = settled(planner, 5s);
+  const Environment with_box = settled(planner, status, "e2e", test::kLongQuietSweeps);
   for (const Box& old : before.boxes()) {
     const Box* same = with_box.find(old.id);
     ASSERT_NE(same, nullptr) << "box " << old.id << " vanished";
@@ -92,8 +93,9 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
   {
     const dds::Participant participant = service_->participant(domain);
     transport::EnvironmentSubscriber planner(participant, "e2e");
+    transport::StatusReader status(participant);
     ASSERT_TRUE(planner.wait_for_version(1, kPatience));
-    before_kill = settled(planner, 5s);
+    before_kill = settled(planner, status, "e2e", test::kLongQuietSweeps);
   }
   const std::uint64_t last = before_kill->version();
   daemon->signal(SIGKILL);
@@ -300,11 +302,12 @@ TEST(CellmapdStateE2eTest, AChangeWaitingToBeGatheredWhenKilledComesOutOnceAfter
   auto daemon = service.start_daemon(domain);
   const dds::Participant participant = service.participant(domain);
   transport::EnvironmentSubscriber planner(participant, "gather");
+  transport::StatusReader status(participant);
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "the restarted daemon announced nothing";
   const std::uint64_t resumed = planner.environment()->version();
   EXPECT_FALSE(service.inject(domain, add_box).empty());  // the simulated cell starts from its scene again
   ASSERT_TRUE(test::wait_until_boxed(planner, centre)) << "the waiting change never came out";
-  const Environment after = settled(planner, 3s);
+  const Environment after = settled(planner, status, "gather");
   const auto holds_box = [&](const Box& box) { return box.contains(centre); };
   EXPECT_EQ(std::count_if(after.boxes().begin(), after.boxes().end(), holds_box), 1);
   EXPECT_EQ(after.version(), resumed + 1) << "the change came out in more than one version";

@@ -103,7 +103,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
   EXPECT_FALSE(planner.environment()->boxes().empty());
   ASSERT_TRUE(test::wait_for_status(reader, service.cell(), running).has_value()) << "never running again";
-  const Environment before = test::settled(planner, 3s);
+  const Environment before = test::settled(planner, reader, service.cell());
 
   // Read-only: the version with the injected box is held until the directory can be written again.
   disk_.make_read_only(true);
@@ -131,7 +131,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   transport::EnvironmentSubscriber planner(participant, service.cell());
   auto daemon = service.start_daemon(test::domain::kLaterVersionFault);
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version";
-  const Environment before = test::settled(planner, 3s);
+  const Environment before = test::settled(planner, reader, service.cell());
 
   disk_.fill();
   const Eigen::Vector3d centre(0.5, 1.5, 0.95);
@@ -152,7 +152,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   disk_.free();
   ASSERT_TRUE(test::wait_until_boxed(planner, centre))
       << "the box injected while the disk was full never arrived";
-  const Environment with_box = test::settled(planner, 3s);
+  const Environment with_box = test::settled(planner, reader, service.cell());
 
   // The state directory removed under the running daemon: its boxes are saved again as the next version.
   fs::remove_all(disk_.state_dir());

@@ -45,7 +45,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   ASSERT_TRUE(observer.wait_for_version(1, test::kPatience)) << "no first version from the daemon";
   const nlohmann::json first = next_state(planner);
   EXPECT_EQ(first.value("state", ""), "free") << first.dump();
-  const Environment before = test::settled(observer, 5s);
+  const Environment before = test::settled(observer, status, "planner", test::kLongQuietSweeps);
 
   const std::string name =
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
@@ -70,7 +70,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_LT(blocked["position"][1].get<double>(), box.center.y());
   EXPECT_LT(blocked.value("distance", 1.0), 0.02);
 
-  const Environment with_box = test::settled(observer, 3s);
+  const Environment with_box = test::settled(observer, status, "planner");
   service.inject(domain, {"remove", "--name", name});
   ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
   EXPECT_EQ(recorder.to(with_box.version() + 1).removed, std::vector<std::uint64_t>{box.id});
@@ -80,7 +80,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
 
   // A clean stop and restart of the daemon (its writers deleted) must not look like "all boxes removed":
   // the local copy keeps every box, and the restarted daemon goes on above the last version.
-  const Environment last = test::settled(observer, 3s);
+  const Environment last = test::settled(observer, status, "planner");
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
   // The daemon's writers have left this participant (its status writer is seen leaving with them).

@@ -116,7 +116,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
         service.inject(test::domain::kKill, {"add-box", "--center", spot, "--half-extents", "0.08,0.08,0.1"})
             .empty());
     // The daemon reports a new box within about five sweeps (1 s): the kill lands before, during (fusion,
-    // persisting, publishing) or after that version.
+    // persisting, publishing) or after that version. A random instant is what this test is about: a sleep.
     std::this_thread::sleep_for(uniform(0.0, 2.5));
     const int victim = static_cast<int>(rng() % 3);  // 0 daemon, 1 subscriber, 2 both
     std::cout << "round " << round << ": box at " << spot << ", killing "
@@ -130,7 +130,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
     if (victim != 1) expect_killed(*daemon, "cellmapd");
     if (victim != 0) expect_killed(*subscriber, "the subscriber");
     collect();
-    std::this_thread::sleep_for(uniform(0.0, 1.0));
+    std::this_thread::sleep_for(uniform(0.0, 1.0));  // a random time down, as random as the kill
     if (victim != 1) daemon = service.start_daemon(test::domain::kKill, true);
     if (victim != 0) {
       subscriber = start_subscriber();
@@ -140,7 +140,11 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   }
 
   // One more change after the last restart, then the subscriber must end on the daemon's newest version.
-  std::this_thread::sleep_for(1s);
+  // The restarted daemon first settles on its scene (injected boxes are not persisted in the simulation).
+  const dds::Participant observer = service.participant(test::domain::kKill);
+  transport::StatusReader status(observer);
+  ASSERT_TRUE(test::wait_until_settled(status, "kill", test::kQuietSweeps))
+      << "the restarted daemon never settled";
   collect();
   const std::uint64_t before = seen.latest();
   EXPECT_FALSE(service
@@ -153,17 +157,17 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
     collect();
   }
   ASSERT_GT(seen.latest(), before) << "no version after the last restart";
-  // Quiet for 3 s: the restarted scene (injected boxes are not persisted in the simulation) has settled.
-  for (std::uint64_t latest = 0; latest != seen.latest();) {
-    latest = seen.latest();
-    std::this_thread::sleep_for(3s);
-    collect();
-  }
-  while (subscriber_last < seen.latest() && std::chrono::steady_clock::now() < deadline) {
+  const std::optional<transport::CellStatus> settled =
+      test::wait_until_settled(status, "kill", test::kQuietSweeps, seen.latest());
+  ASSERT_TRUE(settled) << "the daemon never settled after the last change";
+  collect();
+  EXPECT_EQ(seen.latest(), settled->version) << "the daemon's log and its status disagree";
+  const auto caught_up = std::chrono::steady_clock::now() + test::kPatience;
+  while (subscriber_last < settled->version && std::chrono::steady_clock::now() < caught_up) {
     std::this_thread::sleep_for(100ms);
     collect();
   }
-  EXPECT_EQ(subscriber_last, seen.latest()) << "the subscriber did not end on the daemon's latest version";
+  EXPECT_EQ(subscriber_last, settled->version) << "the subscriber did not end on the daemon's latest version";
   EXPECT_GE(seen.starts(), 1) << "the daemon's start line was not recognised";
   std::cout << "daemon started " << seen.starts() << " times, latest version " << seen.latest() << ", "
             << seen.versions_seen() << " versions seen by subscribers" << std::endl;

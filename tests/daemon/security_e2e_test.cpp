@@ -129,7 +129,7 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
   auto poses = start(probe(test::domain::kAttack, "secure", {"serve"}, &credentials, Role::kDaemon));
   expect_line(*poses, "ready");
   ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version over DDS Security";
-  const Environment before = test::settled(planner, 3s);
+  const Environment before = test::settled(planner, status, "secure");
   const transport::TrackerStats stats_before = planner.stats();
 
   // The outsider, first reading: our own tools without --security, which is what anyone on the plant

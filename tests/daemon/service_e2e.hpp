@@ -128,15 +128,51 @@ inline std::string security_name(const ::testing::TestParamInfo<bool>& info) {
   return info.param ? "Secure" : "Plain";
 }
 
-/// Waits until no new version came for `quiet` (the map has settled); returns the environment then.
-inline Environment settled(const transport::EnvironmentSubscriber& planner, std::chrono::seconds quiet) {
-  std::uint64_t version = planner.environment()->version();
+/// Takes status reports of `cell` until one satisfies `accept` (returned) or the patience runs out.
+inline std::optional<transport::CellStatus> wait_for_status(
+    transport::StatusReader& reader, const std::string& cell,
+    const std::function<bool(const transport::CellStatus&)>& accept) {
   const auto deadline = std::chrono::steady_clock::now() + kPatience;
   while (std::chrono::steady_clock::now() < deadline) {
-    if (!planner.wait_for_version(version + 1, quiet)) return *planner.environment();
-    version = planner.environment()->version();
+    for (const transport::CellStatus& status : reader.take(std::chrono::milliseconds(200))) {
+      if (status.cell == cell && accept(status)) return status;
+    }
   }
-  ADD_FAILURE() << "the environment never settled";
+  return std::nullopt;
+}
+
+/// Waits until the daemon of `cell` reported `quiet_sweeps` sweeps in a row without a new version, at
+/// `min_version` or later (the map settled); returns the status then. Counted in sweeps, not seconds, so a
+/// slow run (a loaded machine, a sanitizer build) waits as many sweeps as a fast one. A restarted daemon
+/// (its sweep count starts again) starts the count again.
+inline std::optional<transport::CellStatus> wait_until_settled(transport::StatusReader& reader,
+                                                               const std::string& cell,
+                                                               std::uint64_t quiet_sweeps,
+                                                               std::uint64_t min_version = 0) {
+  std::optional<transport::CellStatus> since;  // the first report of the current version
+  return wait_for_status(reader, cell, [&](const transport::CellStatus& status) {
+    if (status.version < min_version) return false;
+    if (!since || status.version != since->version || status.sweeps < since->sweeps) since = status;
+    return status.sweeps >= since->sweeps + quiet_sweeps;
+  });
+}
+
+/// Sweeps without a new version that show the map settled: 3 s at the fixture's 0.2 s sweep period.
+inline constexpr std::uint64_t kQuietSweeps = 15;
+/// The same after a start, while the first sweeps of a cell may still add to the map: 5 s at 0.2 s.
+inline constexpr std::uint64_t kLongQuietSweeps = 25;
+
+/// Waits until the map settled (wait_until_settled, at or above the subscriber's version) and the subscriber
+/// holds that version; returns the environment then.
+inline Environment settled(const transport::EnvironmentSubscriber& planner, transport::StatusReader& status,
+                           const std::string& cell, std::uint64_t quiet_sweeps = kQuietSweeps) {
+  const std::uint64_t held = planner.environment() ? planner.environment()->version() : 0;
+  const std::optional<transport::CellStatus> quiet = wait_until_settled(status, cell, quiet_sweeps, held);
+  if (!quiet) {
+    ADD_FAILURE() << "the environment never settled";
+  } else if (!planner.wait_for_version(quiet->version, kPatience)) {
+    ADD_FAILURE() << "the subscriber never got the settled version " << quiet->version;
+  }
   return *planner.environment();
 }
 
@@ -154,19 +190,6 @@ inline bool wait_until_boxed(const transport::EnvironmentSubscriber& planner, co
     planner.wait_for_version(version + 1, std::chrono::seconds(1));
   }
   return boxed();
-}
-
-/// Takes status reports of `cell` until one satisfies `accept` (returned) or the patience runs out.
-inline std::optional<transport::CellStatus> wait_for_status(
-    transport::StatusReader& reader, const std::string& cell,
-    const std::function<bool(const transport::CellStatus&)>& accept) {
-  const auto deadline = std::chrono::steady_clock::now() + kPatience;
-  while (std::chrono::steady_clock::now() < deadline) {
-    for (const transport::CellStatus& status : reader.take(std::chrono::milliseconds(200))) {
-      if (status.cell == cell && accept(status)) return status;
-    }
-  }
-  return std::nullopt;
 }
 
 /// The log of a daemon started with `log_on_stdout`, read line by line as it comes. Every wait below keeps

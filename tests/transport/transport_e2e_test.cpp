@@ -13,6 +13,7 @@
 #include <set>
 #include <thread>
 
+#include "cellmap.h"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "child_process.hpp"
@@ -135,6 +136,10 @@ TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
                                      const std::lock_guard<std::mutex> lock(mutex);
                                      calls.emplace_back(env, delta);
                                    });
+  // A second reader of the deltas in the planner's participant: it tells when the killed daemons' writers
+  // are gone for the planner.
+  const dds::Topic delta_topic(planner, &cellmap_msg_EnvironmentDelta_desc, kEnvironmentDeltaTopic);
+  const dds::Reader delta_watch(planner, delta_topic, environment_delta_qos(kDefaultDeltaDepth));
   test::ChildProcess echo(
       {CELLMAP_TOOL, "echo", "--domain", std::to_string(test::domain::kKilledPublisher), "--timeout", "600"});
 
@@ -152,9 +157,12 @@ TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {
     } catch (const std::exception&) {
     }
   }
-  // Past the 1 s lease of the loopback config: the killed daemons' writers have expired at the subscriber,
-  // which must not read that as "all boxes removed".
-  std::this_thread::sleep_for(2500ms);
+  // The killed daemons' writers expire at the planner when their 1 s lease (the loopback config) runs out;
+  // the subscriber must not read that as "all boxes removed". Wait until it has happened.
+  const auto lease_deadline = std::chrono::steady_clock::now() + kPatience;
+  while (delta_watch.matched_writers() > 0 && std::chrono::steady_clock::now() < lease_deadline)
+    std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(delta_watch.matched_writers(), 0u) << "the killed daemons' writers never expired";
   test::ChildProcess daemon(helper(test::domain::kKilledPublisher, dir.path(), 5, 10));
   const std::uint64_t last = read_until(daemon, "done", published);
   ASSERT_TRUE(subscriber.wait_for_version(last, kPatience)) << subscriber.last_error();
