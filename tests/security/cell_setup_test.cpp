@@ -31,7 +31,7 @@ CellSetup setup_in(const fs::path& directory) {
   setup.valid_from = std::chrono::system_clock::from_time_t(
       std::chrono::system_clock::to_time_t(std::chrono::system_clock::now() - 1h));
   setup.valid_until = setup.valid_from + 24h * 30;
-  setup.grants = transport::role_grants();
+  setup.grants = transport::role_grants(setup.cell);
   return setup;
 }
 
