@@ -11,10 +11,9 @@
 #include <cctype>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <set>
-#include <sstream>
 
+#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "documents.hpp"
 #include "openssl_util.hpp"
@@ -143,20 +142,12 @@ Authority make_authority(const std::string& name, const CellSetup& setup) {
   return ca;
 }
 
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(file.string() + ": cannot read");
-  return text.str();
-}
-
 // One of the plant's CAs, read from another cell's credentials directory; its certificate is copied.
 Authority plant_authority(const std::string& name, const CellSetup& setup) {
   const fs::path certificate_file = setup.plant_ca / (name + ".pem");
   const fs::path key_file = setup.plant_ca / "ca" / (name + "_key.pem");
-  const std::string certificate_pem = read_text(certificate_file);
-  Authority ca{ossl::read_private_key(read_text(key_file)), ossl::read_certificate(certificate_pem)};
+  const std::string certificate_pem = read_file(certificate_file);
+  Authority ca{ossl::read_private_key(read_file(key_file)), ossl::read_certificate(certificate_pem)};
   if (!ca.certificate) throw Error(certificate_file.string() + ": not a PEM certificate");
   if (!ca.key) throw Error(key_file.string() + ": not an unencrypted PEM private key");
   if (X509_check_private_key(ca.certificate.get(), ca.key.get()) != 1)
