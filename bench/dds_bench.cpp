@@ -99,7 +99,7 @@ class BenchCredentials {
     setup.domain = domain;
     setup.valid_from = std::chrono::system_clock::now() - std::chrono::hours(1);
     setup.valid_until = setup.valid_from + std::chrono::hours(24);
-    setup.grants = transport::role_grants();
+    setup.grants = transport::role_grants(setup.cell);
     setup.data_protection = data;
     security::write_cell_credentials(setup);
   }
@@ -137,7 +137,7 @@ int run_delta_subscriber(std::uint32_t domain, const std::string& security_direc
 int run_snapshot_subscriber(std::uint32_t domain) {
   const dds::Participant participant(domain);
   const dds::Topic topic(participant, &cellmap_msg_Environment_desc, transport::kEnvironmentTopic);
-  const dds::Reader reader(participant, topic, transport::environment_qos());
+  const dds::Reader reader(participant, topic, transport::in_cell(transport::environment_qos(), kCell));
   dds::WaitSet waitset(participant);
   waitset.attach(reader);
   for (;;) {
@@ -255,7 +255,7 @@ void BM_FullSnapshotEachChange(benchmark::State& state) {
   SubscriberProcess subscriber("snapshot", 141);
   const dds::Participant participant(141);
   const dds::Topic topic(participant, &cellmap_msg_Environment_desc, transport::kEnvironmentTopic);
-  dds::Qos qos = transport::environment_qos();
+  dds::Qos qos = transport::in_cell(transport::environment_qos(), kCell);
   qos.autodispose(false);
   const dds::Writer writer(participant, topic, qos);
   const Environment first = cell_with_boxes(1);

@@ -399,10 +399,10 @@ void print_foreign(const Options& options, Planners& planners, const MonitorView
     at_join.push_back(static_cast<double>(joined[i]));
   }
   std::printf(
-      "at a planner of another cell: %.2f foreign samples per foreign delta (%zu deltas on the domain, "
+      "at a planner of another cell: %.2f foreign samples per foreign delta (max %.2f; %zu deltas on the domain, "
       "%.0f B payload each), %.0f foreign samples at joining (snapshots %.0f B, deltas %.0f B "
       "payload on average)\n",
-      percentile(per_delta, 0.5), view.delta_bytes.size() - deltas_before,
+      percentile(per_delta, 0.5), percentile(per_delta, 1.0), view.delta_bytes.size() - deltas_before,
       mean_bytes(view.delta_bytes, deltas_before), percentile(at_join, 0.5), mean_bytes(view.snapshot_bytes),
       mean_bytes(view.delta_bytes));
 }
@@ -440,7 +440,7 @@ int run(const Options& options, const std::string& self) {
   const std::vector<std::uint64_t> joined = measure_discovery(options, planners);
 
   drops.push_back(udp_receive_drops());
-  const transport::SceneEditWriter writer(participant);
+  const transport::SceneEditWriter writer(participant, cell_name(0));
   if (!writer.wait_for_reader(std::chrono::seconds(static_cast<int>(options.timeout))))
     throw Error("no daemon's scene-edit reader matched");
   const std::size_t deltas_before = view.delta_bytes.size();

@@ -44,7 +44,7 @@ class SimAcquisition final : public Acquisition {
   SimAcquisition(const DaemonConfig& config, const dds::Participant& participant, AcquisitionOutput output)
       : cell_name_(config.cell),
         cell_(config.sources, config.robot),
-        edits_(participant, inside(cell_), refuse(output.refusals)),
+        edits_(participant, cell_name_, inside(cell_), refuse(output.refusals)),
         output_(output),
         sweep_period_(config.sweep_period) {
     for (const SourceConfig& source : config.sources) sensors_.push_back(source.sensor);

@@ -179,6 +179,8 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   DaemonConfig c;
   c.cell = root.get<std::string>("cell", c.cell);
   if (c.cell.empty()) root.fail("cell", "must not be empty");
+  if (c.cell.find_first_of("*?\\") != std::string::npos)
+    root.fail("cell", "must not hold '*', '?' or '\\' (its DDS partition would be a pattern)");
   c.domain = static_cast<int>(root.integer("domain", c.domain, 0, 232));
   c.state_dir = root.get<std::string>("state_dir", c.state_dir.string());
   c.sweep_period = root.number("sweep_period", c.sweep_period, 0.0, 3600.0);

@@ -10,7 +10,7 @@ CellFollower::CellFollower(const dds::Participant& participant, std::string cell
       cell_(std::move(cell)),
       state_(state),
       publish_(std::move(publish)),
-      status_(participant) {
+      status_(participant, cell_.empty() ? transport::default_cell(participant) : cell_) {
   if (!cell_.empty()) follow(cell_);
 }
 
@@ -44,7 +44,8 @@ void CellFollower::poll(std::chrono::nanoseconds timeout) {
 
 void CellFollower::open_or_close(transport::Layer layer, bool wanted) {
   std::unique_ptr<transport::LayerReader>& reader = layer_readers_[layer];
-  if (wanted && !reader) reader = std::make_unique<transport::LayerReader>(participant_, layer);
+  if (wanted && !reader) reader = std::make_unique<transport::LayerReader>(
+        participant_, layer, cell_.empty() ? transport::default_cell(participant_) : cell_);
   if (!wanted && reader) reader.reset();
   if (!reader) return;
   for (const transport::LayerMessage& message : reader->take()) {

@@ -24,8 +24,9 @@ TEST(PlantBenchTest, TwoCellsTheirPlannersAndAMonitor) {
   EXPECT_NE(run.output.find("all 2 planners within"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("delta latency at cell-1's planner (2 changes)"), std::string::npos)
       << run.output;
-  // The client library ignores foreign cells' samples, but today they reach it: one per change of cell-1.
-  EXPECT_EQ(number_after(run.output, "at a planner of another cell:"), 1.0) << run.output;
+  // Each cell in its own partition: none of cell-1's samples reach cell-2's planner, at joining neither.
+  EXPECT_EQ(number_after(run.output, "at a planner of another cell:"), 0.0) << run.output;
+  EXPECT_EQ(number_after(run.output, "payload each\\), "), 0.0) << run.output;
   EXPECT_GT(number_after(run.output, "RSS per daemon: median"), 1.0) << run.output;
 }
 

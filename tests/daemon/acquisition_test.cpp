@@ -59,10 +59,12 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
 
   // Two free spots on the table (top at z = 0.75), both in the Kinect's view.
   const Eigen::Vector3d mine(2.12, 0.45, 0.9), theirs(0.5, 1.5, 0.9), half(0.1, 0.1, 0.15);
-  const transport::SceneEditWriter writer(participant);
+  const transport::SceneEditWriter writer(participant, "bench-7");
+  const transport::SceneEditWriter other_cell(participant, "bench-8");
   ASSERT_TRUE(writer.wait_for_reader(30s));
+  EXPECT_FALSE(other_cell.wait_for_reader(0s)) << "the daemon reads another cell's partition";
   writer.write(add_box("bench-7", "mine", mine));
-  writer.write(add_box("bench-8", "theirs", theirs));
+  other_cell.write(add_box("bench-8", "theirs", theirs));
   writer.write(add_box("bench-7", "far", Eigen::Vector3d(1e300, 0.45, 0.9)));
   ASSERT_TRUE(writer.wait_for_acks(30s));
 

@@ -251,7 +251,7 @@ TEST_F(CameraE2eTest, FramesArePosedFromTheRobotStateTopicAndDroppedWithoutIt) {
   EXPECT_EQ(unposed->sensors[0].state, "streaming");
 
   // A robot controller at 100 Hz: the tool at rest, stamped on the same clock as the frames.
-  transport::RobotStateWriter writer(participant);
+  transport::RobotStateWriter writer(participant, "wrist-cell");
   std::atomic<bool> stop{false};
   std::thread controller([&] {
     transport::RobotState state;
@@ -326,7 +326,7 @@ TEST_F(CameraE2eTest, FramesArePosedFromJointSamplesThroughTheRobotModel) {
   EXPECT_EQ(unposed->sweeps, 0u) << "a frame without joint samples was fused";
 
   // The controller at 100 Hz, the gantry at rest mid-cell, stamped on the frames' clock.
-  transport::RobotJointsWriter writer(participant);
+  transport::RobotJointsWriter writer(participant, "joints-cell");
   std::atomic<bool> stop{false};
   std::thread controller([&] {
     transport::RobotJoints joints;

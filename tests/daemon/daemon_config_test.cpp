@@ -42,6 +42,8 @@ TEST(DaemonConfigTest, FileOverlaysDefaultsKeyByKey) {
 
 TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {
   EXPECT_EQ(error_of("cel: x\n"), "my.yaml: cel: unknown key");
+  EXPECT_EQ(error_of("cell: \"cell-*\"\n"),
+            "my.yaml: cell: must not hold '*', '?' or '\\' (its DDS partition would be a pattern)");
   EXPECT_EQ(error_of("change: {margin: -1}\n").rfind("my.yaml: change.margin:", 0), 0u)
       << error_of("change: {margin: -1}\n");
   EXPECT_EQ(error_of("source: {kind: kinect}\n"),

@@ -2,16 +2,21 @@
 // right to mount they skip): the disk full when the first version is due and when a later one is, the state
 // directory read-only and removed. Each time the status says degraded with the reason, subscribers (a late
 // joiner too) keep the last version that went out, and the held version goes out once the disk works again,
-// without a restart.
+// without a restart. With DDS Security on: the full disk at the first version, and a refused DDS write of
+// the version keeper (a publication that throws, as a failing write does) with a tool's `cellmap echo`
+// receiving in a process of its own.
 #include <gtest/gtest.h>
 #include <sys/mount.h>
 
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "cellmap/environment/version_store.hpp"
+#include "cellmap/transport/environment_publisher.hpp"
 #include "daemon/service_e2e.hpp"
+#include "versions.hpp"
 #include "support/dds_domains.hpp"
 
 namespace cellmap {
@@ -163,6 +168,81 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   EXPECT_EQ(daemon->wait(), 0);
   EXPECT_EQ(VersionStore(disk_.state_dir(), service.cell()).recovered().environment.version(),
             again.version());
+}
+
+TEST_F(FaultsE2eTest, SecuredFullDiskHoldsTheFirstVersionUntilSpaceComesBack) {
+  const int domain = test::domain::kSecureFirstVersionFault;
+  const test::ServiceFixture service("full-secure", kShortSettling, disk_.state_dir(), domain);
+  const dds::Participant participant = service.participant(domain);
+  transport::StatusReader reader(participant, service.cell());
+  transport::EnvironmentSubscriber planner(participant, service.cell());
+  disk_.fill();
+  auto daemon = service.start_daemon(domain);
+  const auto full = test::wait_for_status(reader, service.cell(), degraded_by("No space left on device"));
+  ASSERT_TRUE(full.has_value()) << "no degraded status while the disk is full";
+  EXPECT_EQ(full->version, 0u);
+  EXPECT_FALSE(planner.environment().has_value()) << "a version went out unsaved";
+  disk_.free();
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
+  EXPECT_FALSE(planner.environment()->boxes().empty());
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
+}
+
+TEST(SecuredVersionKeeperTest, RefusedDdsWriteIsRetriedUntilItGoesOut) {
+  const int domain = test::domain::kSecureRefusedWrite;
+  const std::string cell = "write-secure";
+  test::use_secure_loopback();
+  const test::TestCredentials credentials(cell, domain);
+  const dds::Participant participant(static_cast<std::uint32_t>(domain),
+                                     credentials.as(security::Role::kDaemon));
+  transport::EnvironmentPublisher publisher(participant, cell);
+  std::vector<std::string> argv{CELLMAP_TOOL, "echo", "--domain", std::to_string(domain), "--count", "4",
+                                "--timeout", "90"};
+  const std::vector<std::string> flags = credentials.flags(security::Role::kTool);
+  argv.insert(argv.end(), flags.begin(), flags.end());
+  test::ChildProcess echo(argv);
+  ASSERT_TRUE(publisher.wait_for_subscribers(1, test::kPatience)) << "the tool's echo never matched";
+
+  bool refuse = false;
+  const test::TempDir dir;
+  VersionStore store(dir.path() / "state", cell);
+  daemon::VersionKeeper keeper(store, [&](const Environment& env, const EnvironmentDelta& delta) {
+    if (refuse) throw Error("dds write: refused");
+    publisher.publish(env, delta);
+  });
+  Box box;
+  box.half_extents = Eigen::Vector3d::Constant(0.1);
+  std::vector<Box> boxes;
+  const auto holding = [&](std::uint64_t boxes_held) {
+    for (std::uint64_t id = boxes.size() + 1; id <= boxes_held; ++id) {
+      box.id = id;
+      box.center = Eigen::Vector3d(0.3 * static_cast<double>(id), 0.5, 0.5);
+      boxes.push_back(box);
+    }
+    return CellPipeline(CellPipelineConfig{}, boxes, 10);
+  };
+  keeper.flush(holding(2));
+  refuse = true;
+  keeper.flush(holding(3));
+  EXPECT_EQ(keeper.fault(), "version 2 not published: dds write: refused");
+  EXPECT_TRUE(keeper.pending());
+  refuse = false;
+  keeper.flush(holding(3));
+  EXPECT_FALSE(keeper.pending());
+  EXPECT_EQ(keeper.fault(), "");
+
+  // Version 1 (a delta from 0 and the snapshot), then version 2 (its delta from 1 and the snapshot).
+  std::vector<nlohmann::json> got;
+  while (const std::optional<std::string> line = echo.read_line(test::kPatience)) {
+    got.push_back(nlohmann::json::parse(*line));
+  }
+  EXPECT_EQ(echo.wait(), 0);
+  ASSERT_EQ(got.size(), 4u);
+  EXPECT_EQ(got[2]["from_version"], 1);
+  EXPECT_EQ(got[2]["to_version"], 2);
+  EXPECT_EQ(got[3]["version"], 2);
+  EXPECT_EQ(got[3]["boxes"].size(), 3u);
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const dds::Participant participant = service.participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
-  transport::StatusReader status(participant);  // tells when the stopped daemon's writers are gone
+  transport::StatusReader status(participant, service.cell());  // tells when the stopped daemon's writers are gone
   // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");

@@ -124,7 +124,7 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
   auto daemon = service.start_daemon(test::domain::kAttack);
   const dds::Participant participant = service.participant(test::domain::kAttack);  // this process: a planner
   transport::EnvironmentSubscriber planner(participant, "secure");
-  transport::StatusReader status(participant);
+  transport::StatusReader status(participant, "secure");
   // Where robot poses would go (the simulating daemon reads none): a reader with the daemon's credentials.
   auto poses = start(probe(test::domain::kAttack, "secure", {"serve"}, &credentials, Role::kDaemon));
   expect_line(*poses, "ready");
@@ -220,7 +220,8 @@ TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant
     EXPECT_EQ(code, 0);
     return lines.size() == 1 ? nlohmann::json::parse(lines[0]) : nlohmann::json::object();
   };
-  // What each role may create; the probe tries seven writers and readers, the others must be refused.
+  // What each role may create in its cell's partition; the probe tries seven writers and readers there and
+  // three outside it (another cell's, every cell's), the others must be refused.
   const std::map<Role, std::set<std::string>> created{
       {Role::kPlanner, {"environment_subscriber", "status_reader"}},
       {Role::kRobot, {"robot_state_writer"}},
@@ -228,13 +229,73 @@ TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant
       {Role::kDaemon, {"environment_publisher", "scene_edit_reader", "robot_state_reader"}}};
   for (const auto& [role, allowed] : created) {
     const nlohmann::json got = grants_of(role);
-    EXPECT_EQ(got.size(), 7u) << got.dump();
+    EXPECT_EQ(got.size(), 10u) << got.dump();
     for (const auto& [entity, result] : got.items()) {
       EXPECT_EQ(result, allowed.count(entity) ? "created" : "refused")
           << security::to_string(role) << ": " << entity;
     }
   }
 }
+
+// A plant: cells plant-a and plant-b on one domain, each a daemon publishing its cell; secured, with credentials
+// of one plant's CAs (plant-b's issued with plant-a's), so that every participant authenticates every other
+// and only the partitions keep the cells apart.
+class PlantPartitionsTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PlantPartitionsTest, APlannerOfOneCellReceivesNothingOfAnother) {
+  const bool secured = GetParam();
+  const int domain = secured ? test::domain::kSecurePlant : test::domain::kPlainPlant;
+  if (secured) {
+    test::use_secure_loopback();
+  } else {
+    test::use_loopback();
+  }
+  std::optional<test::TestCredentials> a, b;
+  if (secured) {
+    a.emplace("plant-a", domain);
+    b.emplace("plant-b", domain, &*a);
+  }
+  const auto of = [&](const std::optional<test::TestCredentials>& credentials) {
+    return credentials ? &*credentials : nullptr;
+  };
+  auto daemon_b = start(probe(domain, "plant-b", {"serve", "--publish"}, of(b), Role::kDaemon));
+  expect_line(*daemon_b, "ready");
+  auto daemon_a = start(probe(domain, "plant-a", {"serve", "--publish"}, of(a), Role::kDaemon));
+  expect_line(*daemon_a, "ready");
+  const dds::Participant participant(static_cast<std::uint32_t>(domain),
+                                     a ? std::optional(a->as(Role::kPlanner)) : std::nullopt);
+  transport::EnvironmentSubscriber planner(participant, "plant-a");
+  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version of its own cell";
+
+  // plant-b's data is on the domain: a tool of plant-b (its own process) receives its delta and snapshot.
+  std::vector<std::string> echo{CELLMAP_TOOL, "echo",  "--domain",  std::to_string(domain),
+                                "--cell",     "plant-b", "--count", "2", "--timeout", "60"};
+  if (b) {
+    const std::vector<std::string> flags = b->flags(Role::kTool);
+    echo.insert(echo.end(), flags.begin(), flags.end());
+  }
+  int code = 0;
+  const std::vector<std::string> lines = run(echo, &code);
+  EXPECT_EQ(code, 0);
+  ASSERT_EQ(lines.size(), 2u);
+  for (const std::string& line : lines) EXPECT_EQ(nlohmann::json::parse(line)["cell"], "plant-b") << line;
+
+  EXPECT_EQ(planner.stats().other_cells, 0u) << "plant-b's samples reached plant-a's planner";
+  if (secured) {
+    // plant-a's planner credentials grant plant-a's partition only: no reader of plant-b's, nor of every cell.
+    EXPECT_NE(test::error_of([&] { transport::EnvironmentSubscriber x(participant, "plant-b"); })
+                  .find("Not Allowed By Security"),
+              std::string::npos);
+    EXPECT_NE(test::error_of([&] { transport::StatusReader x(participant, transport::kEveryCell); })
+                  .find("Not Allowed By Security"),
+              std::string::npos);
+  }
+  // plant-b's writers never matched plant-a's planner: their only reader was the echo's.
+  EXPECT_EQ(stop(*daemon_b)["subscribers_joined"], 1);
+  EXPECT_EQ(stop(*daemon_a)["subscribers_joined"], 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(PlainAndSecure, PlantPartitionsTest, ::testing::Bool(), test::security_name);
 
 TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
   test::use_secure_loopback();
@@ -270,7 +331,7 @@ TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
             std::string::npos);
   EXPECT_EQ(code, 1) << "a robot of another CA reached the daemon's robot-state reader";
   const nlohmann::json served = stop(*daemon);
-  EXPECT_EQ(served, (nlohmann::json{{"edits", 0}, {"poses", 0}, {"subscribers", 1}}))
+  EXPECT_EQ(served, (nlohmann::json{{"edits", 0}, {"poses", 0}, {"subscribers", 1}, {"subscribers_joined", 1}}))
       << "only our own planner may have matched";
 }
 

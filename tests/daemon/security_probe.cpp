@@ -7,7 +7,8 @@
 //   security_probe DOMAIN CELL serve [--publish] [--security DIR --role R]
 //     what a daemon reads: scene edits and the cell's robot poses (and with --publish it publishes version 1
 //     of the cell with one box). Prints "ready", then {"edits": E, "poses": P} whenever a count changes; on
-//     SIGTERM one more line with "subscribers" (readers matched to its environment) and exits.
+//     SIGTERM one more line with "subscribers" (readers matched to its environment now) and
+//     "subscribers_joined" (ever) and exits.
 //   security_probe DOMAIN CELL forge FROM_VERSION ID,ID,... [--security DIR --role R]
 //     the attack: a delta from FROM_VERSION removing the ids, a snapshot of an empty cell, and every 100 ms a
 //     scene edit and a robot pose. Prints "forging"; on SIGTERM {"reached_environment": bool,
@@ -63,17 +64,22 @@ std::string attempt(const std::function<void()>& create) {
 void writers(const dds::Participant& p, const std::string& cell) {
   json result;
   result["environment_publisher"] = attempt([&] { transport::EnvironmentPublisher x(p, cell); });
-  result["scene_edit_writer"] = attempt([&] { transport::SceneEditWriter x(p); });
-  result["robot_state_writer"] = attempt([&] { transport::RobotStateWriter x(p); });
+  result["scene_edit_writer"] = attempt([&] { transport::SceneEditWriter x(p, cell); });
+  result["robot_state_writer"] = attempt([&] { transport::RobotStateWriter x(p, cell); });
   result["environment_subscriber"] = attempt([&] { transport::EnvironmentSubscriber x(p, cell); });
-  result["status_reader"] = attempt([&] { transport::StatusReader x(p); });
-  result["scene_edit_reader"] = attempt([&] { transport::SceneEditReader x(p); });
+  result["status_reader"] = attempt([&] { transport::StatusReader x(p, cell); });
+  result["scene_edit_reader"] = attempt([&] { transport::SceneEditReader x(p, cell); });
   result["robot_state_reader"] = attempt([&] { transport::RobotStateReader x(p, cell); });
+  // Outside the cell's partition: another cell's, and every cell's.
+  result["other_cell_subscriber"] = attempt([&] { transport::EnvironmentSubscriber x(p, cell + "-other"); });
+  result["every_cell_status_reader"] = attempt([&] { transport::StatusReader x(p, transport::kEveryCell); });
+  result["every_cell_scene_edit_writer"] =
+      attempt([&] { transport::SceneEditWriter x(p, transport::kEveryCell); });
   std::cout << result.dump() << std::endl;
 }
 
 void serve(const dds::Participant& p, const std::string& cell, bool publish) {
-  transport::SceneEditReader edits(p);
+  transport::SceneEditReader edits(p, cell);
   transport::RobotStateReader poses(p, cell);
   std::optional<transport::EnvironmentPublisher> publisher;
   if (publish) {
@@ -98,6 +104,7 @@ void serve(const dds::Participant& p, const std::string& cell, bool publish) {
     int subscribers = 0;
     while (publisher->wait_for_subscribers(static_cast<std::uint32_t>(subscribers + 1), 0s)) ++subscribers;
     last["subscribers"] = subscribers;
+    last["subscribers_joined"] = publisher->subscribers_joined();
   }
   std::cout << last.dump() << std::endl;
 }
@@ -108,8 +115,8 @@ void forge(const dds::Participant& p, const std::string& cell, std::uint64_t fro
   for (const std::string& id : split(ids, ',')) wipe.removed.push_back(std::stoull(id));
   publisher.publish(Environment(cell, from + 1, wall_clock_ns(), {}), wipe);
   publisher.publish(Environment(cell, from + 2, wall_clock_ns(), {}));
-  const transport::SceneEditWriter edits(p);
-  const transport::RobotStateWriter poses(p);
+  const transport::SceneEditWriter edits(p, cell);
+  const transport::RobotStateWriter poses(p, cell);
   transport::SceneEdit edit;
   edit.cell = cell;
   edit.name = "forged";

@@ -31,7 +31,7 @@ CellSetup setup_in(const fs::path& directory) {
   setup.valid_from = std::chrono::system_clock::from_time_t(
       std::chrono::system_clock::to_time_t(std::chrono::system_clock::now() - 1h));
   setup.valid_until = setup.valid_from + 24h * 30;
-  setup.grants = transport::role_grants();
+  setup.grants = transport::role_grants(setup.cell);
   return setup;
 }
 
@@ -79,6 +79,14 @@ TEST(CellSetupTest, DocumentsGrantEachRoleItsTopicsOnly) {
   EXPECT_EQ(robot.find("<subscribe>"), std::string::npos);
   EXPECT_NE(robot.find("<topic>cellmap/robot_joints</topic>"), std::string::npos);
   EXPECT_EQ(robot.find("cellmap/environment"), std::string::npos);
+  // Every grant in the cell's partition only.
+  for (Role role : all_roles()) {
+    const std::string permissions = read_file(role_files(dir.path(), role).permissions.replace_extension(".xml"));
+    EXPECT_NE(permissions.find("<partitions>\n            <partition>cellmap/cell-7</partition>\n"),
+              std::string::npos)
+        << to_string(role);
+    EXPECT_EQ(permissions.find("cellmap/*"), std::string::npos) << to_string(role);
+  }
   const std::string daemon = read_file(dir.path() / "daemon" / "permissions.xml");
   EXPECT_NE(daemon.find("<subject_name>CN=daemon,OU=cell-7,O=cellmap</subject_name>"), std::string::npos);
   EXPECT_NE(daemon.find("<default>DENY</default>"), std::string::npos);
@@ -101,6 +109,31 @@ TEST(CellSetupTest, RefusesBadOptionsAndNeverOverwrites) {
   EXPECT_EQ(test::error_of([&] { write_cell_credentials(setup); }),
             (dir.path() / "a").string() +
                 ": not empty; credentials are never overwritten (write a new set into a new directory)");
+}
+
+TEST(CellSetupTest, ACellOfAPlantIsIssuedWithAnotherCellsCas) {
+  test::TempDir dir;
+  const CellSetup first = setup_in(dir.path() / "cell-7");
+  write_cell_credentials(first);
+  CellSetup second = setup_in(dir.path() / "cell-8");
+  second.cell = "cell-8";
+  second.grants = transport::role_grants(second.cell);
+  second.plant_ca = first.directory;
+  write_cell_credentials(second);
+  EXPECT_FALSE(fs::exists(second.directory / "ca")) << "the plant's CA keys were copied";
+  EXPECT_EQ(read_file(second.directory / "identity_ca.pem"), read_file(first.directory / "identity_ca.pem"));
+  EXPECT_EQ(read_file(second.directory / "permissions_ca.pem"),
+            read_file(first.directory / "permissions_ca.pem"));
+  for (Role role : all_roles()) {
+    const Credentials credentials = check({second.directory, role}, 7);
+    EXPECT_EQ(credentials.cell, "cell-8");
+    EXPECT_NE(read_file(role_files(second.directory, role).permissions).find("cellmap/cell-8"), std::string::npos);
+  }
+
+  CellSetup orphan = setup_in(dir.path() / "cell-9");
+  orphan.plant_ca = second.directory;  // holds no CA keys
+  EXPECT_EQ(test::error_of([&] { write_cell_credentials(orphan); }).rfind((second.directory / "ca").string(), 0),
+            0u);
 }
 
 }  // namespace

@@ -29,7 +29,7 @@ class CredentialsTest : public ::testing::Test {
     setup.domain = kDomain;
     setup.valid_from = std::chrono::system_clock::now() - 1h;
     setup.valid_until = setup.valid_from + 24h * 30;
-    setup.grants = transport::role_grants();
+    setup.grants = transport::role_grants(setup.cell);
     write_cell_credentials(setup);
   }
   void SetUp() override { write(cell_); }

@@ -80,8 +80,12 @@ inline constexpr int kNoRobotLayerPublisher = 226;
 // faults_e2e_test.
 inline constexpr int kFirstVersionFault = 188;
 inline constexpr int kLaterVersionFault = 189;
+inline constexpr int kSecureFirstVersionFault = 211;
+inline constexpr int kSecureRefusedWrite = 212;
 
 // security_e2e_test.
+inline constexpr int kPlainPlant = 209;
+inline constexpr int kSecurePlant = 210;
 inline constexpr int kAttack = 193;
 inline constexpr int kRoles = 194;
 inline constexpr int kOtherCa = 195;

@@ -13,14 +13,16 @@ namespace cellmap::test {
 
 class TestCredentials {
  public:
-  TestCredentials(const std::string& cell, int domain) {
+  /// `plant_ca`: another cell's credentials, whose CAs issue these (a plant), instead of new CAs.
+  TestCredentials(const std::string& cell, int domain, const TestCredentials* plant_ca = nullptr) {
     security::CellSetup setup;
     setup.directory = dir_.path();
     setup.cell = cell;
     setup.domain = static_cast<std::uint32_t>(domain);
     setup.valid_from = std::chrono::system_clock::now() - std::chrono::hours(1);
     setup.valid_until = setup.valid_from + std::chrono::hours(24);
-    setup.grants = transport::role_grants();
+    setup.grants = transport::role_grants(setup.cell);
+    if (plant_ca) setup.plant_ca = plant_ca->directory();
     security::write_cell_credentials(setup);
   }
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_.path(); }

@@ -48,8 +48,10 @@ TEST(RobotJointsTest, ReaderGetsItsCellsSamplesInTheRobotsJointOrder) {
   dds::Participant controller(test::domain::kJointsInOrder);
   dds::Participant daemon(test::domain::kJointsInOrder);
   RobotJointsReader reader(daemon, "cell-a", kJoints);
-  RobotJointsWriter writer(controller);
+  RobotJointsWriter writer(controller, "cell-a");
+  RobotJointsWriter other_cell(controller, "cell-b");
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
+  EXPECT_FALSE(other_cell.wait_for_reader(0s)) << "cell-a's reader matched cell-b's partition";
   const std::int64_t t0 = wall_clock_ns();
   RobotJoints named = joints_at("cell-a", t0, {"j3", "j1", "j2"}, {0.3, 0.1, 0.2});  // any order
   Payload carton;
@@ -59,7 +61,7 @@ TEST(RobotJointsTest, ReaderGetsItsCellsSamplesInTheRobotsJointOrder) {
   named.payload = carton;
   writer.write(named);
   writer.write(joints_at("cell-a", t0 + 4'000'000, {}, {1.0, 2.0, 3.0}));  // the robot's order
-  writer.write(joints_at("cell-b", t0, {}, {9, 9, 9}));                    // another cell: skipped
+  other_cell.write(joints_at("cell-b", t0, {}, {9, 9, 9}));                // another cell: never arrives
   ASSERT_TRUE(writer.wait_for_acks(kPatience));
   const std::vector<RobotJoints> got = take_until(reader, 2);
   ASSERT_EQ(got.size(), 2u);
@@ -86,7 +88,7 @@ TEST(RobotJointsTest, SamplesThatDoNotFitTheRobotAreRefusedAndCounted) {
   std::string last_refusal;
   RobotJointsReader reader(daemon, "cell-a", kJoints, limits,
                            [&](const std::string& why) { last_refusal = why; });
-  RobotJointsWriter writer(controller);
+  RobotJointsWriter writer(controller, "cell-a");
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
   const std::int64_t t = wall_clock_ns();
   writer.write(joints_at("cell-a", t, {"j1", "j2", "wrist"}, {0, 0, 0}));  // unknown joint

@@ -45,13 +45,17 @@ TEST(RobotStateTest, ReaderGetsItsCellsPosesInOrder) {
   dds::Participant controller(test::domain::kPosesInOrder);
   dds::Participant daemon(test::domain::kPosesInOrder);
   RobotStateReader reader(daemon, "cell-a");
-  RobotStateWriter writer(controller);
+  RobotStateWriter writer(controller, "cell-a");
+  RobotStateWriter other_cell(controller, "cell-b");  // another cell on the same domain
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
+  EXPECT_FALSE(other_cell.wait_for_reader(0s)) << "cell-a's reader matched cell-b's partition";
   for (int i = 0; i < 50; ++i) {
     writer.write(state_at("cell-a", 1'000'000'000LL + i * 4'000'000LL, 0.01 * i, 0.02 * i));
-    writer.write(state_at("cell-b", 7, 9.0, 0.0));  // another cell on the same domain
+    other_cell.write(state_at("cell-b", 7, 9.0, 0.0));
   }
   ASSERT_TRUE(writer.wait_for_acks(kPatience));
+  EXPECT_NE(test::error_of([&] { writer.write(state_at("cell-b", 7, 9.0, 0.0)); }).find("for cell 'cell-a'"),
+            std::string::npos);
   const std::vector<RobotState> got = take_until(reader, 50);
   ASSERT_EQ(got.size(), 50u);
   for (int i = 0; i < 50; ++i) {
@@ -69,7 +73,7 @@ TEST(RobotStateTest, MalformedPosesAreRejectedNotFused) {
   dds::Participant controller(test::domain::kPosesRejected);
   dds::Participant daemon(test::domain::kPosesRejected);
   RobotStateReader reader(daemon, "cell-a");
-  RobotStateWriter writer(controller);
+  RobotStateWriter writer(controller, "cell-a");
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
   RobotState scaled = state_at("cell-a", 1, 0, 0);
   scaled.X_CE.linear() *= 2.0;  // quaternion norm 2: a swapped or scaled orientation

@@ -6,6 +6,7 @@
 #include <functional>
 #include <future>
 #include <mutex>
+#include <set>
 #include <string>
 
 #include "cellmap/common/error.hpp"
@@ -176,18 +177,34 @@ TEST_F(TransportTest, PublisherRestartDoesNotRemoveBoxes) {
   for (const auto& [seen, delta] : recorded.calls) EXPECT_TRUE(delta.removed.empty()) << seen.version();
 }
 
+// Each cell in its own partition: a planner of cell-b is never matched with cell-a's writers, so none of
+// cell-a's samples reach it; a monitor of every cell gets both.
 TEST_F(TransportTest, CellsShareADomainWithoutMixing) {
   dds::Participant daemon(test::domain::kCellsShareADomain);
   dds::Participant planner(test::domain::kCellsShareADomain);
   EnvironmentPublisher cell_a(daemon, "cell-a");
   EnvironmentPublisher cell_b(daemon, "cell-b");
   EnvironmentSubscriber subscriber(planner, "cell-b");
+  EnvironmentMonitor every_cell(planner, kEveryCell);
+  ASSERT_TRUE(cell_a.wait_for_subscribers(1, kPatience)) << "the monitor of every cell did not match cell-a";
+  ASSERT_TRUE(cell_b.wait_for_subscribers(2, kPatience));
   const Environment a = test::next_environment(Environment("cell-a"), 7, 1);
   const Environment b = test::next_environment(Environment("cell-b"), 3, 1);
   cell_a.publish(a);
   cell_b.publish(b);
+  publish_versions(cell_a, a, 10);
   ASSERT_TRUE(subscriber.wait_for_version(3, kPatience));
   EXPECT_EQ(*subscriber.environment(), b);
+  std::set<std::string> cells;
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (cells.size() < 2 && std::chrono::steady_clock::now() < deadline) {
+    for (const EnvironmentMessage& m : every_cell.take(1s))
+      cells.insert(m.index() == 0 ? std::get<Environment>(m).cell() : std::get<EnvironmentDelta>(m).cell);
+  }
+  EXPECT_EQ(cells, (std::set<std::string>{"cell-a", "cell-b"}));
+  EXPECT_EQ(cell_a.subscribers_joined(), 1u) << "cell-b's planner matched cell-a's writers";
+  EXPECT_EQ(subscriber.stats().other_cells, 0u);
+  EXPECT_THROW(EnvironmentSubscriber(planner, "cell*"), Error);  // a pattern is not a cell
 }
 
 TEST_F(TransportTest, MonitorSeesSnapshotsAndDeltasInOrder) {
@@ -231,8 +248,8 @@ TEST_F(TransportTest, MonitorSeesSnapshotsAndDeltasInOrder) {
 TEST_F(TransportTest, SceneEditsArriveIntact) {
   dds::Participant simulator(test::domain::kSceneEdits);
   dds::Participant tool(test::domain::kSceneEdits);
-  SceneEditReader reader(simulator);
-  SceneEditWriter writer(tool);
+  SceneEditReader reader(simulator, "sim-cell");
+  SceneEditWriter writer(tool, kEveryCell);  // edits for every simulating daemon
   ASSERT_TRUE(writer.wait_for_reader(kPatience));
   SceneEdit edit;
   edit.kind = SceneEdit::Kind::kAddBox;
@@ -261,6 +278,9 @@ TEST_F(TransportTest, SceneEditsArriveIntact) {
   EXPECT_EQ(received[1].center, move.center);
   SceneEdit nameless;
   EXPECT_THROW(writer.write(nameless), Error);
+  SceneEdit for_one_cell = edit;
+  for_one_cell.cell = "sim-cell";
+  EXPECT_THROW(writer.write(for_one_cell), Error);  // the every-cell writer writes edits for every cell only
 }
 
 TEST_F(TransportTest, StatusReachesALateReader) {

@@ -1,5 +1,5 @@
-// `cellmap echo [--domain N] [--count K] [--timeout SEC] [--security DIR [--role R]]`: one JSON line per
-// snapshot/delta received.
+// `cellmap echo [--domain N] [--cell C] [--count K] [--timeout SEC] [--security DIR [--role R]]`: one JSON
+// line per snapshot/delta received.
 #include <chrono>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -7,6 +7,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/environment_monitor.hpp"
+#include "cellmap/transport/topics.hpp"
 #include "commands.hpp"
 #include "security_options.hpp"
 
@@ -42,6 +43,7 @@ json message_json(const transport::EnvironmentMessage& message) {
 
 struct EchoOptions {
   std::uint32_t domain = 0;
+  std::string cell;
   std::uint64_t count = 0;
   double timeout = 0;
   SecurityOptions security;
@@ -49,7 +51,8 @@ struct EchoOptions {
 
 void run_echo(const EchoOptions& options) {
   const dds::Participant participant(options.domain, options.security.setting());
-  transport::EnvironmentMonitor monitor(participant);
+  transport::EnvironmentMonitor monitor(
+      participant, options.cell.empty() ? transport::default_cell(participant) : options.cell);
   using Clock = std::chrono::steady_clock;
   const bool forever = options.timeout <= 0;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -84,6 +87,8 @@ void add_echo_command(CLI::App& app) {
   CLI::App* echo =
       app.add_subcommand("echo", "Print one JSON line per environment snapshot/delta received over DDS");
   echo->add_option("--domain", options->domain, "DDS domain id")->check(CLI::Range(0, 232));
+  echo->add_option("--cell", options->cell,
+                   "only this cell's partition (default: every cell; with --security, the credentials' cell)");
   echo->add_option("--count", options->count, "Exit after this many messages (0: never)");
   echo->add_option("--timeout", options->timeout,
                    "Fail after this many seconds without --count messages (0: never)")

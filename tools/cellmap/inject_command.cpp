@@ -8,6 +8,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/scene_edits.hpp"
+#include "cellmap/transport/topics.hpp"
 #include "commands.hpp"
 #include "parse.hpp"
 #include "security_options.hpp"
@@ -40,9 +41,10 @@ std::string fresh_name() {
 }
 
 void send(const InjectOptions& options, transport::SceneEdit edit) {
-  edit.cell = options.cell;
   const dds::Participant participant(options.domain, options.security.setting());
-  const transport::SceneEditWriter writer(participant);
+  const std::string cell = options.cell.empty() ? transport::default_cell(participant) : options.cell;
+  edit.cell = cell == transport::kEveryCell ? "" : cell;  // "": every simulating daemon
+  const transport::SceneEditWriter writer(participant, cell);
   const auto wait =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(options.wait));
   if (!writer.wait_for_reader(wait)) {
@@ -61,7 +63,7 @@ void add_inject_command(CLI::App& app) {
   auto options = std::make_shared<InjectOptions>();
   CLI::App* inject = app.add_subcommand("inject", "Edit the simulated scene of a running cellmapd over DDS");
   inject->add_option("--domain", options->domain, "DDS domain id")->check(CLI::Range(0, 232));
-  inject->add_option("--cell", options->cell, "only this cell's daemon (default: every simulating daemon)");
+  inject->add_option("--cell", options->cell, "only this cell's daemon (default: every simulating daemon; with --security, the credentials' cell)");
   inject->add_option("--wait", options->wait, "seconds to wait for the daemon")
       ->check(CLI::NonNegativeNumber);
   add_security_options(inject, options->security, security::Role::kTool);

@@ -60,9 +60,10 @@ bool of_cell(const std::string& cell, const std::string& wanted) {
 // once; the daemon writes the robot's layer at its next sweep once our reader is matched.
 LiveCell live_cell(const RenderCommandOptions& options) {
   const dds::Participant participant(*options.domain, options.security.setting());
-  transport::EnvironmentMonitor monitor(participant);
+  const std::string cell = options.cell.empty() ? transport::default_cell(participant) : options.cell;
+  transport::EnvironmentMonitor monitor(participant, cell);
   std::optional<transport::LayerReader> robot_reader;
-  if (options.robot) robot_reader.emplace(participant, transport::Layer::kRobot);
+  if (options.robot) robot_reader.emplace(participant, transport::Layer::kRobot, cell);
   std::optional<Environment> env;
   std::optional<transport::RobotLayer> robot;
   using Clock = std::chrono::steady_clock;

@@ -100,7 +100,7 @@ std::uint64_t repeat(const RobotPoseOptions& options, const std::function<void(s
 template <class Writer, class Message>
 void publish_on(const RobotPoseOptions& options, Message message, const std::string& what) {
   const dds::Participant participant(options.domain, options.security.setting());
-  const Writer writer(participant);
+  const Writer writer(participant, options.cell);
   if (!writer.wait_for_reader(seconds(options.wait))) {
     std::ostringstream reason;  // the wait as given ("1 s", not "1.000000 s")
     reason << "robot-pose: no cellmapd reading robot " << what << " on domain " << options.domain

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <set>
 
+#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "documents.hpp"
 #include "openssl_util.hpp"
@@ -141,6 +142,20 @@ Authority make_authority(const std::string& name, const CellSetup& setup) {
   return ca;
 }
 
+// One of the plant's CAs, read from another cell's credentials directory; its certificate is copied.
+Authority plant_authority(const std::string& name, const CellSetup& setup) {
+  const fs::path certificate_file = setup.plant_ca / (name + ".pem");
+  const fs::path key_file = setup.plant_ca / "ca" / (name + "_key.pem");
+  const std::string certificate_pem = read_file(certificate_file);
+  Authority ca{ossl::read_private_key(read_file(key_file)), ossl::read_certificate(certificate_pem)};
+  if (!ca.certificate) throw Error(certificate_file.string() + ": not a PEM certificate");
+  if (!ca.key) throw Error(key_file.string() + ": not an unencrypted PEM private key");
+  if (X509_check_private_key(ca.certificate.get(), ca.key.get()) != 1)
+    throw Error(key_file.string() + ": not the key of " + certificate_file.string());
+  write_new_file(setup.directory / (name + ".pem"), certificate_pem, 0644);
+  return ca;
+}
+
 // A document beside its signed form: DDS reads the .p7s, people the .xml.
 void write_signed(const fs::path& signed_file, const std::string& document, const Authority& signer) {
   fs::path plain = signed_file;
@@ -180,9 +195,12 @@ void write_cell_credentials(const CellSetup& setup) {
   std::error_code ec;
   fs::create_directories(setup.directory, ec);
   if (ec) throw Error(setup.directory.string() + ": cannot create: " + ec.message());
-  make_private_directory(setup.directory / "ca");
-  const Authority identity_ca = make_authority("identity_ca", setup);
-  const Authority permissions_ca = make_authority("permissions_ca", setup);
+  const bool new_cas = setup.plant_ca.empty();
+  if (new_cas) make_private_directory(setup.directory / "ca");
+  const Authority identity_ca =
+      new_cas ? make_authority("identity_ca", setup) : plant_authority("identity_ca", setup);
+  const Authority permissions_ca =
+      new_cas ? make_authority("permissions_ca", setup) : plant_authority("permissions_ca", setup);
   write_signed(setup.directory / "governance.p7s",
                governance_xml(setup.domain, granted_topics(setup), setup.data_protection), permissions_ca);
   for (Role role : all_roles()) write_role(role, setup, identity_ca, permissions_ca);

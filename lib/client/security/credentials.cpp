@@ -102,6 +102,15 @@ TimePoint require_permissions_for(const std::string& permissions, const std::str
   return *until;
 }
 
+// The cell a role's certificate is for: its subject's OU, as `security init` writes it.
+std::string cell_of(const X509* certificate, const fs::path& file) {
+  char cell[256] = {};
+  const int n = X509_NAME_get_text_by_NID(X509_get_subject_name(certificate), NID_organizationalUnitName, cell,
+                                          sizeof cell);
+  if (n <= 0) throw Error(file.string() + ": the subject names no cell (OU)");
+  return std::string(cell, static_cast<std::size_t>(n));
+}
+
 }  // namespace
 
 const char* to_string(Role role) {
@@ -141,6 +150,7 @@ Credentials check(const Setting& setting, std::uint32_t domain, TimePoint now) {
   const std::string permissions =
       load_document(files.permissions, permissions_ca.get(), files.permissions_ca, domain);
   credentials.subject = ossl::subject_of(certificate.get());
+  credentials.cell = cell_of(certificate.get(), files.certificate);
   expires =
       std::min(expires, require_permissions_for(permissions, credentials.subject, files.permissions, now));
   credentials.expires = expires;

@@ -18,11 +18,18 @@ constexpr const char* kGovernanceSchema =
 constexpr const char* kPermissionsSchema =
     R"(xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">)";
 
-void topic_list(std::ostringstream& xml, const char* element, const std::vector<std::string>& topics) {
+void topic_list(std::ostringstream& xml, const char* element, const std::vector<std::string>& topics,
+                const std::vector<std::string>& partitions) {
   if (topics.empty()) return;
   xml << "        <" << element << ">\n          <topics>\n";
   for (const std::string& topic : topics) xml << "            <topic>" << topic << "</topic>\n";
-  xml << "          </topics>\n        </" << element << ">\n";
+  xml << "          </topics>\n";
+  if (!partitions.empty()) {
+    xml << "          <partitions>\n";
+    for (const std::string& partition : partitions) xml << "            <partition>" << partition << "</partition>\n";
+    xml << "          </partitions>\n";
+  }
+  xml << "        </" << element << ">\n";
 }
 
 // The detail OpenSSL attached to its oldest error (PKCS7_verify puts the certificate check's reason there).
@@ -73,8 +80,8 @@ std::string permissions_xml(const std::string& grant_name, const std::string& su
       << "      <validity>\n        <not_before>" << utc_text(valid_from) << "</not_before>\n"
       << "        <not_after>" << utc_text(valid_until) << "</not_after>\n      </validity>\n"
       << "      <allow_rule>\n        <domains>\n          <id>" << domain << "</id>\n        </domains>\n";
-  topic_list(xml, "publish", grants.publish);
-  topic_list(xml, "subscribe", grants.subscribe);
+  topic_list(xml, "publish", grants.publish, grants.partitions);
+  topic_list(xml, "subscribe", grants.subscribe, grants.partitions);
   xml << "      </allow_rule>\n      <default>DENY</default>\n    </grant>\n  </permissions>\n</dds>\n";
   return xml.str();
 }

@@ -20,7 +20,7 @@ namespace cellmap::security {
                                          DataProtection data);
 
 /// One grant for `subject` on `domain`, within [valid_from, valid_until]: the topics it may publish and
-/// subscribe; everything else denied.
+/// subscribe in its partitions; everything else denied.
 [[nodiscard]] std::string permissions_xml(const std::string& grant_name, const std::string& subject,
                                           std::uint32_t domain,
                                           std::chrono::system_clock::time_point valid_from,

@@ -52,6 +52,11 @@ Qos& Qos::autodispose(bool on) {
   return *this;
 }
 
+Qos& Qos::partition(const std::string& name) {
+  dds_qset_partition1(qos_, name.c_str());
+  return *this;
+}
+
 Qos& Qos::property(const std::string& name, const std::string& value) {
   dds_qset_prop(qos_, name.c_str(), value.c_str());
   return *this;

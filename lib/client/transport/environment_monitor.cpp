@@ -7,11 +7,12 @@
 
 namespace cellmap::transport {
 
-EnvironmentMonitor::EnvironmentMonitor(const dds::Participant& participant, std::uint32_t delta_depth)
+EnvironmentMonitor::EnvironmentMonitor(const dds::Participant& participant, const std::string& cell,
+                                       std::uint32_t delta_depth)
     : snapshot_topic_(participant, &cellmap_msg_Environment_desc, kEnvironmentTopic),
       delta_topic_(participant, &cellmap_msg_EnvironmentDelta_desc, kEnvironmentDeltaTopic),
-      snapshot_reader_(participant, snapshot_topic_, environment_qos()),
-      delta_reader_(participant, delta_topic_, environment_delta_qos(delta_depth)),
+      snapshot_reader_(participant, snapshot_topic_, in_cell(environment_qos(), cell)),
+      delta_reader_(participant, delta_topic_, in_cell(environment_delta_qos(delta_depth), cell)),
       waitset_(participant) {
   waitset_.attach(snapshot_reader_);
   waitset_.attach(delta_reader_);

@@ -15,15 +15,13 @@ dds::Qos writer_qos(dds::Qos qos) {
 
 EnvironmentPublisher::EnvironmentPublisher(const dds::Participant& participant, std::string cell,
                                            std::uint32_t delta_depth)
-    : cell_(std::move(cell)),
+    : cell_(one_cell(std::move(cell), "environment publisher")),
       snapshot_topic_(participant, &cellmap_msg_Environment_desc, kEnvironmentTopic),
       delta_topic_(participant, &cellmap_msg_EnvironmentDelta_desc, kEnvironmentDeltaTopic),
       status_topic_(participant, &cellmap_msg_Status_desc, kStatusTopic),
-      snapshot_writer_(participant, snapshot_topic_, writer_qos(environment_qos())),
-      delta_writer_(participant, delta_topic_, writer_qos(environment_delta_qos(delta_depth))),
-      status_writer_(participant, status_topic_, writer_qos(status_qos())) {
-  if (cell_.empty()) throw Error("environment publisher: cell id must not be empty");
-}
+      snapshot_writer_(participant, snapshot_topic_, writer_qos(in_cell(environment_qos(), cell_))),
+      delta_writer_(participant, delta_topic_, writer_qos(in_cell(environment_delta_qos(delta_depth), cell_))),
+      status_writer_(participant, status_topic_, writer_qos(in_cell(status_qos(), cell_))) {}
 
 void EnvironmentPublisher::check_version(const Environment& env) const {
   const std::string what = "publish '" + env.cell() + "' version " + std::to_string(env.version());
@@ -60,6 +58,10 @@ void EnvironmentPublisher::publish_status(const CellStatus& status) {
 
 bool EnvironmentPublisher::wait_for_subscribers(std::uint32_t count, std::chrono::nanoseconds timeout) const {
   return delta_writer_.wait_for_readers(count, timeout);
+}
+
+std::uint32_t EnvironmentPublisher::subscribers_joined() const {
+  return delta_writer_.matched_readers_ever();
 }
 
 }  // namespace cellmap::transport

@@ -11,7 +11,7 @@ EnvironmentSubscriber::EnvironmentSubscriber(const dds::Participant& participant
       on_change_(std::move(on_change)),
       snapshot_topic_(participant, &cellmap_msg_Environment_desc, kEnvironmentTopic),
       delta_topic_(participant, &cellmap_msg_EnvironmentDelta_desc, kEnvironmentDeltaTopic),
-      delta_reader_(participant, delta_topic_, environment_delta_qos(delta_depth)),
+      delta_reader_(participant, delta_topic_, in_cell(environment_delta_qos(delta_depth), cell)),
       waitset_(participant),
       tracker_(std::move(cell)) {
   waitset_.attach(delta_reader_);
@@ -41,7 +41,7 @@ void EnvironmentSubscriber::open_or_close_snapshot_reader() {
   }
   if (needed && !snapshot_reader_) {
     // Transient local: the writer hands the new reader its current snapshot right after matching.
-    snapshot_reader_.emplace(participant_, snapshot_topic_, environment_qos());
+    snapshot_reader_.emplace(participant_, snapshot_topic_, in_cell(environment_qos(), tracker_.cell()));
     waitset_.attach(*snapshot_reader_);
   } else if (!needed && snapshot_reader_) {
     waitset_.detach(*snapshot_reader_);

@@ -413,17 +413,15 @@ std::size_t wire_size(const RobotLayer& layer) {
 }
 
 LayerWriter::LayerWriter(const dds::Participant& participant, std::string cell)
-    : cell_(std::move(cell)),
+    : cell_(one_cell(std::move(cell), "layer writer")),
       voxel_topic_(participant, descriptor(Layer::kVoxels), kVoxelLayerTopic),
       region_topic_(participant, descriptor(Layer::kChangeRegions), kChangeRegionLayerTopic),
       sensor_topic_(participant, descriptor(Layer::kSensors), kSensorLayerTopic),
       robot_topic_(participant, descriptor(Layer::kRobot), kRobotLayerTopic),
-      voxel_writer_(participant, voxel_topic_, layer_qos()),
-      region_writer_(participant, region_topic_, layer_qos()),
-      sensor_writer_(participant, sensor_topic_, layer_qos()),
-      robot_writer_(participant, robot_topic_, layer_qos()) {
-  if (cell_.empty()) throw Error("layer writer: cell must not be empty");
-}
+      voxel_writer_(participant, voxel_topic_, in_cell(layer_qos(), cell_)),
+      region_writer_(participant, region_topic_, in_cell(layer_qos(), cell_)),
+      sensor_writer_(participant, sensor_topic_, in_cell(layer_qos(), cell_)),
+      robot_writer_(participant, robot_topic_, in_cell(layer_qos(), cell_)) {}
 
 const dds::Writer& LayerWriter::writer(Layer layer) const {
   switch (layer) {
@@ -478,10 +476,10 @@ void LayerWriter::write(const RobotLayer& layer) const {
   robot_writer_.write(sample.get());
 }
 
-LayerReader::LayerReader(const dds::Participant& participant, Layer layer)
+LayerReader::LayerReader(const dds::Participant& participant, Layer layer, const std::string& cell)
     : layer_(layer),
       topic_(participant, descriptor(layer), topic_name(layer)),
-      reader_(participant, topic_, layer_qos()),
+      reader_(participant, topic_, in_cell(layer_qos(), cell)),
       waitset_(participant) {
   waitset_.attach(reader_);
 }

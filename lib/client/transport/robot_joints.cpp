@@ -37,9 +37,10 @@ RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& j
   return joints;
 }
 
-RobotJointsWriter::RobotJointsWriter(const dds::Participant& participant)
-    : topic_(participant, &cellmap_msg_RobotJoints_desc, kRobotJointsTopic),
-      writer_(participant, topic_, robot_joints_qos()) {}
+RobotJointsWriter::RobotJointsWriter(const dds::Participant& participant, std::string cell)
+    : cell_(one_cell(std::move(cell), std::string(kRobotJointsTopic) + " writer")),
+      topic_(participant, &cellmap_msg_RobotJoints_desc, kRobotJointsTopic),
+      writer_(participant, topic_, in_cell(robot_joints_qos(), cell_)) {}
 
 bool RobotJointsWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_readers(1, timeout);
@@ -47,6 +48,10 @@ bool RobotJointsWriter::wait_for_reader(std::chrono::nanoseconds timeout) const 
 
 void RobotJointsWriter::write(const RobotJoints& joints) const {
   wire::validate(joints);
+  if (joints.cell != cell_) {
+    throw Error(std::string(kRobotJointsTopic) + " '" + joints.cell + "': this writer is for cell '" + cell_ +
+                "'");
+  }
   const wire::RobotJointsSample sample(joints);
   writer_.write(sample.get());
 }
@@ -58,12 +63,12 @@ bool RobotJointsWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
 RobotJointsReader::RobotJointsReader(const dds::Participant& participant, std::string cell,
                                      std::vector<std::string> joint_names, InputLimits limits,
                                      OnRefused on_refused)
-    : cell_(std::move(cell)),
+    : cell_(one_cell(std::move(cell), std::string(kRobotJointsTopic) + " reader")),
       joint_names_(std::move(joint_names)),
       limits_(std::move(limits)),
       on_refused_(std::move(on_refused)),
       topic_(participant, &cellmap_msg_RobotJoints_desc, kRobotJointsTopic),
-      reader_(participant, topic_, robot_joints_qos()),
+      reader_(participant, topic_, in_cell(robot_joints_qos(), cell_)),
       waitset_(participant) {
   const std::string where = std::string(kRobotJointsTopic) + " reader";
   if (joint_names_.empty()) throw Error(where + ": the robot has no joints");

@@ -9,9 +9,10 @@
 
 namespace cellmap::transport {
 
-RobotStateWriter::RobotStateWriter(const dds::Participant& participant)
-    : topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
-      writer_(participant, topic_, robot_state_qos()) {}
+RobotStateWriter::RobotStateWriter(const dds::Participant& participant, std::string cell)
+    : cell_(one_cell(std::move(cell), std::string(kRobotStateTopic) + " writer")),
+      topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
+      writer_(participant, topic_, in_cell(robot_state_qos(), cell_)) {}
 
 bool RobotStateWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_readers(1, timeout);
@@ -19,6 +20,8 @@ bool RobotStateWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
 
 void RobotStateWriter::write(const RobotState& state) const {
   if (state.cell.empty()) throw Error(std::string(kRobotStateTopic) + ": cell: must not be empty");
+  if (state.cell != cell_)
+    throw Error(std::string(kRobotStateTopic) + " '" + state.cell + "': this writer is for cell '" + cell_ + "'");
   if (!state.X_CE.matrix().allFinite())
     throw Error(std::string(kRobotStateTopic) + " '" + state.cell + "': pose is not finite");
   const wire::RobotStateSample sample(state);
@@ -31,11 +34,11 @@ bool RobotStateWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
 
 RobotStateReader::RobotStateReader(const dds::Participant& participant, std::string cell, InputLimits limits,
                                    OnRefused on_refused)
-    : cell_(std::move(cell)),
+    : cell_(one_cell(std::move(cell), std::string(kRobotStateTopic) + " reader")),
       limits_(std::move(limits)),
       on_refused_(std::move(on_refused)),
       topic_(participant, &cellmap_msg_RobotState_desc, kRobotStateTopic),
-      reader_(participant, topic_, robot_state_qos()),
+      reader_(participant, topic_, in_cell(robot_state_qos(), cell_)),
       waitset_(participant) {
   waitset_.attach(reader_);
 }

@@ -6,9 +6,10 @@
 
 namespace cellmap::transport {
 
-SceneEditWriter::SceneEditWriter(const dds::Participant& participant)
-    : topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
-      writer_(participant, topic_, scene_edit_qos()) {}
+SceneEditWriter::SceneEditWriter(const dds::Participant& participant, std::string cell)
+    : cell_(std::move(cell)),
+      topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
+      writer_(participant, topic_, in_cell(scene_edit_qos(), cell_)) {}
 
 bool SceneEditWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_readers(1, timeout);
@@ -16,6 +17,12 @@ bool SceneEditWriter::wait_for_reader(std::chrono::nanoseconds timeout) const {
 
 void SceneEditWriter::write(const SceneEdit& edit) const {
   if (edit.name.empty()) throw Error(std::string(kSceneEditTopic) + ": name: must not be empty");
+  const bool for_every_cell = edit.cell.empty();
+  if (for_every_cell != (cell_ == kEveryCell) || (!for_every_cell && edit.cell != cell_)) {
+    throw Error(std::string(kSceneEditTopic) + ": an edit for " +
+                (for_every_cell ? "every cell" : "cell '" + edit.cell + "'") + " on a writer for " +
+                (cell_ == kEveryCell ? "every cell" : "cell '" + cell_ + "'"));
+  }
   const wire::SceneEditSample sample(edit);
   writer_.write(sample.get());
 }
@@ -24,12 +31,12 @@ bool SceneEditWriter::wait_for_acks(std::chrono::nanoseconds timeout) const {
   return writer_.wait_for_acks(timeout);
 }
 
-SceneEditReader::SceneEditReader(const dds::Participant& participant, InputLimits limits,
-                                 OnRefused on_refused)
+SceneEditReader::SceneEditReader(const dds::Participant& participant, const std::string& cell,
+                                 InputLimits limits, OnRefused on_refused)
     : limits_(std::move(limits)),
       on_refused_(std::move(on_refused)),
       topic_(participant, &cellmap_msg_SceneEdit_desc, kSceneEditTopic),
-      reader_(participant, topic_, scene_edit_qos()),
+      reader_(participant, topic_, in_cell(scene_edit_qos(), cell)),
       waitset_(participant) {
   waitset_.attach(reader_);
 }

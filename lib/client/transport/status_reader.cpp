@@ -8,9 +8,9 @@
 
 namespace cellmap::transport {
 
-StatusReader::StatusReader(const dds::Participant& participant)
+StatusReader::StatusReader(const dds::Participant& participant, const std::string& cell)
     : topic_(participant, &cellmap_msg_Status_desc, kStatusTopic),
-      reader_(participant, topic_, status_qos()),
+      reader_(participant, topic_, in_cell(status_qos(), cell)),
       waitset_(participant) {
   waitset_.attach(reader_);
 }

@@ -4,6 +4,29 @@
 
 namespace cellmap::transport {
 
+std::string cell_partition(const std::string& cell) {
+  if (cell == kEveryCell) return std::string(kPartitionPrefix) + kEveryCell;
+  if (cell.empty()) throw Error("a cell id must not be empty");
+  if (cell.find_first_of("*?\\") != std::string::npos)
+    throw Error("cell id '" + cell + "': '*', '?' and '\\' are DDS partition patterns");
+  return kPartitionPrefix + cell;
+}
+
+std::string one_cell(std::string cell, const std::string& what) {
+  if (cell.empty()) throw Error(what + ": the cell id must not be empty");
+  if (cell == kEveryCell) throw Error(what + ": is for one cell, not every cell");
+  return cell;
+}
+
+std::string default_cell(const dds::Participant& participant) {
+  return participant.credentials() ? participant.credentials()->cell : std::string(kEveryCell);
+}
+
+dds::Qos in_cell(dds::Qos qos, const std::string& cell) {
+  qos.partition(cell_partition(cell));
+  return qos;
+}
+
 dds::Qos environment_qos() {
   return dds::Qos::make(true, 1);
 }
@@ -29,16 +52,18 @@ dds::Qos layer_qos() {
   return dds::Qos::make(false, 1);
 }
 
-std::map<security::Role, security::TopicGrants> role_grants() {
+std::map<security::Role, security::TopicGrants> role_grants(const std::string& cell) {
   using security::Role;
+  const std::vector<std::string> partition{cell_partition(one_cell(cell, "DDS Security grants"))};
   const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
   std::vector<std::string> environment_and_layers = environment;
   environment_and_layers.insert(environment_and_layers.end(),
                                 {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic, kRobotLayerTopic});
-  return {{Role::kDaemon, {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}}},
-          {Role::kPlanner, {{}, environment_and_layers}},
-          {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}}},
-          {Role::kTool, {{kSceneEditTopic}, environment}}};
+  return {{Role::kDaemon,
+           {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}, partition}},
+          {Role::kPlanner, {{}, environment_and_layers, partition}},
+          {Role::kRobot, {{kRobotStateTopic, kRobotJointsTopic}, {}, partition}},
+          {Role::kTool, {{kSceneEditTopic}, environment, partition}}};
 }
 
 dds::Qos robot_joints_qos() {

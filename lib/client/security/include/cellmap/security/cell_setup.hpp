@@ -15,10 +15,13 @@
 
 namespace cellmap::security {
 
-/// What one role may write (publish) and read (subscribe): DDS topic names. Everything else is denied.
+/// What one role may write (publish) and read (subscribe): DDS topic names, in the DDS partitions listed
+/// (none: the default partition only). Everything else is denied: another partition, a partition pattern
+/// that is not listed as such, a topic not listed.
 struct TopicGrants final {
   std::vector<std::string> publish;
   std::vector<std::string> subscribe;
+  std::vector<std::string> partitions;
 };
 
 /// How samples on the cell's topics travel. Either way only authenticated participants with the right
@@ -34,13 +37,20 @@ struct CellSetup final {
   std::chrono::system_clock::time_point valid_until;  ///< after valid_from
   std::map<Role, TopicGrants> grants;                 ///< every role's; the governance covers their topics
   DataProtection data_protection = DataProtection::kEncrypt;
+  /// Empty: new CAs for this cell alone (its participants talk to no other cell's). Otherwise the
+  /// credentials directory of another cell of the same plant, holding its CA certificates and ca/ keys:
+  /// this cell's identities and documents are issued by those CAs, so the plant's participants
+  /// authenticate each other, while each cell's permissions still grant only its own partitions.
+  std::filesystem::path plant_ca;
 };
 
 /// Writes the credentials of `setup.cell` into `setup.directory`: private keys with mode 0600 (created so,
-/// never wider for an instant), the role and CA folders 0700, the rest 0644. The plain XML of each signed
+/// never wider for an instant), the role and CA folders 0700, the rest 0644. With `plant_ca` the CA
+/// certificates are copied from there and no ca/ folder is written (the plant's CA keys stay in one place). The plain XML of each signed
 /// document is written beside it (`.xml`) for reading; DDS reads only the signed one.
 /// @throws Error naming the option or path: bad cell id, domain or validity, a role without grants, a
-/// directory that is not empty, a write or OpenSSL failure (the directory may then hold part of the set).
+/// directory that is not empty, a plant CA directory without its CA certificates and keys (or a key that is
+/// not its certificate's), a write or OpenSSL failure (the directory may then hold part of the set).
 void write_cell_credentials(const CellSetup& setup);
 
 }  // namespace cellmap::security

@@ -52,6 +52,7 @@ struct Setting final {
 struct Credentials final {
   RoleFiles files;
   std::string subject;  ///< the certificate's subject, e.g. "CN=planner,OU=cell-1,O=cellmap"
+  std::string cell;     ///< the cell they are for (the subject's OU): their permissions grant its partition only
   /// The earliest end of validity among the certificates and the permissions: after it the participant
   /// can no longer join (and a running one loses its peers).
   std::chrono::system_clock::time_point expires;
@@ -62,7 +63,7 @@ struct Credentials final {
 /// unencrypted PEM private key, S/MIME document); the private key must give group and others no access and
 /// belong to the certificate; the certificates must be within their validity at `now`, the role's signed by
 /// the identity CA; the documents must be signed by the permissions CA, made for `domain`, and the
-/// permissions for this certificate's subject and within their validity.
+/// permissions for this certificate's subject and within their validity. The subject must name a cell (OU).
 /// @throws Error "<file>: <reason>" naming the first file found wrong.
 [[nodiscard]] Credentials check(const Setting& setting, std::uint32_t domain,
                                 std::chrono::system_clock::time_point now = std::chrono::system_clock::now());

@@ -38,6 +38,10 @@ class Qos final {
   /// Writers only: when false, deleting the writer (a daemon restart) unregisters its instances without
   /// disposing them, so readers keep the data instead of seeing it removed.
   Qos& autodispose(bool on);
+  /// Readers and writers: puts the entity in one DDS partition (instead of the default partition ""). A name
+  /// with '*' or '?' is a pattern: it matches every partition it fits (Cyclone matches patterns on either
+  /// side, never a pattern with a pattern).
+  Qos& partition(const std::string& name);
   /// Sets a named property (participants: e.g. DDS Security's "dds.sec.*").
   Qos& property(const std::string& name, const std::string& value);
   [[nodiscard]] const dds_qos_t* get() const { return qos_; }

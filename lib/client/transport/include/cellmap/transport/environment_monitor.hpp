@@ -15,13 +15,15 @@ namespace cellmap::transport {
 
 using EnvironmentMessage = std::variant<Environment, EnvironmentDelta>;
 
-/// Raw reader of cellmap/environment and cellmap/environment_delta (all cells, no bookkeeping). On joining
-/// it receives each cell's current snapshot and up to `delta_depth` recent deltas (transient local).
+/// Raw reader of cellmap/environment and cellmap/environment_delta (no bookkeeping), of one cell's partition
+/// or of every cell's (kEveryCell). On joining it receives each cell's current snapshot and up to
+/// `delta_depth` recent deltas (transient local).
 /// `participant` must outlive it. Not thread-safe.
 class EnvironmentMonitor final {
  public:
-  /// @throws Error if a reader cannot be created.
-  explicit EnvironmentMonitor(const dds::Participant& participant,
+  /// @throws Error if a reader cannot be created (e.g. DDS Security grants only one cell's partition) or
+  /// the cell id is not valid (cell_partition).
+  explicit EnvironmentMonitor(const dds::Participant& participant, const std::string& cell = kEveryCell,
                               std::uint32_t delta_depth = kDefaultDeltaDepth);
   ~EnvironmentMonitor();
   EnvironmentMonitor(const EnvironmentMonitor&) = delete;

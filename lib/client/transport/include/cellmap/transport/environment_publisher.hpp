@@ -19,8 +19,9 @@ namespace cellmap::transport {
 /// `participant` must outlive the publisher. Not thread-safe (one publishing thread).
 class EnvironmentPublisher final {
  public:
+  /// Writes into the cell's partition (topics.hpp).
   /// @param delta_depth the delta history kept for late joiners (KEEP_LAST), >= 1.
-  /// @throws Error if a writer cannot be created or delta_depth is 0.
+  /// @throws Error if a writer cannot be created, delta_depth is 0, or `cell` is not one valid cell id.
   EnvironmentPublisher(const dds::Participant& participant, std::string cell,
                        std::uint32_t delta_depth = kDefaultDeltaDepth);
 
@@ -38,6 +39,8 @@ class EnvironmentPublisher final {
   /// Blocks until `count` readers of the delta topic (every subscriber and monitor has one) matched or the
   /// timeout passed; true if they did.
   bool wait_for_subscribers(std::uint32_t count, std::chrono::nanoseconds timeout) const;
+  /// How many readers of the delta topic ever matched (grows by one per subscriber that joins).
+  [[nodiscard]] std::uint32_t subscribers_joined() const;
 
   [[nodiscard]] const std::string& cell() const { return cell_; }
   /// The last version published, 0 before the first.

@@ -19,6 +19,7 @@ namespace cellmap::transport {
 /// change with the delta from the previous local version. A late joiner gets the current environment at once
 /// (the snapshot topic is transient local).
 ///
+/// Its readers are in the cell's partition only (topics.hpp): other cells' samples never reach it.
 /// While in sync it reads only cellmap/environment_delta; it opens a reader on cellmap/environment only while
 /// it needs a snapshot (at start and after a gap), so a one-box change costs each planner one small delta on
 /// the wire, not a full snapshot.

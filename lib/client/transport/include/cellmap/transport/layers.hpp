@@ -121,7 +121,7 @@ inline constexpr std::array<Layer, 4> kLayers{Layer::kVoxels, Layer::kChangeRegi
 /// outlive it. Thread-safe as Cyclone's writes are.
 class LayerWriter final {
  public:
-  /// @throws Error if a writer cannot be created or `cell` is empty.
+  /// @throws Error if a writer cannot be created or `cell` is empty or kEveryCell.
   LayerWriter(const dds::Participant& participant, std::string cell);
   /// Readers of `layer` matched now: write the layer only when this is above 0.
   [[nodiscard]] std::uint32_t readers(Layer layer) const;
@@ -152,12 +152,12 @@ class LayerWriter final {
   dds::Writer robot_writer_;
 };
 
-/// A viewer's side: reads one layer of every cell. Opening it is what asks the daemons for the layer;
+/// A viewer's side: reads one layer of one cell or of every cell (kEveryCell). Opening it is what asks the daemons for the layer;
 /// destroying it stops them. `participant` must outlive it. Not thread-safe.
 class LayerReader final {
  public:
   /// @throws Error if the reader cannot be created.
-  LayerReader(const dds::Participant& participant, Layer layer);
+  LayerReader(const dds::Participant& participant, Layer layer, const std::string& cell = kEveryCell);
   ~LayerReader();
   LayerReader(const LayerReader&) = delete;
   LayerReader& operator=(const LayerReader&) = delete;

@@ -10,6 +10,7 @@
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
+#include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport {
 
@@ -17,10 +18,11 @@ namespace cellmap::transport {
 /// Cyclone's writes are.
 class RobotJointsWriter final {
  public:
-  explicit RobotJointsWriter(const dds::Participant& participant);
+  /// Writes joint states of `cell` only, into its partition. @throws Error if `cell` is empty or kEveryCell.
+  RobotJointsWriter(const dds::Participant& participant, std::string cell);
   /// True once at least one robot-joints reader (a daemon) matched, false on timeout.
   bool wait_for_reader(std::chrono::nanoseconds timeout) const;
-  /// @throws Error naming the topic and field if the cell is empty, names are given but their count is not
+  /// @throws Error naming the topic and field if the cell is empty or not the writer's, names are given but their count is not
   /// the positions' count, a number is not finite, a payload half extent is negative or its rotation is not
   /// orthonormal, or the write fails.
   void write(const RobotJoints& joints) const;
@@ -28,6 +30,7 @@ class RobotJointsWriter final {
   bool wait_for_acks(std::chrono::nanoseconds timeout) const;
 
  private:
+  std::string cell_;
   dds::Topic topic_;
   dds::Writer writer_;
 };

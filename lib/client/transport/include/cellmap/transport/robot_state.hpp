@@ -10,6 +10,7 @@
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
+#include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport {
 
@@ -17,17 +18,19 @@ namespace cellmap::transport {
 /// Cyclone's writes are.
 class RobotStateWriter final {
  public:
-  explicit RobotStateWriter(const dds::Participant& participant);
+  /// Writes poses of `cell` only, into its partition. @throws Error if `cell` is empty or kEveryCell.
+  RobotStateWriter(const dds::Participant& participant, std::string cell);
   /// True once at least one robot-state reader (a daemon) matched, false on timeout.
   bool wait_for_reader(std::chrono::nanoseconds timeout) const;
   /// The rotation is sent as a quaternion of X_CE.linear(), which must be a rotation matrix: a scaled one
   /// is sent as a non-unit quaternion, which every reader rejects and counts.
-  /// @throws Error if the cell is empty, the pose is not finite, or the write fails.
+  /// @throws Error if the cell is not the writer's, the pose is not finite, or the write fails.
   void write(const RobotState& state) const;
   /// True once every matched reader acknowledged everything written, false on timeout.
   bool wait_for_acks(std::chrono::nanoseconds timeout) const;
 
  private:
+  std::string cell_;
   dds::Topic topic_;
   dds::Writer writer_;
 };

@@ -7,6 +7,7 @@
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/messages.hpp"
+#include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport {
 
@@ -15,15 +16,19 @@ namespace cellmap::transport {
 /// `participant` must outlive it.
 class SceneEditWriter final {
  public:
-  explicit SceneEditWriter(const dds::Participant& participant);
+  /// Writes into the partition of `cell`, reaching that cell's daemon; with kEveryCell every simulating
+  /// daemon on the domain (its edits have an empty cell).
+  SceneEditWriter(const dds::Participant& participant, std::string cell);
   /// True once at least one scene-edit reader (a simulating daemon) matched, false on timeout.
   bool wait_for_reader(std::chrono::nanoseconds timeout) const;
-  /// @throws Error if the edit has no name or the write fails.
+  /// @throws Error if the edit has no name, is for another cell than the writer (an empty cell on a
+  /// kEveryCell writer), or the write fails.
   void write(const SceneEdit& edit) const;
   /// True once every matched reader acknowledged everything written, false on timeout.
   bool wait_for_acks(std::chrono::nanoseconds timeout) const;
 
  private:
+  std::string cell_;
   dds::Topic topic_;
   dds::Writer writer_;
 };
@@ -31,10 +36,11 @@ class SceneEditWriter final {
 /// Receives scene edits (the simulator side). `participant` must outlive it. Not thread-safe.
 class SceneEditReader final {
  public:
+  /// @param cell       reads the partition of this cell (edits for it and for every cell)
   /// @param limits     edits outside them are refused (input_limits.hpp)
   /// @param on_refused called with the reason of each refused edit, from take()
-  explicit SceneEditReader(const dds::Participant& participant, InputLimits limits = {},
-                           OnRefused on_refused = {});
+  SceneEditReader(const dds::Participant& participant, const std::string& cell, InputLimits limits = {},
+                  OnRefused on_refused = {});
   ~SceneEditReader();
   SceneEditReader(const SceneEditReader&) = delete;
   SceneEditReader& operator=(const SceneEditReader&) = delete;

@@ -1,5 +1,5 @@
 #pragma once
-// Reads cellmap/status: the health reports of every cell daemon on a domain.
+// Reads cellmap/status: the health reports of one cell's daemon or of every cell daemon on a domain.
 
 #include <chrono>
 #include <string>
@@ -7,6 +7,7 @@
 
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/messages.hpp"
+#include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport {
 
@@ -14,8 +15,9 @@ namespace cellmap::transport {
 /// Not thread-safe.
 class StatusReader final {
  public:
-  /// @throws Error if the reader cannot be created.
-  explicit StatusReader(const dds::Participant& participant);
+  /// Reads the partition of `cell`, or of every cell (kEveryCell).
+  /// @throws Error if the reader cannot be created (e.g. DDS Security grants only one cell's partition).
+  explicit StatusReader(const dds::Participant& participant, const std::string& cell = kEveryCell);
   ~StatusReader();
   StatusReader(const StatusReader&) = delete;
   StatusReader& operator=(const StatusReader&) = delete;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <string>
 
 #include "cellmap/security/cell_setup.hpp"
 #include "cellmap/transport/dds.hpp"
@@ -20,6 +21,28 @@ inline constexpr const char* kChangeRegionLayerTopic = "cellmap/layer/change_reg
 inline constexpr const char* kSensorLayerTopic = "cellmap/layer/sensors";
 inline constexpr const char* kRobotLayerTopic = "cellmap/layer/robot";
 inline constexpr const char* kRobotJointsTopic = "cellmap/robot_joints";
+
+/// Each cell's traffic travels in a DDS partition of its own, "cellmap/<cell>": a reader of one cell is never
+/// matched with another cell's writers, so their samples never reach it (keys alone would only sort them
+/// into instances after they crossed the wire). kEveryCell in place of a cell id makes the pattern
+/// "cellmap/*": a reader that follows every cell (a monitor, `cellmap echo`), or a scene-edit writer that
+/// edits every simulating daemon.
+inline constexpr const char* kEveryCell = "*";
+inline constexpr const char* kPartitionPrefix = "cellmap/";
+
+/// "cellmap/<cell>", or "cellmap/*" for kEveryCell.
+/// @throws Error if the cell is empty or holds '*', '?' or '\\' (pattern characters) other than kEveryCell.
+[[nodiscard]] std::string cell_partition(const std::string& cell);
+
+/// `cell` when it names one cell. @throws Error "<what>: ..." if it is empty or kEveryCell.
+[[nodiscard]] std::string one_cell(std::string cell, const std::string& what);
+
+/// `qos` limited to the partition of `cell` (cell_partition).
+[[nodiscard]] dds::Qos in_cell(dds::Qos qos, const std::string& cell);
+
+/// What a program follows when no cell is given: with DDS Security on, the cell of its credentials (they
+/// grant no other partition); without, kEveryCell.
+[[nodiscard]] std::string default_cell(const dds::Participant& participant);
 
 /// How many deltas per cell the writer keeps for late joiners unless configured otherwise.
 inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
@@ -42,11 +65,13 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 /// wants the newest, and the daemon writes it only while a reader is matched).
 [[nodiscard]] dds::Qos layer_qos();
 
-/// What each DDS Security role may write and read (`cellmap security init` signs these into the permissions):
+/// What each DDS Security role of `cell` may write and read, in the cell's partition only (`cellmap security
+/// init` signs these into the permissions):
 ///   daemon   writes environment, delta, status, layers;  reads robot state and joints, scene edits (sim)
 ///   planner  writes nothing;                             reads environment, delta, status, layers (`view`)
 ///   robot    writes robot state and joints;              reads nothing
 ///   tool     writes scene edits (`inject`);              reads environment, delta, status (`echo`)
-[[nodiscard]] std::map<security::Role, security::TopicGrants> role_grants();
+/// @throws Error if `cell` is not one valid cell id.
+[[nodiscard]] std::map<security::Role, security::TopicGrants> role_grants(const std::string& cell);
 
 }  // namespace cellmap::transport
