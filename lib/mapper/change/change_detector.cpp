@@ -1,7 +1,12 @@
 #include "cellmap/change/change_detector.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <istream>
 #include <iterator>
+#include <limits>
+#include <optional>
+#include <ostream>
 #include <sstream>
 #include <tuple>
 #include <unordered_set>
@@ -34,6 +39,37 @@ void for_each_neighbour(const Key& key, Visit&& visit) {
   }
 }
 
+constexpr const char* kStateHeader = "cellmap-change";
+
+// Keys of `map` in (z, y, x) order, so that a state is written the same way every time.
+template <class Map>
+std::vector<Key> sorted_keys(const Map& map) {
+  std::vector<Key> keys;
+  keys.reserve(map.size());
+  for (const auto& entry : map) keys.push_back(entry.first);
+  std::sort(keys.begin(), keys.end(), zyx_less);
+  return keys;
+}
+
+std::ostream& write_key(std::ostream& out, const Key& key) {
+  return out << key[0] << ' ' << key[1] << ' ' << key[2];
+}
+
+// Reads the rest of a line, `count` unsigned integers separated by one space, from `in`; false if it is not.
+bool read_line(std::istream& in, std::uint64_t* values, int count) {
+  for (int i = 0; i < count; ++i) {
+    if ((i > 0 && in.get() != ' ') || !std::isdigit(in.peek()) || !(in >> values[i])) return false;
+  }
+  return in.get() == '\n';
+}
+
+// The key of the first three values of a line, if each is a key coordinate.
+std::optional<Key> key_of(const std::uint64_t* xyz) {
+  if (xyz[0] > 0xffff || xyz[1] > 0xffff || xyz[2] > 0xffff) return std::nullopt;
+  return Key(static_cast<std::uint16_t>(xyz[0]), static_cast<std::uint16_t>(xyz[1]),
+             static_cast<std::uint16_t>(xyz[2]));
+}
+
 [[noreturn]] void bad(const std::string& field, const std::string& rule, double value) {
   std::ostringstream msg;
   msg << "change." << field << ": " << rule << ", got " << value;
@@ -61,6 +97,44 @@ ChangeConfig ChangeConfig::from_yaml(YamlMap section) {
 
 ChangeDetector::ChangeDetector(const ChangeConfig& config) : config_(config) {
   config_.validate();
+}
+
+void ChangeDetector::write(std::ostream& out) const {
+  out << kStateHeader << ' ' << sweep_ << ' ' << pending_.size() << ' ' << reported_.size() << '\n';
+  for (const Key& key : sorted_keys(pending_)) {
+    const Pending& p = pending_.at(key);
+    write_key(out, key) << ' ' << (p.was_occupied ? 1 : 0) << ' ' << p.sweeps << '\n';
+  }
+  for (const Key& key : sorted_keys(reported_)) write_key(out, key) << ' ' << reported_.at(key) << '\n';
+  if (!out) throw Error("change detector state: write failed");
+}
+
+void ChangeDetector::read(std::istream& in) {
+  const auto fail = [](const std::string& what) { throw Error("change detector state: " + what); };
+  std::string header(std::char_traits<char>::length(kStateHeader), '\0');
+  std::uint64_t counts[3];  // sweep, pending, reported
+  if (!in.read(header.data(), static_cast<std::streamsize>(header.size())) || header != kStateHeader ||
+      in.get() != ' ' || !read_line(in, counts, 3)) {
+    fail("bad header line");
+  }
+  const std::uint64_t sweep = counts[0];
+  std::unordered_map<Key, Pending, Key::KeyHash> pending;
+  for (std::uint64_t i = 0; i < counts[1]; ++i) {
+    std::uint64_t v[5];  // x y z was_occupied sweeps_held
+    const std::optional<Key> key = read_line(in, v, 5) ? key_of(v) : std::nullopt;
+    if (!key || v[3] > 1 || v[4] < 1 || v[4] > 1000) fail("bad pending voxel " + std::to_string(i + 1));
+    pending.emplace(*key, Pending{v[3] == 1, static_cast<int>(v[4])});
+  }
+  std::unordered_map<Key, std::uint64_t, Key::KeyHash> reported;
+  for (std::uint64_t i = 0; i < counts[2]; ++i) {
+    std::uint64_t v[4];  // x y z sweep
+    const std::optional<Key> key = read_line(in, v, 4) ? key_of(v) : std::nullopt;
+    if (!key || v[3] > sweep) fail("bad reported voxel " + std::to_string(i + 1));
+    reported.emplace(*key, v[3]);
+  }
+  sweep_ = sweep;
+  pending_ = std::move(pending);
+  reported_ = std::move(reported);
 }
 
 ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyMap& map) {

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <unordered_map>
 #include <vector>
 
@@ -80,6 +81,18 @@ class ChangeDetector final {
   /// Voxels whose flip is still waiting for confirmation.
   [[nodiscard]] std::size_t pending() const { return pending_.size(); }
   [[nodiscard]] const ChangeConfig& config() const { return config_; }
+
+  /// Writes what the detector remembers between sweeps (the sweep count, the pending flips, the appeared
+  /// voxels of recently reported regions) as text: a line `cellmap-change SWEEP PENDING REPORTED`, then one
+  /// line per pending voxel (`x y z was_occupied sweeps_held`) and per reported voxel (`x y z sweep`), keys
+  /// in (z, y, x) order. Saved with the map it belongs to, so that after a restart a flip seen before the
+  /// map was saved still waits for confirmation instead of passing for the confirmed state.
+  /// @throws Error if the stream fails.
+  void write(std::ostream& out) const;
+  /// Replaces the state with one written by write(). Flips that held longer than `persist_sweeps` (a
+  /// config lowered meanwhile) are confirmed by the next update().
+  /// @throws Error (the state unchanged) if the text is not such a state.
+  void read(std::istream& in);
 
  private:
   struct Pending {
