@@ -17,7 +17,6 @@ namespace cellmap {
 namespace {
 
 using Key = octomap::OcTreeKey;
-using KeySet = std::unordered_set<Key, Key::KeyHash>;
 
 bool zyx_less(const Key& a, const Key& b) {
   return std::make_tuple(a[2], a[1], a[0]) < std::make_tuple(b[2], b[1], b[0]);
@@ -140,8 +139,27 @@ void ChangeDetector::read(std::istream& in) {
 ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyMap& map) {
   ChangeSet changes;
   changes.sweep = ++sweep_;
+  record_flips(update);
+  const ConfirmedFlips confirmed = confirm_held_flips();
+  forget_old_reports();
+  if (confirmed.empty()) return changes;
 
-  // 1. Flips: a pending voxel that flips again is back at its confirmed state; any other starts pending.
+  // Grouped in sorted order so that the result is deterministic.
+  std::vector<Key> seeds;
+  seeds.reserve(confirmed.size());
+  for (const auto& entry : confirmed) seeds.push_back(entry.first);
+  std::sort(seeds.begin(), seeds.end(), zyx_less);
+  KeySet grouped;
+  for (const Key& seed : seeds) {
+    if (!grouped.insert(seed).second) continue;
+    std::optional<ChangeRegion> region = grow_region(seed, confirmed, map, grouped);
+    if (region) changes.regions.push_back(std::move(*region));
+  }
+  return changes;
+}
+
+// A pending voxel that flips again is back at its confirmed state; any other starts pending.
+void ChangeDetector::record_flips(const OccupancyUpdate& update) {
   auto flip = [&](const Key& key, bool now_occupied) {
     const auto it = pending_.find(key);
     if (it != pending_.end()) {
@@ -152,9 +170,11 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
   };
   for (const Key& key : update.appeared) flip(key, true);
   for (const Key& key : update.vanished) flip(key, false);
+}
 
-  // 2. Confirm the voxels whose new state has now held for persist_sweeps sweeps.
-  std::unordered_map<Key, bool, Key::KeyHash> confirmed;  // key → now occupied
+// The voxels whose new state has now held for persist_sweeps sweeps leave the pending ones.
+ChangeDetector::ConfirmedFlips ChangeDetector::confirm_held_flips() {
+  ConfirmedFlips confirmed;
   for (auto it = pending_.begin(); it != pending_.end();) {
     if (++it->second.sweeps >= config_.persist_sweeps) {
       confirmed.emplace(it->first, !it->second.was_occupied);
@@ -163,56 +183,54 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
       ++it;
     }
   }
-  // A reported object's voxels stop counting as "new" once its slower parts have had time to follow.
+  return confirmed;
+}
+
+// A reported object's voxels stop counting as "new" once its slower parts have had time to follow.
+void ChangeDetector::forget_old_reports() {
   const std::uint64_t follow = 2 * static_cast<std::uint64_t>(config_.persist_sweeps);
   for (auto it = reported_.begin(); it != reported_.end();) {
     it = (sweep_ - it->second >= follow) ? reported_.erase(it) : std::next(it);
   }
-  if (confirmed.empty()) return changes;
+}
 
-  // 3. Group by 26-connectivity, in sorted order so that the result is deterministic.
-  std::vector<Key> seeds;
-  seeds.reserve(confirmed.size());
-  for (const auto& entry : confirmed) seeds.push_back(entry.first);
-  std::sort(seeds.begin(), seeds.end(), zyx_less);
-  const double half = 0.5 * map.tree().getResolution();
-  KeySet grouped;
-  for (const Key& seed : seeds) {
-    if (!grouped.insert(seed).second) continue;
-    ChangeRegion region;
-    int off_surface_appeared = 0, off_surface_vanished = 0;
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-    Eigen::Vector3d hi = -lo;
-    std::vector<Key> stack = {seed};
-    while (!stack.empty()) {
-      const Key key = stack.back();
-      stack.pop_back();
-      const bool appeared = confirmed.at(key);
-      (appeared ? region.appeared : region.vanished).push_back(key);
-      const Eigen::Vector3d c = map.centre(key);
-      lo = lo.cwiseMin(c);
-      hi = hi.cwiseMax(c);
-      bool touches_unchanged_surface = false;
-      for_each_neighbour(key, [&](const Key& n) {
-        if (confirmed.count(n) != 0) {
-          if (grouped.insert(n).second) stack.push_back(n);
-        } else if (!touches_unchanged_surface && pending_.count(n) == 0 && reported_.count(n) == 0 &&
-                   map.state(n) == VoxelState::occupied) {
-          touches_unchanged_surface = true;
-        }
-      });
-      if (!touches_unchanged_surface) ++(appeared ? off_surface_appeared : off_surface_vanished);
-    }
-    // Counted per kind: a surface voxel that jitters to its neighbour is one vanished and one appeared voxel,
-    // which together are not an object arriving or leaving.
-    if (std::max(off_surface_appeared, off_surface_vanished) < config_.min_voxels) continue;  // jitter
-    for (const Key& key : region.appeared) reported_.emplace(key, sweep_);
-    std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
-    std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
-    region.bounds = Region{lo.array() - half, hi.array() + half}.grown(config_.margin);
-    changes.regions.push_back(std::move(region));
+// The confirmed voxels 26-connected to `seed` (added to `grouped`), as a region; nullopt when too few of
+// them lie off the unchanged surface (jitter).
+std::optional<ChangeRegion> ChangeDetector::grow_region(const Key& seed, const ConfirmedFlips& confirmed,
+                                                        const OccupancyMap& map, KeySet& grouped) {
+  ChangeRegion region;
+  int off_surface_appeared = 0, off_surface_vanished = 0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  std::vector<Key> stack = {seed};
+  while (!stack.empty()) {
+    const Key key = stack.back();
+    stack.pop_back();
+    const bool appeared = confirmed.at(key);
+    (appeared ? region.appeared : region.vanished).push_back(key);
+    const Eigen::Vector3d c = map.centre(key);
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+    bool touches_unchanged_surface = false;
+    for_each_neighbour(key, [&](const Key& n) {
+      if (confirmed.count(n) != 0) {
+        if (grouped.insert(n).second) stack.push_back(n);
+      } else if (!touches_unchanged_surface && pending_.count(n) == 0 && reported_.count(n) == 0 &&
+                 map.state(n) == VoxelState::occupied) {
+        touches_unchanged_surface = true;
+      }
+    });
+    if (!touches_unchanged_surface) ++(appeared ? off_surface_appeared : off_surface_vanished);
   }
-  return changes;
+  // Counted per kind: a surface voxel that jitters to its neighbour is one vanished and one appeared voxel,
+  // which together are not an object arriving or leaving.
+  if (std::max(off_surface_appeared, off_surface_vanished) < config_.min_voxels) return std::nullopt;
+  for (const Key& key : region.appeared) reported_.emplace(key, sweep_);
+  std::sort(region.appeared.begin(), region.appeared.end(), zyx_less);
+  std::sort(region.vanished.begin(), region.vanished.end(), zyx_less);
+  const double half = 0.5 * map.tree().getResolution();
+  region.bounds = Region{lo.array() - half, hi.array() + half}.grown(config_.margin);
+  return region;
 }
 
 }  // namespace cellmap

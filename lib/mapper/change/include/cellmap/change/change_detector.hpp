@@ -9,7 +9,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "cellmap/common/region.hpp"
@@ -99,6 +101,16 @@ class ChangeDetector final {
     bool was_occupied;  // the state before the flip (the last confirmed state)
     int sweeps;         // sweeps the new state has held, counting the flip's sweep
   };
+  using KeySet = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash>;
+  // Voxels confirmed in this sweep → now occupied.
+  using ConfirmedFlips = std::unordered_map<octomap::OcTreeKey, bool, octomap::OcTreeKey::KeyHash>;
+  void record_flips(const OccupancyUpdate& update);
+  [[nodiscard]] ConfirmedFlips confirm_held_flips();
+  void forget_old_reports();
+  [[nodiscard]] std::optional<ChangeRegion> grow_region(const octomap::OcTreeKey& seed,
+                                                        const ConfirmedFlips& confirmed,
+                                                        const OccupancyMap& map, KeySet& grouped);
+
   ChangeConfig config_;
   std::uint64_t sweep_ = 0;
   std::unordered_map<octomap::OcTreeKey, Pending, octomap::OcTreeKey::KeyHash> pending_;
