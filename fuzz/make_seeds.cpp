@@ -178,7 +178,8 @@ void version_store_seeds(const fs::path& dir, const fs::path& scratch) {
   fs::remove_all(scratch);
 }
 
-// An empty map and one that saw a few points, as the daemon saves them.
+// An empty map and one that saw a few points in two sweeps (their voxels flipped, waiting for confirmation),
+// as the daemon saves them.
 void map_blob_seeds(const fs::path& dir) {
   const daemon::DaemonConfig config = daemon::DaemonConfig::parse("", "defaults", ".");
   const CellPipeline empty(config.pipeline, {}, 1);
@@ -189,6 +190,7 @@ void map_blob_seeds(const fs::path& dir) {
   scan.origin_C = {1.0, 1.0, 2.0};
   for (int i = 0; i < 20; ++i) scan.points_C.push_back(pcl::PointXYZ(0.8f + 0.02f * i, 1.0f, 0.3f));
   sweep.scans.push_back(scan);
+  (void)seen.process(sweep);
   (void)seen.process(sweep);
   write(dir / "small_map", seen.map_state());
 }

@@ -1,6 +1,6 @@
-// The map state the daemon saves with each version (header, viewpoint, OctoMap tree) and reads back at
-// start; an unreadable one must be refused (the daemon then starts with an empty map). With the daemon's
-// built-in pipeline settings.
+// The map state the daemon saves with each version (header, viewpoint, the change detector's pending flips,
+// OctoMap tree) and reads back at start; an unreadable one must be refused (the daemon then starts with an
+// empty map). With the daemon's built-in pipeline settings.
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "daemon_config.hpp"
 #include "fuzz_support.hpp"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <set>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "cellmap/common/error.hpp"
 
@@ -53,6 +55,54 @@ std::vector<std::uint64_t> boxes_touched(const std::vector<Box>& previous,
   return ids;
 }
 
+namespace {
+
+// The re-segmented boxes that neither a kept box nor a bigger re-segmented one holds, largest first, so a
+// sliver inside a bigger new box (a face segment the merge left apart) is the one dropped.
+std::vector<const Box*> candidates_of(const std::vector<Box>& resegmented,
+                                      const std::vector<const Box*>& kept, double redundant_tolerance) {
+  std::vector<const Box*> by_volume;
+  for (const Box& box : resegmented) by_volume.push_back(&box);
+  std::stable_sort(by_volume.begin(), by_volume.end(),
+                   [](const Box* a, const Box* b) { return a->volume() > b->volume(); });
+  std::vector<const Box*> candidates;
+  for (const Box* box : by_volume) {
+    const auto covers = [&](const Box* other) { return box_inside(*box, *other, redundant_tolerance); };
+    if (std::none_of(kept.begin(), kept.end(), covers) &&
+        std::none_of(candidates.begin(), candidates.end(), covers)) {
+      candidates.push_back(box);
+    }
+  }
+  return candidates;
+}
+
+// Pairs (candidate, old box) overlapping by at least min_overlap, best overlap first; ties broken by index
+// so the result is deterministic.
+std::vector<std::pair<std::size_t, std::size_t>> by_overlap(const std::vector<const Box*>& candidates,
+                                                            const std::vector<const Box*>& old_in_scope,
+                                                            double min_overlap) {
+  std::vector<std::tuple<double, std::size_t, std::size_t>> scored;
+  for (std::size_t n = 0; n < candidates.size(); ++n) {
+    for (std::size_t o = 0; o < old_in_scope.size(); ++o) {
+      const double overlap = iou(bounds_of(*candidates[n]), bounds_of(*old_in_scope[o]));
+      if (overlap >= min_overlap) scored.emplace_back(-overlap, n, o);
+    }
+  }
+  std::sort(scored.begin(), scored.end());
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (const auto& [negative_overlap, n, o] : scored) pairs.emplace_back(n, o);
+  return pairs;
+}
+
+void sort_by_id(Reconciled& out) {
+  const auto by_id = [](const Box& a, const Box& b) { return a.id < b.id; };
+  std::sort(out.boxes.begin(), out.boxes.end(), by_id);
+  std::sort(out.modified.begin(), out.modified.end(), by_id);
+  std::sort(out.removed.begin(), out.removed.end());
+}
+
+}  // namespace
+
 Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::uint64_t>& in_scope,
                      const std::vector<Box>& resegmented, std::uint64_t next_id,
                      const ReconcileOptions& options) {
@@ -67,36 +117,12 @@ Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::ui
   std::vector<const Box*> old_in_scope;
   std::vector<const Box*> kept;
   for (const Box& box : previous) (scope.count(box.id) ? old_in_scope : kept).push_back(&box);
+  const std::vector<const Box*> candidates = candidates_of(resegmented, kept, options.redundant_tolerance);
 
-  // Largest first, so a sliver inside a bigger new box (a face segment the merge left apart) is the one
-  // dropped.
-  std::vector<const Box*> by_volume;
-  for (const Box& box : resegmented) by_volume.push_back(&box);
-  std::stable_sort(by_volume.begin(), by_volume.end(),
-                   [](const Box* a, const Box* b) { return a->volume() > b->volume(); });
-  std::vector<const Box*> candidates;
-  for (const Box* box : by_volume) {
-    const auto covers = [&](const Box* other) {
-      return box_inside(*box, *other, options.redundant_tolerance);
-    };
-    if (std::none_of(kept.begin(), kept.end(), covers) &&
-        std::none_of(candidates.begin(), candidates.end(), covers)) {
-      candidates.push_back(box);
-    }
-  }
-
-  // Greedy matching, best overlap first; ties broken by index so the result is deterministic.
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
-  for (std::size_t n = 0; n < candidates.size(); ++n) {
-    for (std::size_t o = 0; o < old_in_scope.size(); ++o) {
-      const double overlap = iou(bounds_of(*candidates[n]), bounds_of(*old_in_scope[o]));
-      if (overlap >= options.min_overlap) pairs.emplace_back(-overlap, n, o);
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
+  // Greedy matching: a matched old box keeps its id (and its geometry within the tolerance).
   std::vector<bool> new_used(candidates.size(), false);
   std::vector<bool> old_used(old_in_scope.size(), false);
-  for (const auto& [negative_overlap, n, o] : pairs) {
+  for (const auto& [n, o] : by_overlap(candidates, old_in_scope, options.min_overlap)) {
     if (new_used[n] || old_used[o]) continue;
     new_used[n] = old_used[o] = true;
     const Box& old_box = *old_in_scope[o];
@@ -121,10 +147,7 @@ Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::ui
     out.added.push_back(added);
   }
   out.next_id = next_id;
-  const auto by_id = [](const Box& a, const Box& b) { return a.id < b.id; };
-  std::sort(out.boxes.begin(), out.boxes.end(), by_id);
-  std::sort(out.modified.begin(), out.modified.end(), by_id);
-  std::sort(out.removed.begin(), out.removed.end());
+  sort_by_id(out);
   return out;
 }
 

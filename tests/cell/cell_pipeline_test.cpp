@@ -410,19 +410,47 @@ TEST(CellPipelineTest, MapStateRoundTripsWithItsViewpointAndRejectsGarbage) {
   EXPECT_THROW(CellPipeline(defaults(), {}, 1, std::string("not a state\n")), Error);
 }
 
+// `state` (the current format) as an older cellmap wrote it: `header` and, after the viewpoint line,
+// `counter` in formats 1 and 2; no change detector state.
+std::string older_map_state(const std::string& state, const std::string& header) {
+  const std::size_t viewpoint = state.find('\n') + 1;
+  const std::size_t change = state.find("cellmap-change ");
+  const std::size_t map = state.find("cellmap-occupancy ");
+  return header + "\n" + state.substr(viewpoint, change - viewpoint) + state.substr(map);
+}
+
 // The box-id counter lives with the versions, not in the map state: a restored pipeline goes on from the
 // counter it is given. A state written before (version 2, with the counter) still raises it.
 TEST(CellPipelineTest, MapStateLeavesTheBoxIdCounterToTheCallerAndOlderStatesStillRaiseIt) {
   Cell cell(coarse_cell());
   (void)cell.sweep();
   const std::string state = cell.pipeline().map_state();
-  ASSERT_EQ(state.rfind("cellmap-map-state 3\n", 0), 0u);
+  ASSERT_EQ(state.rfind("cellmap-map-state 4\n", 0), 0u);
   EXPECT_EQ(CellPipeline(defaults(), {}, 9, state).next_box_id(), 9u);
-  const std::string older = "cellmap-map-state 2\n12\n" + state.substr(state.find('\n') + 1);
+  const std::string older = "cellmap-map-state 2\n12\n" + older_map_state(state, "").substr(1);
   const CellPipeline from_older(defaults(), {}, 9, older);
   EXPECT_EQ(from_older.next_box_id(), 12u);
-  EXPECT_EQ(from_older.map_state(), state);  // same map and viewpoint, written in the current format
+  // Same map and viewpoint, written in the current format with nothing pending.
+  EXPECT_EQ(from_older.map_state(),
+            CellPipeline(defaults(), {}, 9, older_map_state(state, "cellmap-map-state 3")).map_state());
   EXPECT_EQ(CellPipeline(defaults(), {}, 20, older).next_box_id(), 20u);
+}
+
+// The change detector's state is part of the map state: flips pending when it was saved still wait after a
+// restart (a state of format 3 has none).
+TEST(CellPipelineTest, MapStateKeepsTheFlipsWaitingForConfirmation) {
+  Cell cell(coarse_cell());
+  (void)cell.sweep();
+  (void)cell.sweep();  // the first hits flip the voxels they fell into in the second
+  const std::string state = cell.pipeline().map_state();
+  const std::string change_line =
+      state.substr(state.find("cellmap-change "),
+                   state.find('\n', state.find("cellmap-change ")) - state.find("cellmap-change "));
+  EXPECT_NE(change_line, "cellmap-change 2 0 0") << "nothing pending after the second sweep";
+  const std::string older = older_map_state(state, "cellmap-map-state 3");
+  const std::string from_older = CellPipeline(defaults(), {}, 1, older).map_state();
+  EXPECT_NE(from_older.find("\ncellmap-change 0 0 0\ncellmap-occupancy "), std::string::npos);
+  EXPECT_THROW(CellPipeline(defaults(), {}, 1, state.substr(0, state.find("cellmap-occupancy ") - 3)), Error);
 }
 
 // Sensor noise (Kinect model: depth noise and flying pixels at edges) on a static cell: after the first

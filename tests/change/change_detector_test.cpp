@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "cellmap/common/error.hpp"
@@ -167,6 +168,81 @@ TEST(ChangeDetectorTest, AddedAndRemovedBoxGiveOneRegionEach) {
     EXPECT_TRUE(removed.bounds.contains(box.max_C - Eigen::Vector3d(0, 0.02, 0)));
   }
   EXPECT_EQ(detector.pending(), 0u);
+}
+
+// A map and its detector saved while a new box's flips wait for confirmation (as a daemon saves them with a
+// version) and read back: the copy reports the box at the same sweep and as the same region as the original.
+// A fresh detector on the saved map never reports it: the voxels do not flip again.
+TEST(ChangeDetectorTest, AStateReadBackConfirmsThePendingFlipsAsIfUninterrupted) {
+  OccupancyMap map;
+  const ChangeConfig config;
+  ChangeDetector detector(config);
+  const PinholeIntrinsics camera = small_camera(120, 90, 220.0);
+  std::vector<AlignedBox> scene = table_scene();
+  for (int i = 0; i < 8; ++i) (void)detector.update(map.integrate(sweep_of(scene, camera)), map);
+  scene.push_back({{-0.15, 0.3, 1.21}, {0.1, 0.5, 1.45}});
+  const int seen = map.config().sweeps_to_occupy();  // the box's voxels flipped in the last of these
+  for (int i = 0; i < seen; ++i)
+    ASSERT_TRUE(detector.update(map.integrate(sweep_of(scene, camera)), map).empty());
+  ASSERT_GT(detector.pending(), 50u);
+
+  std::stringstream map_state, detector_state;
+  map.write(map_state);
+  detector.write(detector_state);
+  OccupancyMap map_copy, map_fresh;
+  map_copy.read(map_state);
+  map_state.seekg(0);
+  map_fresh.read(map_state);
+  ChangeDetector copy(config), fresh(config);
+  copy.read(detector_state);
+  EXPECT_EQ(copy.pending(), detector.pending());
+
+  std::vector<std::uint64_t> original_sweeps, copy_sweeps;
+  for (int i = 0; i < config.persist_sweeps + 2; ++i) {
+    const Sweep sweep = sweep_of(scene, camera);
+    const ChangeSet original = detector.update(map.integrate(sweep), map);
+    const ChangeSet copied = copy.update(map_copy.integrate(sweep), map_copy);
+    EXPECT_TRUE(fresh.update(map_fresh.integrate(sweep), map_fresh).empty()) << "sweep " << i + 1;
+    ASSERT_EQ(copied.sweep, original.sweep);
+    ASSERT_EQ(copied.regions.size(), original.regions.size()) << "sweep " << original.sweep;
+    for (std::size_t r = 0; r < original.regions.size(); ++r) {
+      EXPECT_EQ(copied.regions[r].appeared, original.regions[r].appeared);
+      EXPECT_EQ(copied.regions[r].vanished, original.regions[r].vanished);
+      EXPECT_EQ(copied.regions[r].bounds.min, original.regions[r].bounds.min);
+      EXPECT_EQ(copied.regions[r].bounds.max, original.regions[r].bounds.max);
+    }
+    if (!original.empty()) original_sweeps.push_back(original.sweep);
+  }
+  EXPECT_EQ(original_sweeps,
+            (std::vector<std::uint64_t>{8u + std::uint64_t(seen + config.persist_sweeps - 1)}));
+}
+
+TEST(ChangeDetectorTest, AMalformedStateIsRefusedAndChangesNothing) {
+  OccupancyMap map;
+  ChangeConfig config;
+  config.persist_sweeps = 3;
+  ChangeDetector detector(config);
+  OccupancyUpdate appear;
+  appear.appeared.push_back(map.tree().coordToKey(0.5, 0.5, 0.5));
+  (void)detector.update(appear, map);
+  std::stringstream saved;
+  detector.write(saved);
+  EXPECT_EQ(saved.str(), "cellmap-change 1 1 0\n32793 32793 32793 0 1\n");
+  const auto read = [&](const std::string& text) {
+    return error_of([&] {
+      std::istringstream in(text);
+      detector.read(in);
+    });
+  };
+  EXPECT_EQ(read("cellmap-map 1 1 0\n"), "change detector state: bad header line");
+  EXPECT_EQ(read("cellmap-change 1 2 0\n1 2 3 0 1\n"), "change detector state: bad pending voxel 2");
+  EXPECT_EQ(read("cellmap-change 1 1 0\n65536 2 3 0 1\n"), "change detector state: bad pending voxel 1");
+  EXPECT_EQ(read("cellmap-change 1 1 0\n1 2 3 2 1\n"), "change detector state: bad pending voxel 1");
+  EXPECT_EQ(read("cellmap-change 1 1 0\n1 2 3 0 -1\n"), "change detector state: bad pending voxel 1");
+  EXPECT_EQ(read("cellmap-change 1 0 1\n1 2 3 2\n"), "change detector state: bad reported voxel 1");
+  EXPECT_EQ(detector.pending(), 1u);  // unchanged by the refusals
+  EXPECT_EQ(read(saved.str()), "");
+  EXPECT_EQ(detector.pending(), 1u);
 }
 
 TEST(ChangeDetectorTest, FlipBackBeforePersistingIsForgotten) {

@@ -223,7 +223,11 @@ TEST(RecoverPipelineTest, OlderStateDirectoryKeepsTheCounterOfItsMapState) {
   CellPipeline seen(CellPipelineConfig{});
   (void)seen.process(wall_sweep());
   const std::string current = seen.map_state();
-  const std::string older = "cellmap-map-state 2\n9\n" + current.substr(current.find('\n') + 1);
+  // Format 2: the counter line, the viewpoint line, the map (no change detector state).
+  const std::size_t viewpoint = current.find('\n') + 1;
+  const std::string older = "cellmap-map-state 2\n9\n" +
+                            current.substr(viewpoint, current.find("cellmap-change ") - viewpoint) +
+                            current.substr(current.find("cellmap-occupancy "));
   {
     VersionStore store(dir.path(), "cell");
     store.save(Environment("cell", 1, 1, boxes_with_ids({1, 2})), older);

@@ -13,12 +13,14 @@
 namespace cellmap {
 namespace {
 
-// The map state's first line. Version 3 leaves out the box-id counter (it is kept with the versions, where
-// a lost map cannot take it along); versions 2 (counter + viewpoint) and 1 (counter only) are still read,
-// their counter raising the one the pipeline was given.
+// The map state's first line. Version 4 adds the change detector's state (its pending flips belong to the
+// map they flipped in); version 3 (viewpoint and map) is still read, with no flip pending. Versions 2
+// (counter + viewpoint) and 1 (counter only) also carried the box-id counter, which now is kept with the
+// versions, where a lost map cannot take it along; it raises the one the pipeline was given.
 constexpr std::string_view kStateMagicV1 = "cellmap-map-state 1";
 constexpr std::string_view kStateMagicV2 = "cellmap-map-state 2";
-constexpr std::string_view kStateMagic = "cellmap-map-state 3";
+constexpr std::string_view kStateMagicV3 = "cellmap-map-state 3";
+constexpr std::string_view kStateMagic = "cellmap-map-state 4";
 
 // A box re-fits only when it lost a tenth of its voxels: the table losing the few voxels an object removed
 // from it shared with its top layer keeps its boxes (still covering all it holds) instead of being split
@@ -69,9 +71,9 @@ void CellPipeline::restore(const std::string& map_state) {
   std::istringstream in(map_state);
   std::string magic;
   std::getline(in, magic);
-  if (magic != kStateMagic && magic != kStateMagicV2 && magic != kStateMagicV1)
+  if (magic != kStateMagic && magic != kStateMagicV3 && magic != kStateMagicV2 && magic != kStateMagicV1)
     throw Error("map state: not a cellmap map state (bad header)");
-  if (magic != kStateMagic) {
+  if (magic == kStateMagicV2 || magic == kStateMagicV1) {
     std::uint64_t legacy_next_id = 0;
     if (!(in >> legacy_next_id) || in.get() != '\n') throw Error("map state: bad box-id counter line");
     next_box_id_ = std::max(next_box_id_, legacy_next_id);
@@ -84,6 +86,11 @@ void CellPipeline::restore(const std::string& map_state) {
     }
     viewpoint_C_ = viewpoint;
   }
+  try {
+    if (magic == kStateMagic) detector_.read(in);
+  } catch (const Error& e) {
+    throw Error(std::string("map state: ") + e.what());
+  }
   map_.read(in);
 }
 
@@ -92,6 +99,7 @@ std::string CellPipeline::map_state() const {
   out << kStateMagic << "\n";
   out.precision(17);
   out << viewpoint_C_.x() << " " << viewpoint_C_.y() << " " << viewpoint_C_.z() << "\n";
+  detector_.write(out);
   map_.write(out);
   return out.str();
 }

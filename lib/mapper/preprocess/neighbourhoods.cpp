@@ -10,14 +10,47 @@
 
 namespace cellmap {
 
-Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_normals,
-                                      const Eigen::Vector3f& viewpoint) {
-  if (k < 1) throw Error("neighbourhoods: k must be >= 1, got " + std::to_string(k));
+namespace {
+
+void require_finite(const Cloud& cloud) {
   for (const pcl::PointXYZ& p : cloud) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       throw Error("neighbourhoods: the cloud has a non-finite point (drop them when loading)");
     }
   }
+}
+
+// Eq. 2: the normal (facing `viewpoint`) and curvature of point i from the covariance of its neighbourhood
+// `found[0, count)` about the neighbourhood mean, accumulated relative to the query point so that
+// coordinates of a few metres do not cancel in float.
+void fit_normal(const Cloud& cloud, int i, const pcl::Indices& found, int count,
+                const Eigen::Vector3f& viewpoint, Neighbourhoods& result) {
+  const Eigen::Vector3d origin = cloud[i].getVector3fMap().cast<double>();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int j = 0; j < count; ++j) {
+    const Eigen::Vector3d d = cloud[found[j]].getVector3fMap().cast<double>() - origin;
+    mean += d;
+    scatter.noalias() += d * d.transpose();
+  }
+  mean /= count;
+  const Eigen::Matrix3d covariance = scatter / count - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
+  const Eigen::Vector3d lambda = solver.eigenvalues().cwiseMax(0.0);  // ascending
+  const double total = lambda.sum();
+  Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
+  if (normal.dot(viewpoint - cloud[i].getVector3fMap()) < 0.0f) normal = -normal;
+  result.normals[i] = normal;
+  result.curvature[i] = total > 0.0 ? static_cast<float>(lambda[0] / total) : 0.0f;
+}
+
+}  // namespace
+
+Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_normals,
+                                      const Eigen::Vector3f& viewpoint) {
+  if (k < 1) throw Error("neighbourhoods: k must be >= 1, got " + std::to_string(k));
+  require_finite(cloud);
   const int n = static_cast<int>(cloud.size());
   Neighbourhoods result;
   result.k = k;
@@ -46,28 +79,7 @@ Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_norma
       sum += std::sqrt(static_cast<double>(found_sq[j]));  // in double, as PCL does
     }
     result.mean_distance[i] = static_cast<float>(sum / k);
-    if (!with_normals || count < 3) continue;
-
-    // Eq. 2 about the neighbourhood mean, accumulated relative to the query point so that coordinates of a
-    // few metres do not cancel in float.
-    const Eigen::Vector3d origin = cloud[i].getVector3fMap().cast<double>();
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (int j = 0; j < count; ++j) {
-      const Eigen::Vector3d d = cloud[found[j]].getVector3fMap().cast<double>() - origin;
-      mean += d;
-      scatter.noalias() += d * d.transpose();
-    }
-    mean /= count;
-    const Eigen::Matrix3d covariance = scatter / count - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(covariance);
-    const Eigen::Vector3d lambda = solver.eigenvalues().cwiseMax(0.0);  // ascending
-    const double total = lambda.sum();
-    Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
-    if (normal.dot(viewpoint - cloud[i].getVector3fMap()) < 0.0f) normal = -normal;
-    result.normals[i] = normal;
-    result.curvature[i] = total > 0.0 ? static_cast<float>(lambda[0] / total) : 0.0f;
+    if (with_normals && count >= 3) fit_normal(cloud, i, found, count, viewpoint, result);
   }
   return result;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include "cellmap/common/error.hpp"
@@ -33,16 +34,12 @@ class UnionFind {
   std::vector<int> parent_;
 };
 
-}  // namespace
+// Boundary point pairs (closer than the gap) per adjacent segment pair, keyed (smaller label << 32) | larger.
+using Boundaries = std::unordered_map<std::uint64_t, std::vector<std::pair<int, int>>>;
 
-Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segments& segments,
-                      const ConvexMergeParams& params, MergeStats* stats) {
-  if (segments.label.size() != cloud.size() || nb.normals.size() != cloud.size()) {
-    throw Error("merge_convex: cloud, neighbourhoods and labels differ in size");
-  }
-  const float max_sq_gap = static_cast<float>(params.gap * params.gap);
-  // Boundary point pairs per adjacent segment pair (smaller label first).
-  std::unordered_map<std::uint64_t, std::vector<std::pair<int, int>>> boundaries;
+Boundaries boundaries_of(const Neighbourhoods& nb, const Segments& segments, double gap) {
+  const float max_sq_gap = static_cast<float>(gap * gap);
+  Boundaries boundaries;
   for (int i = 0; i < nb.size(); ++i) {
     const int a = segments.label[i];
     if (a < 0) continue;
@@ -55,59 +52,71 @@ Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segmen
                                                                                                      other);
     }
   }
+  return boundaries;
+}
 
-  pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}));
-  pcl::Indices near;
-  std::vector<float> near_sq;
-  const auto patch = [&](int centre, int segment) {
+// The patches of one segment around boundary points: centroid and mean normal within the patch radius.
+class PatchFinder {
+ public:
+  PatchFinder(const Cloud& cloud, const Neighbourhoods& nb, const Segments& segments, double radius)
+      : cloud_(cloud), nb_(nb), segments_(segments), radius_(radius), tree_(false) {
+    tree_.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}));
+  }
+  Patch at(int centre, int segment) {
     Patch p;
-    tree.radiusSearch(cloud[centre], params.patch_radius, near, near_sq);
-    for (int q : near) {
-      if (segments.label[q] != segment) continue;
-      p.centroid += cloud[q].getVector3fMap();
-      p.normal += nb.normals[q];
+    tree_.radiusSearch(cloud_[centre], radius_, near_, near_sq_);
+    for (int q : near_) {
+      if (segments_.label[q] != segment) continue;
+      p.centroid += cloud_[q].getVector3fMap();
+      p.normal += nb_.normals[q];
       ++p.size;
     }
     if (p.size > 0) p.centroid /= static_cast<float>(p.size);
     if (p.normal.norm() > 0.0f) p.normal.normalize();
     return p;
-  };
-
-  const float concave_limit = static_cast<float>(-2.0 * std::sin(0.5 * params.concavity_tolerance));
-  UnionFind sets(segments.count);
-  MergeStats local;
-  struct Edge {
-    float score;
-    int a, b;
-  };
-  std::vector<Edge> convex, concave;
-  for (const auto& [key, pairs] : boundaries) {
-    if (static_cast<int>(pairs.size()) < params.min_boundary_points) continue;
-    ++local.adjacent_pairs;
-    const int a = static_cast<int>(key >> 32);
-    const int b = static_cast<int>(key & 0xffffffffu);
-    const int samples = std::min<int>(params.samples_per_boundary, static_cast<int>(pairs.size()));
-    // Per place v = (n_s − n_t)·d̂ with d̂ = (x_s − x_t)/|x_s − x_t|: v >= 0 is LCCP's convex case, v < 0
-    // concave, and a concave bend by an angle β gives v ≈ −2 sin(β/2). The median over the places decides.
-    std::vector<float> v;
-    v.reserve(static_cast<std::size_t>(samples));
-    for (int s = 0; s < samples; ++s) {
-      const auto [i, j] = pairs[static_cast<std::size_t>(s) * pairs.size() / samples];
-      const Patch ps = patch(i, a);
-      const Patch pt = patch(j, b);
-      if (ps.size < 3 || pt.size < 3) continue;
-      const Eigen::Vector3f d = ps.centroid - pt.centroid;
-      if (d.norm() <= 0.0f) continue;
-      v.push_back((ps.normal - pt.normal).dot(d.normalized()));
-    }
-    if (v.empty()) continue;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    const float score = v[v.size() / 2];
-    (score >= concave_limit ? convex : concave).push_back({score, a, b});
   }
-  // Most convex first; a merge that would join two segments with a concave boundary between them is refused,
-  // so a small fragment convex to both an object and the table cannot chain them together.
+
+ private:
+  const Cloud& cloud_;
+  const Neighbourhoods& nb_;
+  const Segments& segments_;
+  double radius_;
+  pcl::search::KdTree<pcl::PointXYZ> tree_;
+  pcl::Indices near_;
+  std::vector<float> near_sq_;
+};
+
+// How convex the boundary between segments a and b is: per place v = (n_s − n_t)·d̂ with
+// d̂ = (x_s − x_t)/|x_s − x_t|, v >= 0 is LCCP's convex case, v < 0 concave, and a concave bend by an angle β
+// gives v ≈ −2 sin(β/2). The median over the sampled places decides; nullopt if no place had patches.
+std::optional<float> convexity(const std::vector<std::pair<int, int>>& pairs, int a, int b,
+                               const ConvexMergeParams& params, PatchFinder& patches) {
+  const int samples = std::min<int>(params.samples_per_boundary, static_cast<int>(pairs.size()));
+  std::vector<float> v;
+  v.reserve(static_cast<std::size_t>(samples));
+  for (int s = 0; s < samples; ++s) {
+    const auto [i, j] = pairs[static_cast<std::size_t>(s) * pairs.size() / samples];
+    const Patch ps = patches.at(i, a);
+    const Patch pt = patches.at(j, b);
+    if (ps.size < 3 || pt.size < 3) continue;
+    const Eigen::Vector3f d = ps.centroid - pt.centroid;
+    if (d.norm() <= 0.0f) continue;
+    v.push_back((ps.normal - pt.normal).dot(d.normalized()));
+  }
+  if (v.empty()) return std::nullopt;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct Edge {
+  float score;
+  int a, b;
+};
+
+// Most convex first; a merge that would join two segments with a concave boundary between them is refused,
+// so a small fragment convex to both an object and the table cannot chain them together.
+void merge_convex_edges(std::vector<Edge>& convex, const std::vector<Edge>& concave, UnionFind& sets,
+                        MergeStats& stats) {
   std::sort(convex.begin(), convex.end(), [](const Edge& x, const Edge& y) { return x.score > y.score; });
   for (const Edge& edge : convex) {
     const int ra = sets.find(edge.a), rb = sets.find(edge.b);
@@ -118,8 +127,31 @@ Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segmen
     });
     if (conflict) continue;
     sets.unite(ra, rb);
-    ++local.convex_pairs;
+    ++stats.convex_pairs;
   }
+}
+
+}  // namespace
+
+Segments merge_convex(const Cloud& cloud, const Neighbourhoods& nb, const Segments& segments,
+                      const ConvexMergeParams& params, MergeStats* stats) {
+  if (segments.label.size() != cloud.size() || nb.normals.size() != cloud.size()) {
+    throw Error("merge_convex: cloud, neighbourhoods and labels differ in size");
+  }
+  PatchFinder patches(cloud, nb, segments, params.patch_radius);
+  const float concave_limit = static_cast<float>(-2.0 * std::sin(0.5 * params.concavity_tolerance));
+  MergeStats local;
+  std::vector<Edge> convex, concave;
+  for (const auto& [key, pairs] : boundaries_of(nb, segments, params.gap)) {
+    if (static_cast<int>(pairs.size()) < params.min_boundary_points) continue;
+    ++local.adjacent_pairs;
+    const int a = static_cast<int>(key >> 32);
+    const int b = static_cast<int>(key & 0xffffffffu);
+    const std::optional<float> score = convexity(pairs, a, b, params, patches);
+    if (score) (*score >= concave_limit ? convex : concave).push_back({*score, a, b});
+  }
+  UnionFind sets(segments.count);
+  merge_convex_edges(convex, concave, sets, local);
   if (stats) *stats = local;
 
   std::vector<int> merged(segments.label.size(), -1);

@@ -234,6 +234,79 @@ SegmentConfig load_segment_config(const std::string& path) {
   return segment_config_from_yaml(YamlMap::load(path));
 }
 
+namespace {
+
+// The points the segmentation works on: cropped to the workspace, outliers removed, with their
+// neighbourhoods; `index` maps them back to the input.
+struct Prepared {
+  std::vector<int> index;
+  Cloud cloud;
+  Neighbourhoods nb;
+};
+
+Prepared prepare(const Cloud& points, const SegmentConfig& config, SegmentStats& stats, Stopwatch& clock) {
+  std::vector<int> index = workspace_index(points, config);
+  stats.outside_workspace = points.size() - index.size();
+  Cloud cropped = subset(points, index);
+  stats.t_crop = clock.lap();
+
+  // One kd-tree search serves both outlier removal (eq. 1) and the features (eq. 2) of the survivors; their
+  // normals thus include the removed points' few contributions (sparse outliers are rarely anyone's
+  // neighbour).
+  const Neighbourhoods all = compute_neighbourhoods(cropped, config.k, true, points.sensor_origin_.head<3>());
+  stats.t_features = clock.lap();
+  const OutlierResult outliers = remove_outliers(all, config.outlier_u, config.outlier_mode);
+  stats.outliers_sparse = outliers.removed_sparse;
+  stats.outliers_dense = outliers.removed_dense;
+  Prepared prepared{std::vector<int>(outliers.kept.size()), subset(cropped, outliers.kept),
+                    subset_neighbourhoods(all, outliers.kept)};
+  for (std::size_t i = 0; i < outliers.kept.size(); ++i) prepared.index[i] = index[outliers.kept[i]];
+  stats.t_outliers = clock.lap();
+  return prepared;
+}
+
+// Regions grown (Algorithm 1), the leftovers covered and convex neighbours merged; `gap` is the gap used.
+Segments grow_and_merge(const Prepared& in, const SegmentConfig& config, SegmentStats& stats,
+                        Stopwatch& clock, double& gap) {
+  RegionGrowingParams growing = config.region_growing;
+  ConvexMergeParams merging = config.merge_params;
+  if (config.gap_floor_factor > 0.0) {
+    growing.gap = widened_gap(config, in.nb);
+    merging.gap = std::max(merging.gap, growing.gap);
+  }
+  gap = stats.gap = growing.gap;
+  Segments segments = grow_regions(in.nb, growing);
+  stats.regions = static_cast<std::size_t>(segments.count);
+  stats.t_grow = clock.lap();
+
+  stats.leftovers = cover_leftovers(in.cloud, in.nb, segments, growing.gap, config.leftover_min_points);
+  stats.t_leftovers = clock.lap();
+
+  if (config.merge) segments = merge_convex(in.cloud, in.nb, segments, merging, &stats.merge);
+  stats.merged_segments = static_cast<std::size_t>(segments.count);
+  stats.t_merge = clock.lap();
+  return segments;
+}
+
+// Segments too big for one box split (by free space or supervoxels), then neighbours joined where one box
+// holds both without blocking free space.
+Segments split_and_join(const Prepared& in, Segments segments, const SegmentConfig& config,
+                        const Eigen::Vector3d& viewpoint, double gap, SegmentStats& stats, Stopwatch& clock) {
+  const BoxSplitParams parts = box_split_params(config, in.cloud, in.nb, viewpoint, gap);
+  if (config.split_method == SplitMethod::kFreeSpace) {
+    segments = split_by_free_space(in.cloud, in.nb, segments, viewpoint, parts, &stats.split_segments);
+  } else if (config.split_method == SplitMethod::kSupervoxels) {
+    segments = split_large_segments(in.cloud, segments, config.split, &stats.split_segments);
+  }
+  stats.t_split = clock.lap();
+  if (config.join_max_growth > 0)
+    segments = join_by_free_space(in.cloud, segments, viewpoint, parts, &stats.joins);
+  stats.t_join = clock.lap();
+  return segments;
+}
+
+}  // namespace
+
 SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   SegmentResult result;
   SegmentStats& stats = result.stats;
@@ -242,61 +315,12 @@ SegmentResult segment_cloud(const Cloud& points, const SegmentConfig& config) {
   result.boxes.version = 1;
   result.boxes.frame = "cell";
   Stopwatch clock;
-
-  // `index` maps the current working cloud back to the input.
-  std::vector<int> index = workspace_index(points, config);
-  stats.outside_workspace = points.size() - index.size();
-  Cloud cropped = subset(points, index);
-  stats.t_crop = clock.lap();
-  const Eigen::Vector3f viewpoint = points.sensor_origin_.head<3>();
-
-  // One kd-tree search serves both outlier removal (eq. 1) and the features (eq. 2) of the survivors; their
-  // normals thus include the removed points' few contributions (sparse outliers are rarely anyone's
-  // neighbour).
-  const Neighbourhoods all = compute_neighbourhoods(cropped, config.k, true, viewpoint);
-  stats.t_features = clock.lap();
-  const OutlierResult outliers = remove_outliers(all, config.outlier_u, config.outlier_mode);
-  stats.outliers_sparse = outliers.removed_sparse;
-  stats.outliers_dense = outliers.removed_dense;
-  const Neighbourhoods nb = subset_neighbourhoods(all, outliers.kept);
-  std::vector<int> kept_index(outliers.kept.size());
-  for (std::size_t i = 0; i < outliers.kept.size(); ++i) kept_index[i] = index[outliers.kept[i]];
-  index = std::move(kept_index);
-  const Cloud cloud = subset(cropped, outliers.kept);
-  stats.t_outliers = clock.lap();
-
-  RegionGrowingParams growing = config.region_growing;
-  ConvexMergeParams merging = config.merge_params;
-  if (config.gap_floor_factor > 0.0) {
-    growing.gap = widened_gap(config, nb);
-    merging.gap = std::max(merging.gap, growing.gap);
-  }
-  stats.gap = growing.gap;
-  Segments segments = grow_regions(nb, growing);
-  stats.regions = static_cast<std::size_t>(segments.count);
-  stats.t_grow = clock.lap();
-
-  stats.leftovers = cover_leftovers(cloud, nb, segments, growing.gap, config.leftover_min_points);
-  stats.t_leftovers = clock.lap();
-
-  if (config.merge) segments = merge_convex(cloud, nb, segments, merging, &stats.merge);
-  stats.merged_segments = static_cast<std::size_t>(segments.count);
-  stats.t_merge = clock.lap();
-
-  const BoxSplitParams parts = box_split_params(config, cloud, nb, viewpoint.cast<double>(), growing.gap);
-  if (config.split_method == SplitMethod::kFreeSpace) {
-    segments =
-        split_by_free_space(cloud, nb, segments, viewpoint.cast<double>(), parts, &stats.split_segments);
-  } else if (config.split_method == SplitMethod::kSupervoxels) {
-    segments = split_large_segments(cloud, segments, config.split, &stats.split_segments);
-  }
-  stats.t_split = clock.lap();
-  if (config.join_max_growth > 0) {
-    segments = join_by_free_space(cloud, segments, viewpoint.cast<double>(), parts, &stats.joins);
-  }
-  stats.t_join = clock.lap();
-
-  fit_boxes(cloud, segments, index, config, result);
+  const Prepared prepared = prepare(points, config, stats, clock);
+  double gap = 0;
+  Segments segments = grow_and_merge(prepared, config, stats, clock, gap);
+  const Eigen::Vector3d viewpoint = points.sensor_origin_.head<3>().cast<double>();
+  segments = split_and_join(prepared, std::move(segments), config, viewpoint, gap, stats, clock);
+  fit_boxes(prepared.cloud, segments, prepared.index, config, result);
   stats.boxes = result.boxes.boxes.size();
   stats.t_boxes = clock.lap();
   return result;

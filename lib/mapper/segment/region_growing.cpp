@@ -73,22 +73,13 @@ Segments grow_regions(const Neighbourhoods& nb, const RegionGrowingParams& param
   return compact_segments(label, drop);
 }
 
-LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& nb, Segments& segments, double gap,
-                              int min_points) {
-  if (segments.label.size() != cloud.size() || static_cast<std::size_t>(nb.size()) != cloud.size()) {
-    throw Error("cover_leftovers: labels, neighbourhoods and cloud differ in size");
-  }
-  if (!(gap > 0.0)) throw Error("cover_leftovers: gap must be > 0");
-  LeftoverStats stats;
-  std::vector<int> still;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (segments.label[i] < 0) still.push_back(static_cast<int>(i));
-  }
-  const float max_sq_gap = static_cast<float>(gap * gap);
+namespace {
 
-  // 1. Attach in waves: each leftover takes the segment of its nearest labelled k-neighbour within the gap,
-  //    with labels read from the previous wave (so the result does not depend on the order of the points).
-  //    A band of leftovers between two segments is thus shared out by distance, never bridged.
+// Attaches leftovers in waves: each takes the segment of its nearest labelled k-neighbour within the gap,
+// with labels read from the previous wave (so the result does not depend on the order of the points). A band
+// of leftovers between two segments is thus shared out by distance, never bridged. Returns the rest.
+std::vector<int> attach_in_waves(std::vector<int> still, const Neighbourhoods& nb, Segments& segments,
+                                 float max_sq_gap, LeftoverStats& stats) {
   std::vector<std::pair<int, int>> assigned;
   while (!still.empty()) {
     assigned.clear();
@@ -114,12 +105,15 @@ LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& nb, Segm
     stats.attached += assigned.size();
     still = std::move(next);
   }
-  if (still.empty()) return stats;
-  const auto shared = Cloud::ConstPtr(&cloud, [](const Cloud*) {});
+  return still;
+}
 
-  // 2. Euclidean clusters of the rest at the same gap.
+// Euclidean clusters of `still` at the gap: those of at least min_points become segments of their own.
+void cluster_the_rest(const Cloud& cloud, const std::vector<int>& still, Segments& segments, double gap,
+                      int min_points, LeftoverStats& stats) {
   pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(shared, std::make_shared<const pcl::Indices>(still.begin(), still.end()));
+  tree.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}),
+                     std::make_shared<const pcl::Indices>(still.begin(), still.end()));
   std::unordered_map<int, bool> visited;
   for (int i : still) visited[i] = false;
   pcl::Indices near;
@@ -146,6 +140,24 @@ LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& nb, Segm
     ++stats.own_segments;
     stats.in_own_segments += group.size();
   }
+}
+
+}  // namespace
+
+LeftoverStats cover_leftovers(const Cloud& cloud, const Neighbourhoods& nb, Segments& segments, double gap,
+                              int min_points) {
+  if (segments.label.size() != cloud.size() || static_cast<std::size_t>(nb.size()) != cloud.size()) {
+    throw Error("cover_leftovers: labels, neighbourhoods and cloud differ in size");
+  }
+  if (!(gap > 0.0)) throw Error("cover_leftovers: gap must be > 0");
+  LeftoverStats stats;
+  std::vector<int> leftovers;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (segments.label[i] < 0) leftovers.push_back(static_cast<int>(i));
+  }
+  const std::vector<int> still =
+      attach_in_waves(std::move(leftovers), nb, segments, static_cast<float>(gap * gap), stats);
+  if (!still.empty()) cluster_the_rest(cloud, still, segments, gap, min_points, stats);
   return stats;
 }
 

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "cellmap/common/error.hpp"
@@ -137,6 +138,46 @@ void OpenNI2Source::release() {
   clock_.reset();
 }
 
+namespace {
+
+// Sets `chosen` on the stream unless it is already the offered mode; an error text, or empty.
+std::string use_mode(openni::VideoStream& stream, const DepthMode& chosen) {
+  if (to_mode(stream.getVideoMode()).to_string() == chosen.to_string()) return {};
+  openni::VideoMode mode;
+  mode.setResolution(chosen.width, chosen.height);
+  mode.setFps(static_cast<int>(std::lround(chosen.fps)));
+  mode.setPixelFormat(chosen.format == "DEPTH_1_MM" ? openni::PIXEL_FORMAT_DEPTH_1_MM
+                                                    : openni::PIXEL_FORMAT_DEPTH_100_UM);
+  if (stream.setVideoMode(mode) == openni::STATUS_OK) return {};
+  return "cannot set mode " + chosen.to_string() + ": " + openni_error();
+}
+
+// The configured intrinsics, else those of the field of view the device reports, with the mode's depth
+// scale and the configured ranges; nullopt (and `error`) when the device reports no field of view.
+std::optional<PinholeIntrinsics> intrinsics_for(openni::VideoStream& stream, const DepthMode& chosen,
+                                                const OpenNI2Config& config, std::string& error) {
+  PinholeIntrinsics k;
+  if (config.intrinsics) {
+    k = *config.intrinsics;
+  } else {
+    const double hfov = stream.getHorizontalFieldOfView();
+    const double vfov = stream.getVerticalFieldOfView();
+    if (!(hfov > 0 && hfov < M_PI) || !(vfov > 0 && vfov < M_PI)) {
+      error = "reports no field of view (" + std::to_string(hfov) + ", " + std::to_string(vfov) +
+              " rad); set intrinsics in the config";
+      return std::nullopt;
+    }
+    k = intrinsics_from_fov(chosen.width, chosen.height, hfov, vfov);
+  }
+  k.depth_scale = chosen.format == "DEPTH_1_MM" ? 0.001 : 0.0001;
+  k.min_range = config.min_range;
+  k.max_range = config.max_range;
+  k.max_depth_jump = config.max_depth_jump;
+  return k;
+}
+
+}  // namespace
+
 void OpenNI2Source::connect(double now) {
   release();
   ++attempts_;
@@ -159,34 +200,14 @@ void OpenNI2Source::connect(double now) {
       return;
     }
     const DepthMode chosen = choose_depth_mode(depth_modes(device->stream), config_.mode, device_name);
-    const openni::VideoMode offered = device->stream.getVideoMode();
-    if (to_mode(offered).to_string() != chosen.to_string()) {
-      openni::VideoMode mode;
-      mode.setResolution(chosen.width, chosen.height);
-      mode.setFps(static_cast<int>(std::lround(chosen.fps)));
-      mode.setPixelFormat(chosen.format == "DEPTH_1_MM" ? openni::PIXEL_FORMAT_DEPTH_1_MM
-                                                        : openni::PIXEL_FORMAT_DEPTH_100_UM);
-      if (device->stream.setVideoMode(mode) != openni::STATUS_OK) {
-        reconnector_.failed(device_name + ": cannot set mode " + chosen.to_string() + ": " + openni_error());
-        return;
-      }
+    std::string error = use_mode(device->stream, chosen);
+    const std::optional<PinholeIntrinsics> intrinsics =
+        error.empty() ? intrinsics_for(device->stream, chosen, config_, error) : std::nullopt;
+    if (!intrinsics) {
+      reconnector_.failed(device_name + ": " + error);
+      return;
     }
-    if (config_.intrinsics) {
-      intrinsics_ = *config_.intrinsics;
-    } else {
-      const double hfov = device->stream.getHorizontalFieldOfView();
-      const double vfov = device->stream.getVerticalFieldOfView();
-      if (!(hfov > 0 && hfov < M_PI) || !(vfov > 0 && vfov < M_PI)) {
-        reconnector_.failed(device_name + ": reports no field of view (" + std::to_string(hfov) + ", " +
-                            std::to_string(vfov) + " rad); set intrinsics in the config");
-        return;
-      }
-      intrinsics_ = intrinsics_from_fov(chosen.width, chosen.height, hfov, vfov);
-    }
-    intrinsics_.depth_scale = chosen.format == "DEPTH_1_MM" ? 0.001 : 0.0001;
-    intrinsics_.min_range = config_.min_range;
-    intrinsics_.max_range = config_.max_range;
-    intrinsics_.max_depth_jump = config_.max_depth_jump;
+    intrinsics_ = *intrinsics;
     if (openni::PlaybackControl* playback = device->device.getPlaybackControl()) {
       playback->setRepeatEnabled(false);
       playback->setSpeed(config_.realtime_playback ? 1.0f : 0.0f);

@@ -186,59 +186,63 @@ std::vector<bool> near_depth_edge(const NoiseModel& model, const std::vector<dou
   return dilate(edge_pixels(model, exact_z, width, height, false), width, height, radius);
 }
 
-std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vector<double>& exact_z, int width,
-                                       int height, const NoiseKey& key, int threads) {
-  if (model.is_zero()) return exact_z;
-  const Random random(key);
-  std::vector<double> z = exact_z;
+namespace {
 
-  if (model.flying_probability > 0) {
-    const std::vector<bool> edge = edge_pixels(model, exact_z, width, height, false);
-    parallel_for(height, threads, [&](int v) {
-      for (int u = 0; u < width; ++u) {
-        const std::size_t p = at(u, v, width);
-        if (!edge[p] || random.uniform(p, kFlying) >= model.flying_probability) continue;
-        double lo = exact_z[p], hi = exact_z[p];
-        for (int nv = std::max(0, v - 1); nv <= std::min(height - 1, v + 1); ++nv) {
-          for (int nu = std::max(0, u - 1); nu <= std::min(width - 1, u + 1); ++nu) {
-            const double zq = exact_z[at(nu, nv, width)];
-            if (zq > 0) lo = std::min(lo, zq), hi = std::max(hi, zq);
-          }
+// Flying pixels: an edge pixel integrates light from both surfaces, so its phase, and so its depth, lands in
+// between (with model.flying_probability).
+void add_flying_pixels(const NoiseModel& model, const Random& random, const std::vector<double>& exact_z,
+                       int width, int height, int threads, std::vector<double>& z) {
+  const std::vector<bool> edge = edge_pixels(model, exact_z, width, height, false);
+  parallel_for(height, threads, [&](int v) {
+    for (int u = 0; u < width; ++u) {
+      const std::size_t p = at(u, v, width);
+      if (!edge[p] || random.uniform(p, kFlying) >= model.flying_probability) continue;
+      double lo = exact_z[p], hi = exact_z[p];
+      for (int nv = std::max(0, v - 1); nv <= std::min(height - 1, v + 1); ++nv) {
+        for (int nu = std::max(0, u - 1); nu <= std::min(width - 1, u + 1); ++nu) {
+          const double zq = exact_z[at(nu, nv, width)];
+          if (zq > 0) lo = std::min(lo, zq), hi = std::max(hi, zq);
         }
-        // The pixel integrates light from both surfaces: its phase, and so its depth, lands in between.
-        z[p] = lo + random.uniform(p, kMix) * (hi - lo);
       }
-    });
-  }
+      z[p] = lo + random.uniform(p, kMix) * (hi - lo);
+    }
+  });
+}
 
-  if (model.smear_radius > 0) {
-    const int r = model.smear_radius;
-    const std::vector<bool> near_edge = edge_pixels(model, exact_z, width, height, true);
-    const std::vector<bool> reach = dilate(near_edge, width, height, r);  // only these can be smeared
-    parallel_for(height, threads, [&](int v) {
-      for (int u = 0; u < width; ++u) {
-        const std::size_t p = at(u, v, width);
-        const double zp = exact_z[p];
-        if (zp <= 0 || !reach[p]) continue;
-        // The nearest near-side edge pixel in front of this one: the block matcher's window overlaps it and
-        // the foreground's texture wins, so the background is pulled towards the foreground depth.
-        double best_d2 = (r + 0.5) * (r + 0.5);
-        double z_front = 0;
-        for (int nv = std::max(0, v - r); nv <= std::min(height - 1, v + r); ++nv) {
-          for (int nu = std::max(0, u - r); nu <= std::min(width - 1, u + r); ++nu) {
-            const std::size_t q = at(nu, nv, width);
-            if (!near_edge[q] || !(exact_z[q] < zp - model.edge_threshold(exact_z[q]))) continue;
-            const double d2 = static_cast<double>((nu - u) * (nu - u) + (nv - v) * (nv - v));
-            if (d2 < best_d2) best_d2 = d2, z_front = exact_z[q];
-          }
+// Stereo smear: the nearest near-side edge pixel in front of a background pixel within model.smear_radius
+// overlaps the block matcher's window and the foreground's texture wins, so the background is pulled towards
+// the foreground depth.
+void smear_edges(const NoiseModel& model, const Random& random, const std::vector<double>& exact_z, int width,
+                 int height, int threads, std::vector<double>& z) {
+  const int r = model.smear_radius;
+  const std::vector<bool> near_edge = edge_pixels(model, exact_z, width, height, true);
+  const std::vector<bool> reach = dilate(near_edge, width, height, r);  // only these can be smeared
+  parallel_for(height, threads, [&](int v) {
+    for (int u = 0; u < width; ++u) {
+      const std::size_t p = at(u, v, width);
+      const double zp = exact_z[p];
+      if (zp <= 0 || !reach[p]) continue;
+      double best_d2 = (r + 0.5) * (r + 0.5);
+      double z_front = 0;
+      for (int nv = std::max(0, v - r); nv <= std::min(height - 1, v + r); ++nv) {
+        for (int nu = std::max(0, u - r); nu <= std::min(width - 1, u + r); ++nu) {
+          const std::size_t q = at(nu, nv, width);
+          if (!near_edge[q] || !(exact_z[q] < zp - model.edge_threshold(exact_z[q]))) continue;
+          const double d2 = static_cast<double>((nu - u) * (nu - u) + (nv - v) * (nv - v));
+          if (d2 < best_d2) best_d2 = d2, z_front = exact_z[q];
         }
-        if (z_front <= 0) continue;
-        const double s = (std::sqrt(best_d2) + 0.5 * random.uniform(p, kSmear)) / (r + 1.0);
-        z[p] = z_front + std::min(s, 1.0) * (zp - z_front);
       }
-    });
-  }
+      if (z_front <= 0) continue;
+      const double s = (std::sqrt(best_d2) + 0.5 * random.uniform(p, kSmear)) / (r + 1.0);
+      z[p] = z_front + std::min(s, 1.0) * (zp - z_front);
+    }
+  });
+}
 
+// Depth noise of every returning pixel: white (truncated normal) plus, where the model has it, a smooth
+// waviness field; negative depths clamp to 0.
+void add_depth_noise(const NoiseModel& model, const Random& random, int width, int height, int threads,
+                     std::vector<double>& z) {
   const bool wavy = model.wave_amplitude > 0;
   const Waviness wave(random, wavy ? model.wave_length_px : 1.0, wavy ? width : 0, wavy ? height : 0);
   parallel_for(height, threads, [&](int v) {
@@ -251,6 +255,18 @@ std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vecto
       z[p] = std::max(noisy, 0.0);
     }
   });
+}
+
+}  // namespace
+
+std::vector<double> apply_camera_noise(const NoiseModel& model, const std::vector<double>& exact_z, int width,
+                                       int height, const NoiseKey& key, int threads) {
+  if (model.is_zero()) return exact_z;
+  const Random random(key);
+  std::vector<double> z = exact_z;
+  if (model.flying_probability > 0) add_flying_pixels(model, random, exact_z, width, height, threads, z);
+  if (model.smear_radius > 0) smear_edges(model, random, exact_z, width, height, threads, z);
+  add_depth_noise(model, random, width, height, threads, z);
   return z;
 }
 

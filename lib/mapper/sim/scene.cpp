@@ -84,6 +84,71 @@ Eigen::VectorXd joint_vector(YamlMap& map, const std::string& key, int dof) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
+// `stops`: a list of joint vectors.
+std::vector<Eigen::VectorXd> read_stops(YamlMap& map, int dof) {
+  const YAML::Node stops = map.node("stops");
+  if (!stops.IsSequence() || stops.size() == 0)
+    map.fail("stops", "must be a non-empty list of joint vectors");
+  std::vector<Eigen::VectorXd> q;
+  for (std::size_t i = 0; i < stops.size(); ++i) {
+    YAML::Node holder(YAML::NodeType::Map);
+    holder["q"] = stops[i];
+    YamlMap item(holder, map.key_path("stops[" + std::to_string(i) + "]"), map.source());
+    q.push_back(joint_vector(item, "q", dof));
+  }
+  return q;
+}
+
+// `line`: {from, to, count} equidistant stops.
+std::vector<Eigen::VectorXd> read_line(YamlMap line, int dof) {
+  const Eigen::VectorXd from = joint_vector(line, "from", dof);
+  const Eigen::VectorXd to = joint_vector(line, "to", dof);
+  const long count = line.integer("count", 2, 1, 100000);
+  std::vector<Eigen::VectorXd> q;
+  for (long k = 0; k < count; ++k) {
+    const double s = count == 1 ? 0.0 : static_cast<double>(k) / static_cast<double>(count - 1);
+    q.push_back(from + s * (to - from));
+  }
+  line.expect_all_read();
+  return q;
+}
+
+// `grid`: {from, to, counts} in serpentine order: the first joint fastest, each joint reversing direction on
+// every pass of the joints above it, so consecutive stops are always neighbours and the robot never jumps
+// back.
+std::vector<Eigen::VectorXd> read_grid(YamlMap grid, int dof) {
+  const Eigen::VectorXd from = joint_vector(grid, "from", dof);
+  const Eigen::VectorXd to = joint_vector(grid, "to", dof);
+  const std::vector<double> counts = grid.numbers("counts", static_cast<std::size_t>(dof));
+  std::vector<long> n(counts.size());
+  long total = 1;
+  for (std::size_t j = 0; j < counts.size(); ++j) {
+    if (counts[j] < 1 || counts[j] > 10000 || counts[j] != std::floor(counts[j])) {
+      grid.fail("counts", "must be integers in [1, 10000]");
+    }
+    n[j] = static_cast<long>(counts[j]);
+    total *= n[j];
+  }
+  if (total > 100000) grid.fail("counts", "more than 100000 stops");
+  std::vector<Eigen::VectorXd> stops;
+  for (long k = 0; k < total; ++k) {
+    Eigen::VectorXd q = from;
+    long span = 1;
+    for (std::size_t j = 0; j < n.size(); ++j) {
+      const long below = span;
+      span *= n[j];
+      long i = (k / below) % n[j];
+      if ((k / span) % 2 == 1) i = n[j] - 1 - i;
+      const double s = n[j] == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(n[j] - 1);
+      const auto e = static_cast<Eigen::Index>(j);
+      q[e] = from[e] + s * (to[e] - from[e]);
+    }
+    stops.push_back(q);
+  }
+  grid.expect_all_read();
+  return stops;
+}
+
 // A sweep plan: exactly one of `stops` (list of joint vectors), `line` {from, to, count} or `grid` {from, to,
 // counts}; plus `period`.
 SweepPlan read_plan(YamlMap map, int dof) {
@@ -92,57 +157,11 @@ SweepPlan read_plan(YamlMap map, int dof) {
   const int kinds = map.has("stops") + map.has("line") + map.has("grid");
   if (kinds != 1) map.fail("stops", "exactly one of stops, line, grid is required");
   if (map.has("stops")) {
-    const YAML::Node stops = map.node("stops");
-    if (!stops.IsSequence() || stops.size() == 0)
-      map.fail("stops", "must be a non-empty list of joint vectors");
-    for (std::size_t i = 0; i < stops.size(); ++i) {
-      YAML::Node holder(YAML::NodeType::Map);
-      holder["q"] = stops[i];
-      YamlMap item(holder, map.key_path("stops[" + std::to_string(i) + "]"), map.source());
-      plan.stops.push_back(joint_vector(item, "q", dof));
-    }
+    plan.stops = read_stops(map, dof);
   } else if (map.has("line")) {
-    YamlMap line = map.child("line");
-    const Eigen::VectorXd from = joint_vector(line, "from", dof);
-    const Eigen::VectorXd to = joint_vector(line, "to", dof);
-    const long count = line.integer("count", 2, 1, 100000);
-    for (long k = 0; k < count; ++k) {
-      const double s = count == 1 ? 0.0 : static_cast<double>(k) / static_cast<double>(count - 1);
-      plan.stops.push_back(from + s * (to - from));
-    }
-    line.expect_all_read();
+    plan.stops = read_line(map.child("line"), dof);
   } else {
-    YamlMap grid = map.child("grid");
-    const Eigen::VectorXd from = joint_vector(grid, "from", dof);
-    const Eigen::VectorXd to = joint_vector(grid, "to", dof);
-    const std::vector<double> counts = grid.numbers("counts", static_cast<std::size_t>(dof));
-    std::vector<long> n(counts.size());
-    long total = 1;
-    for (std::size_t j = 0; j < counts.size(); ++j) {
-      if (counts[j] < 1 || counts[j] > 10000 || counts[j] != std::floor(counts[j])) {
-        grid.fail("counts", "must be integers in [1, 10000]");
-      }
-      n[j] = static_cast<long>(counts[j]);
-      total *= n[j];
-    }
-    if (total > 100000) grid.fail("counts", "more than 100000 stops");
-    // Serpentine order: the first joint fastest, each joint reversing direction on every pass of the joints
-    // above it, so consecutive stops are always neighbours and the robot never jumps back.
-    for (long k = 0; k < total; ++k) {
-      Eigen::VectorXd q = from;
-      long span = 1;
-      for (std::size_t j = 0; j < n.size(); ++j) {
-        const long below = span;
-        span *= n[j];
-        long i = (k / below) % n[j];
-        if ((k / span) % 2 == 1) i = n[j] - 1 - i;
-        const double s = n[j] == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(n[j] - 1);
-        const auto e = static_cast<Eigen::Index>(j);
-        q[e] = from[e] + s * (to[e] - from[e]);
-      }
-      plan.stops.push_back(q);
-    }
-    grid.expect_all_read();
+    plan.stops = read_grid(map.child("grid"), dof);
   }
   map.expect_all_read();
   return plan;
@@ -513,10 +532,9 @@ Eigen::Isometry3d Scene::sensor_pose(int index, const Eigen::VectorXd& q) const 
   return robot.tool_pose(q) * sensor.X_ES;
 }
 
-void Scene::validate() const {
-  if (!cell.min.allFinite() || !cell.max.allFinite() || !(cell.min.array() < cell.max.array()).all()) {
-    throw Error("cell: min must be below max on every axis");
-  }
+namespace {
+
+void validate_obstacles(const std::vector<Obstacle>& obstacles) {
   std::set<std::string> names;
   for (std::size_t i = 0; i < obstacles.size(); ++i) {
     const Obstacle& o = obstacles[i];
@@ -526,56 +544,73 @@ void Scene::validate() const {
     check_shape(o.shape, what);
     if (!all_finite(o.X_CO)) throw Error(what + ": pose must be finite");
   }
-  auto check_plan = [&](const SweepPlan& plan, const std::string& key) {
-    if (plan.stops.empty()) throw Error(key + ": no stops");
-    if (!(plan.period > 0)) throw Error(key + ".period: must be positive");
-    for (std::size_t k = 0; k < plan.stops.size(); ++k) {
-      if (!robot.within_limits(plan.stops[k])) {
-        throw Error(key + ": stop " + std::to_string(k) + " q = " + format_vector(plan.stops[k]) +
-                    " is outside the robot's joint limits or has the wrong size (dof " +
-                    std::to_string(robot.dof()) + ")");
-      }
-    }
-  };
-  check_plan(sweep, "sweep");
-  names.clear();
-  for (std::size_t i = 0; i < sensors.size(); ++i) {
-    const SensorSpec& s = sensors[i];
-    const std::string key = "sensors[" + std::to_string(i) + "]";
-    if (s.name.empty()) throw Error(key + ".name: must not be empty");
-    if (!names.insert(s.name).second) throw Error(key + ".name: '" + s.name + "' used twice");
-    if (!all_finite(s.X_ES) || !all_finite(s.X_CS)) throw Error(key + ".mount: pose must be finite");
-    try {
-      if (s.is_camera()) {
-        s.intrinsics.validate();
-      } else {
-        s.scanner.validate();
-      }
-    } catch (const Error& e) {
-      throw Error(key + ": " + e.what());
-    }
-    const SweepPlan& plan = plan_for(s);
-    const std::string plan_key = s.sweep ? key + ".sweep" : std::string("sweep");
-    if (s.sweep) check_plan(*s.sweep, plan_key);
-    for (std::size_t k = 0; k < plan.stops.size(); ++k) {
-      const Eigen::Vector3d p_CS = sensor_pose(static_cast<int>(i), plan.stops[k]).translation();
-      if (!cell.contains(p_CS)) {
-        throw Error(key + ".mount: sensor '" + s.name + "' is outside the cell at " + plan_key + " stop " +
-                    std::to_string(k) + " (sensor at " + format_vector(p_CS) + ", cell " +
-                    format_vector(cell.min) + " to " + format_vector(cell.max) + ")");
-      }
+}
+
+// `plan` (the YAML key `key`) has stops, a positive period and every stop within the robot's joint limits.
+void check_plan(const SweepPlan& plan, const std::string& key, const Robot& robot) {
+  if (plan.stops.empty()) throw Error(key + ": no stops");
+  if (!(plan.period > 0)) throw Error(key + ".period: must be positive");
+  for (std::size_t k = 0; k < plan.stops.size(); ++k) {
+    if (!robot.within_limits(plan.stops[k])) {
+      throw Error(key + ": stop " + std::to_string(k) + " q = " + format_vector(plan.stops[k]) +
+                  " is outside the robot's joint limits or has the wrong size (dof " +
+                  std::to_string(robot.dof()) + ")");
     }
   }
+}
+
+// Sensor i: its name (not in `names` yet), pose, intrinsics or scanner, its own plan and that it stays inside
+// the cell at every stop of its plan.
+void validate_sensor(const Scene& scene, std::size_t i, std::set<std::string>& names) {
+  const SensorSpec& s = scene.sensors[i];
+  const std::string key = "sensors[" + std::to_string(i) + "]";
+  if (s.name.empty()) throw Error(key + ".name: must not be empty");
+  if (!names.insert(s.name).second) throw Error(key + ".name: '" + s.name + "' used twice");
+  if (!all_finite(s.X_ES) || !all_finite(s.X_CS)) throw Error(key + ".mount: pose must be finite");
+  try {
+    if (s.is_camera()) {
+      s.intrinsics.validate();
+    } else {
+      s.scanner.validate();
+    }
+  } catch (const Error& e) {
+    throw Error(key + ": " + e.what());
+  }
+  const SweepPlan& plan = scene.plan_for(s);
+  const std::string plan_key = s.sweep ? key + ".sweep" : std::string("sweep");
+  if (s.sweep) check_plan(*s.sweep, plan_key, scene.robot);
+  for (std::size_t k = 0; k < plan.stops.size(); ++k) {
+    const Eigen::Vector3d p_CS = scene.sensor_pose(static_cast<int>(i), plan.stops[k]).translation();
+    if (!scene.cell.contains(p_CS)) {
+      throw Error(key + ".mount: sensor '" + s.name + "' is outside the cell at " + plan_key + " stop " +
+                  std::to_string(k) + " (sensor at " + format_vector(p_CS) + ", cell " +
+                  format_vector(scene.cell.min) + " to " + format_vector(scene.cell.max) + ")");
+    }
+  }
+}
+
+void validate_motion(const Scene& scene) {
+  scene.motion->validate(scene.robot);
+  for (const Waypoint& w : scene.motion->waypoints) {
+    const int picked = scene.find_obstacle(w.pick);
+    if (!w.pick.empty() && (picked < 0 || !std::holds_alternative<BoxShape>(scene.obstacles[picked].shape))) {
+      throw Error("motion: pick '" + w.pick + "': no box obstacle of that name");
+    }
+  }
+}
+
+}  // namespace
+
+void Scene::validate() const {
+  if (!cell.min.allFinite() || !cell.max.allFinite() || !(cell.min.array() < cell.max.array()).all()) {
+    throw Error("cell: min must be below max on every axis");
+  }
+  validate_obstacles(obstacles);
+  check_plan(sweep, "sweep", robot);
+  std::set<std::string> sensor_names;
+  for (std::size_t i = 0; i < sensors.size(); ++i) validate_sensor(*this, i, sensor_names);
   if (sensors.empty()) throw Error("sensors: at least one sensor is required");
-  if (motion) {
-    motion->validate(robot);
-    for (const Waypoint& w : motion->waypoints) {
-      const int picked = find_obstacle(w.pick);
-      if (!w.pick.empty() && (picked < 0 || !std::holds_alternative<BoxShape>(obstacles[picked].shape))) {
-        throw Error("motion: pick '" + w.pick + "': no box obstacle of that name");
-      }
-    }
-  }
+  if (motion) validate_motion(*this);
   for (const Walker& walker : walkers) walker.validate();
 }
 

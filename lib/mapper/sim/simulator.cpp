@@ -22,6 +22,84 @@ long first_tick(double t, double period) {
   return static_cast<long>(std::ceil(t / period - 1e-9));
 }
 
+// Unnormalised ray of pixel (u, v) in S; its z component is 1, so depth z = t / |ray|.
+Eigen::Vector3d pixel_ray_S(const PinholeIntrinsics& k, double u, double v) {
+  return Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+}
+
+// The obstacles that rays of the tile of pixels [u0, u1] × [v0, v1] may hit: those in the cone around its
+// four corner rays, which holds every ray of the tile (the tile is convex on the image plane).
+std::vector<SceneCaster::Candidate> tile_candidates(const SceneCaster& caster, const PinholeIntrinsics& k,
+                                                    const Eigen::Isometry3d& X_CS, int u0, int v0, int u1,
+                                                    int v1) {
+  const Eigen::Vector3d corners[4] = {
+      pixel_ray_S(k, u0, v0).normalized(), pixel_ray_S(k, u1, v0).normalized(),
+      pixel_ray_S(k, u0, v1).normalized(), pixel_ray_S(k, u1, v1).normalized()};
+  const Eigen::Vector3d axis_S = (corners[0] + corners[1] + corners[2] + corners[3]).normalized();
+  double half_angle = 0;
+  for (const Eigen::Vector3d& c : corners) {
+    half_angle = std::max(half_angle, std::acos(std::clamp(axis_S.dot(c), -1.0, 1.0)));
+  }
+  const Eigen::Matrix3d R_CS = X_CS.linear();
+  return caster.candidates(X_CS.translation(), R_CS * axis_S, half_angle + 1e-9);
+}
+
+// The exact depth of every pixel (0: nothing within the camera's range and the cell) and the obstacle hit,
+// cast tile by tile on `threads` threads.
+SimFrame cast_pixels(const PinholeIntrinsics& k, const Eigen::Isometry3d& X_CS, const Region& cell,
+                     const SceneCaster& caster, int threads) {
+  const int width = k.width, height = k.height;
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const Eigen::Matrix3d R_CS = X_CS.linear();
+  const Eigen::Vector3d p_CS = X_CS.translation();
+  SimFrame out;
+  out.exact.assign(pixels, 0.0);
+  out.hit.assign(pixels, RayHit::kNothing);
+  const int tiles_u = (width + kTile - 1) / kTile, tiles_v = (height + kTile - 1) / kTile;
+  parallel_for(tiles_u * tiles_v, threads, [&](int tile) {
+    const int u0 = (tile % tiles_u) * kTile, v0 = (tile / tiles_u) * kTile;
+    const int u1 = std::min(width, u0 + kTile) - 1, v1 = std::min(height, v0 + kTile) - 1;
+    const std::vector<SceneCaster::Candidate> candidates = tile_candidates(caster, k, X_CS, u0, v0, u1, v1);
+    for (int v = v0; v <= v1; ++v) {
+      for (int u = u0; u <= u1; ++u) {
+        const Eigen::Vector3d r_S = pixel_ray_S(k, u, v);
+        const double length = r_S.norm();
+        const Eigen::Vector3d d_C = R_CS * (r_S / length);
+        const double t_max = std::min(exit_distance(cell, p_CS, d_C), k.max_range * length);
+        const RayHit hit = caster.cast(p_CS, d_C, t_max, &candidates);
+        if (hit.obstacle == RayHit::kNothing) continue;
+        const double z = hit.t / length;
+        if (z < k.min_range || z > k.max_range) continue;
+        const std::size_t p = static_cast<std::size_t>(v) * width + u;
+        out.exact[p] = z;
+        out.hit[p] = hit.obstacle;
+      }
+    }
+  });
+  return out;
+}
+
+// The depth image of depths `z` as the camera quantizes them (raw units of depth_scale, 0 = no return),
+// without what lies outside the cell.
+DepthImage quantized(const std::vector<double>& z, const PinholeIntrinsics& k, const Eigen::Isometry3d& X_CS,
+                     const Region& cell) {
+  DepthImage image;
+  image.intrinsics = k;
+  image.depth.assign(z.size(), 0);
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * k.width + u;
+      if (z[p] <= 0) continue;
+      const double raw = std::round(z[p] / k.depth_scale);
+      const double quantized_z = raw * k.depth_scale;
+      if (raw < 1 || raw > 65535 || quantized_z < k.min_range || quantized_z > k.max_range) continue;
+      if (!cell.contains(X_CS * (pixel_ray_S(k, u, v) * quantized_z))) continue;
+      image.depth[p] = static_cast<std::uint16_t>(raw);
+    }
+  }
+  return image;
+}
+
 }  // namespace
 
 Simulator::Simulator(Scene scene, SimOptions options)
@@ -78,7 +156,8 @@ SimWindow Simulator::window(double t0, double t1, const std::vector<int>& sensor
   if (!(t0 >= 0) || !(t1 >= t0)) throw Error("simulator: window needs 0 <= t0 <= t1");
   std::vector<int> rendered = sensors;
   if (sensors.empty()) {
-    for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor) rendered.push_back(sensor);
+    for (int sensor = 0; sensor < static_cast<int>(scene_.sensors.size()); ++sensor)
+      rendered.push_back(sensor);
   }
   SimWindow out;
   for (const int sensor : rendered) {
@@ -160,69 +239,11 @@ std::vector<SimFrame> Simulator::sweep(int sensor, std::uint64_t sweep_index, do
 
 SimFrame Simulator::render_camera(const SensorSpec& spec, const Eigen::Isometry3d& X_CS, const NoiseKey& key,
                                   const SceneCaster& caster) const {
-  const PinholeIntrinsics& k = spec.intrinsics;
-  const int width = k.width, height = k.height;
-  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  const Eigen::Matrix3d R_CS = X_CS.linear();
-  const Eigen::Vector3d p_CS = X_CS.translation();
-  // Unnormalised ray of pixel (u, v) in S; its z component is 1, so depth z = t / |ray|.
-  auto ray_S = [&](double u, double v) { return Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0); };
-
-  SimFrame out;
-  out.exact.assign(pixels, 0.0);
-  out.hit.assign(pixels, RayHit::kNothing);
-  const int tiles_u = (width + kTile - 1) / kTile, tiles_v = (height + kTile - 1) / kTile;
-  parallel_for(tiles_u * tiles_v, options_.threads, [&](int tile) {
-    const int u0 = (tile % tiles_u) * kTile, v0 = (tile / tiles_u) * kTile;
-    const int u1 = std::min(width, u0 + kTile) - 1, v1 = std::min(height, v0 + kTile) - 1;
-    // The cone around the tile's four corner rays holds every ray of the tile (the tile is convex on the
-    // image plane); obstacles outside it cannot be hit from this tile.
-    const Eigen::Vector3d corners[4] = {ray_S(u0, v0).normalized(), ray_S(u1, v0).normalized(),
-                                        ray_S(u0, v1).normalized(), ray_S(u1, v1).normalized()};
-    const Eigen::Vector3d axis_S = (corners[0] + corners[1] + corners[2] + corners[3]).normalized();
-    double half_angle = 0;
-    for (const Eigen::Vector3d& c : corners) {
-      half_angle = std::max(half_angle, std::acos(std::clamp(axis_S.dot(c), -1.0, 1.0)));
-    }
-    const std::vector<SceneCaster::Candidate> candidates =
-        caster.candidates(p_CS, R_CS * axis_S, half_angle + 1e-9);
-    for (int v = v0; v <= v1; ++v) {
-      for (int u = u0; u <= u1; ++u) {
-        const Eigen::Vector3d r_S = ray_S(u, v);
-        const double length = r_S.norm();
-        const Eigen::Vector3d d_C = R_CS * (r_S / length);
-        const double t_max = std::min(exit_distance(scene_.cell, p_CS, d_C), k.max_range * length);
-        const RayHit hit = caster.cast(p_CS, d_C, t_max, &candidates);
-        if (hit.obstacle == RayHit::kNothing) continue;
-        const double z = hit.t / length;
-        if (z < k.min_range || z > k.max_range) continue;
-        const std::size_t p = static_cast<std::size_t>(v) * width + u;
-        out.exact[p] = z;
-        out.hit[p] = hit.obstacle;
-      }
-    }
-  });
-
-  const NoiseModel model = options_.noise ? noise_model(spec.model, k) : zero_noise();
-  const std::vector<double> noisy =
-      apply_camera_noise(model, out.exact, width, height, key, options_.threads);
-
-  // Quantize like the camera does (raw units of depth_scale, 0 = no return) and drop what lies outside the
-  // cell.
-  DepthImage image;
-  image.intrinsics = k;
-  image.depth.assign(pixels, 0);
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const std::size_t p = static_cast<std::size_t>(v) * width + u;
-      if (noisy[p] <= 0) continue;
-      const double raw = std::round(noisy[p] / k.depth_scale);
-      const double z = raw * k.depth_scale;
-      if (raw < 1 || raw > 65535 || z < k.min_range || z > k.max_range) continue;
-      if (!scene_.cell.contains(X_CS * (ray_S(u, v) * z))) continue;
-      image.depth[p] = static_cast<std::uint16_t>(raw);
-    }
-  }
+  SimFrame out = cast_pixels(spec.intrinsics, X_CS, scene_.cell, caster, options_.threads);
+  const NoiseModel model = options_.noise ? noise_model(spec.model, spec.intrinsics) : zero_noise();
+  const std::vector<double> noisy = apply_camera_noise(model, out.exact, spec.intrinsics.width,
+                                                       spec.intrinsics.height, key, options_.threads);
+  DepthImage image = quantized(noisy, spec.intrinsics, X_CS, scene_.cell);
   out.frame.points_S = depth_to_points(image);
   out.frame.depth = std::move(image);
   return out;

@@ -118,10 +118,11 @@ struct Resegmentation final {
 /// next id of the counter. Not thread-safe; one instance per cell, driven by one thread.
 class CellPipeline final {
  public:
-  /// Starts from `boxes` and, if `map_state` is given, the map saved by map_state() (else an empty map, which
-  /// settles first). `next_box_id` must be above every id this cell ever handed out (not only the ids in
-  /// `boxes`): it is where the counter goes on. A map state written by an older version that still carries
-  /// the counter raises it to that counter if higher.
+  /// Starts from `boxes` and, if `map_state` is given, the map saved by map_state() with the flips that were
+  /// pending then (else an empty map, which settles first). A map state of the older layout without them
+  /// starts with no flip pending. `next_box_id` must be above every id this cell ever handed out (not only
+  /// the ids in `boxes`): it is where the counter goes on. A map state written by an older version that still
+  /// carries the counter raises it to that counter if higher.
   /// @throws Error if the config is invalid or the map state is unreadable.
   explicit CellPipeline(const CellPipelineConfig& config, std::vector<Box> boxes = {},
                         std::uint64_t next_box_id = 1,
@@ -173,9 +174,11 @@ class CellPipeline final {
   /// whole: with min_group = change.min_voxels the obstacle voxels the boxes leave out (the safety property
   /// wants 0), with 1 every occupied voxel they leave out (noise included). Costs a pass over the map.
   [[nodiscard]] std::size_t voxels_outside_boxes(int min_group) const;
-  /// The map and the viewpoint normals face, as one opaque string (what a restart passes back to the
-  /// constructor; also how a measurement clones a pipeline). The box-id counter is not part of it: it is
-  /// kept with the versions (VersionStore), so a lost map state cannot bring back an id.
+  /// The map, the viewpoint normals face and the change detector's state (the flips still waiting for
+  /// confirmation, so that a restart confirms them as if it had not happened), as one opaque string (what a
+  /// restart passes back to the constructor; also how a measurement clones a pipeline). The box-id counter is
+  /// not part of it: it is kept with the versions (VersionStore), so a lost map state cannot bring back an
+  /// id.
   [[nodiscard]] std::string map_state() const;
 
  private:

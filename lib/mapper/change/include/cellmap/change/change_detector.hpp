@@ -8,7 +8,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
+#include <optional>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "cellmap/common/region.hpp"
@@ -81,11 +84,33 @@ class ChangeDetector final {
   [[nodiscard]] std::size_t pending() const { return pending_.size(); }
   [[nodiscard]] const ChangeConfig& config() const { return config_; }
 
+  /// Writes what the detector remembers between sweeps (the sweep count, the pending flips, the appeared
+  /// voxels of recently reported regions) as text: a line `cellmap-change SWEEP PENDING REPORTED`, then one
+  /// line per pending voxel (`x y z was_occupied sweeps_held`) and per reported voxel (`x y z sweep`), keys
+  /// in (z, y, x) order. Saved with the map it belongs to, so that after a restart a flip seen before the
+  /// map was saved still waits for confirmation instead of passing for the confirmed state.
+  /// @throws Error if the stream fails.
+  void write(std::ostream& out) const;
+  /// Replaces the state with one written by write(). Flips that held longer than `persist_sweeps` (a
+  /// config lowered meanwhile) are confirmed by the next update().
+  /// @throws Error (the state unchanged) if the text is not such a state.
+  void read(std::istream& in);
+
  private:
   struct Pending {
     bool was_occupied;  // the state before the flip (the last confirmed state)
     int sweeps;         // sweeps the new state has held, counting the flip's sweep
   };
+  using KeySet = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash>;
+  // Voxels confirmed in this sweep → now occupied.
+  using ConfirmedFlips = std::unordered_map<octomap::OcTreeKey, bool, octomap::OcTreeKey::KeyHash>;
+  void record_flips(const OccupancyUpdate& update);
+  [[nodiscard]] ConfirmedFlips confirm_held_flips();
+  void forget_old_reports();
+  [[nodiscard]] std::optional<ChangeRegion> grow_region(const octomap::OcTreeKey& seed,
+                                                        const ConfirmedFlips& confirmed,
+                                                        const OccupancyMap& map, KeySet& grouped);
+
   ChangeConfig config_;
   std::uint64_t sweep_ = 0;
   std::unordered_map<octomap::OcTreeKey, Pending, octomap::OcTreeKey::KeyHash> pending_;
