@@ -370,20 +370,25 @@ TEST(CellmapdStateE2eTest, AChangeWaitingForConfirmationWhenKilledComesOutOnceAf
   {
     auto daemon = service.start_daemon(domain, /*log_on_stdout=*/true);
     test::DaemonLog log(*daemon);
-    const transport::SceneEditWriter edits(participant);
+    const transport::SceneEditWriter edits(participant, "pending");
+    const auto add_box = [](const char* name, const Eigen::Vector3d& centre, const Eigen::Vector3d& half) {
+      transport::SceneEdit edit = transport::SceneEdit::add_box(name, centre, half);
+      edit.cell = "pending";
+      return edit;
+    };
     ASSERT_TRUE(edits.wait_for_reader(kPatience));
     const std::optional<std::string> first = log.wait_for("version 1: ");
     ASSERT_TRUE(first.has_value()) << "no first version";
     const std::optional<std::string> before_a = log.wait_for(kSweepLine);
     ASSERT_TRUE(before_a.has_value());
-    edits.write(transport::SceneEdit::add_box("a", a, a_half));
+    edits.write(add_box("a", a, a_half));
     // B once a sweep that sees A was fused (else both are confirmed together), so well within A's
     // persist_sweeps B's voxels have flipped and wait when A's version is saved.
     std::optional<std::string> line;
     while ((line = log.wait_for(kSweepLine)) && points_of(*line) == points_of(*before_a)) {
     }
     ASSERT_TRUE(line.has_value()) << "A was never seen";
-    edits.write(transport::SceneEdit::add_box("b", b, b_half));
+    edits.write(add_box("b", b, b_half));
     ASSERT_TRUE(log.wait_for("version 2: ").has_value()) << "A never came out";
     daemon->signal(SIGKILL);
     daemon->wait();
