@@ -37,6 +37,17 @@ void log_dds_security(const dds::Participant& participant, int domain) {
   }
 }
 
+// The participant, once its credentials are known to be the cell's own: their permissions grant that cell's
+// partition only, so DDS would otherwise refuse the first writer with a reason that names neither cell.
+const dds::Participant& of_cell(const dds::Participant& participant, const std::string& cell) {
+  const std::optional<security::Credentials>& credentials = participant.credentials();
+  if (credentials && credentials->cell != cell) {
+    throw Error(credentials->files.certificate.string() + ": issued for cell '" + credentials->cell +
+                "', not this daemon's cell '" + cell + "'");
+  }
+  return participant;
+}
+
 // Measures one step on the calling thread.
 class Stopwatch {
  public:
@@ -64,7 +75,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
       options_(std::move(options)),
       store_(config_.state_dir, config_.cell),
       participant_(static_cast<std::uint32_t>(config_.domain), config_.security),
-      publisher_(participant_, config_.cell, config_.delta_depth),
+      publisher_(of_cell(participant_, config_.cell), config_.cell, config_.delta_depth),
       layers_(participant_, config_.cell),
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
       keeper_(store_,

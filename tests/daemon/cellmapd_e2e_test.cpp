@@ -52,7 +52,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   const dds::Participant participant = service_->participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber planner(participant, "e2e", std::ref(recorder));
-  transport::StatusReader status(participant);
+  transport::StatusReader status(participant, "e2e");
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "no first version from the daemon";
   const Environment before = settled(planner, status, "e2e", test::kLongQuietSweeps);
   ASSERT_FALSE(before.boxes().empty());
@@ -94,7 +94,7 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
   {
     const dds::Participant participant = service_->participant(domain);
     transport::EnvironmentSubscriber planner(participant, "e2e");
-    transport::StatusReader status(participant);
+    transport::StatusReader status(participant, "e2e");
     ASSERT_TRUE(planner.wait_for_version(1, kPatience));
     before_kill = settled(planner, status, "e2e", test::kLongQuietSweeps);
   }
@@ -303,7 +303,7 @@ TEST(CellmapdStateE2eTest, AChangeWaitingToBeGatheredWhenKilledComesOutOnceAfter
   auto daemon = service.start_daemon(domain);
   const dds::Participant participant = service.participant(domain);
   transport::EnvironmentSubscriber planner(participant, "gather");
-  transport::StatusReader status(participant);
+  transport::StatusReader status(participant, "gather");
   ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "the restarted daemon announced nothing";
   const std::uint64_t resumed = planner.environment()->version();
   EXPECT_FALSE(service.inject(domain, add_box).empty());  // the simulated cell starts from its scene again
@@ -314,121 +314,6 @@ TEST(CellmapdStateE2eTest, AChangeWaitingToBeGatheredWhenKilledComesOutOnceAfter
   EXPECT_EQ(after.version(), resumed + 1) << "the change came out in more than one version";
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
-}
-
-// The default cell's scene (config/cell.yaml) with `obstacles` (YAML flow mappings) added, written to `path`.
-std::filesystem::path default_scene_with(const std::filesystem::path& path,
-                                         const std::vector<std::string>& obstacles) {
-  std::ifstream in(CELLMAP_SOURCE_DIR "/config/cell.yaml");
-  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::size_t robot = scene.find("\nrobot:\n");
-  EXPECT_NE(robot, std::string::npos) << "config/cell.yaml has no robot section";
-  std::string added;
-  for (const std::string& obstacle : obstacles) added += "  - " + obstacle + "\n";
-  scene.insert(robot + 1, added);
-  std::ofstream(path) << scene;
-  return path;
-}
-
-// The points a per-sweep log line counts ("sweep 12: 5 frames, 235152 points, ..."), or 0.
-std::uint64_t points_of(const std::string& line) {
-  const std::size_t frames = line.find(" frames, ");
-  return frames == std::string::npos ? 0 : std::strtoull(line.c_str() + frames + 9, nullptr, 10);
-}
-
-// The number of the last sweep logged before the first line holding `text`, or 0.
-std::uint64_t sweep_before(const std::vector<std::string>& lines, const std::string& text) {
-  std::uint64_t sweep = 0;
-  for (const std::string& line : lines) {
-    if (line.find(text) != std::string::npos) return sweep;
-    if (sweep_number(line) > 0) sweep = sweep_number(line);
-  }
-  return 0;
-}
-
-// A change whose voxels flipped and wait for confirmation (change.persist_sweeps) when another change's
-// version is saved: the map saved with that version already holds the waiting change, so the restarted
-// daemon must know that it waits, or it never confirms it (its voxels do not flip again); with
-// reconcile.cover_every_version off nothing else would box it. Killed right after that version and restarted
-// on the cell as it now is (both boxes in its scene), the daemon brings the waiting change out as one version
-// within persist_sweeps sweeps (what it still had to wait), one box holding it.
-TEST(CellmapdStateE2eTest, AChangeWaitingForConfirmationWhenKilledComesOutOnceAfterTheRestart) {
-  constexpr int kPersist = 12;
-  test::ServiceFixture service("pending");
-  const auto write_config = [&](const std::string& source) {
-    std::ofstream(service.config_file(), std::ios::trunc)
-        << "cell: pending\nsweep_period: 0.25\nstatus_period: 0.5\nsource: " << source
-        << "\nchange: {settle_sweeps: 2, persist_sweeps: " << kPersist
-        << "}\nreconcile: {cover_every_version: false}\n";
-  };
-  write_config("{noise: false}");
-  const int domain = test::domain::kPendingRestart;
-  const dds::Participant participant = service.participant(domain);
-  // Two boxes on free parts of the table (top at z = 0.75): A, then B a sweep or two later.
-  const Eigen::Vector3d a(2.12, 0.45, 0.9), b(0.5, 1.5, 0.95);
-  const Eigen::Vector3d a_half(0.1, 0.1, 0.15), b_half(0.08, 0.08, 0.2);
-  {
-    auto daemon = service.start_daemon(domain, /*log_on_stdout=*/true);
-    test::DaemonLog log(*daemon);
-    const transport::SceneEditWriter edits(participant, "pending");
-    const auto add_box = [](const char* name, const Eigen::Vector3d& centre, const Eigen::Vector3d& half) {
-      transport::SceneEdit edit = transport::SceneEdit::add_box(name, centre, half);
-      edit.cell = "pending";
-      return edit;
-    };
-    ASSERT_TRUE(edits.wait_for_reader(kPatience));
-    const std::optional<std::string> first = log.wait_for("version 1: ");
-    ASSERT_TRUE(first.has_value()) << "no first version";
-    const std::optional<std::string> before_a = log.wait_for(kSweepLine);
-    ASSERT_TRUE(before_a.has_value());
-    edits.write(add_box("a", a, a_half));
-    // B once a sweep that sees A was fused (else both are confirmed together), so well within A's
-    // persist_sweeps B's voxels have flipped and wait when A's version is saved.
-    std::optional<std::string> line;
-    while ((line = log.wait_for(kSweepLine)) && points_of(*line) == points_of(*before_a)) {
-    }
-    ASSERT_TRUE(line.has_value()) << "A was never seen";
-    edits.write(add_box("b", b, b_half));
-    ASSERT_TRUE(log.wait_for("version 2: ").has_value()) << "A never came out";
-    daemon->signal(SIGKILL);
-    daemon->wait();
-    log.drain();
-    ASSERT_EQ(log.count("version 3: "), 0u) << "B came out before the kill";
-  }
-
-  // The cell as it now is: the simulated cell starts from its scene, which now holds both boxes.
-  write_config(
-      "{noise: false, scene: " +
-      default_scene_with(service.config_file().parent_path() / "cell.yaml",
-                         {"{name: a, box: {half_extents: [0.1, 0.1, 0.15]}, center: [2.12, 0.45, 0.9]}",
-                          "{name: b, box: {half_extents: [0.08, 0.08, 0.2]}, center: [0.5, 1.5, 0.95]}"})
-          .string() +
-      "}");
-  auto daemon = service.start_daemon(domain, /*log_on_stdout=*/true);
-  test::DaemonLog log(*daemon);
-  transport::EnvironmentSubscriber planner(participant, "pending");
-  const auto holds = [](const Environment& env, const Eigen::Vector3d& p_C) {
-    return std::count_if(env.boxes().begin(), env.boxes().end(),
-                         [&](const Box& box) { return box.contains(p_C); });
-  };
-  ASSERT_TRUE(log.wait_for("resumed version 2").has_value())
-      << "the restarted daemon did not resume version 2";
-  ASSERT_TRUE(test::wait_for_version(planner, 2, log));
-  const Environment resumed = *planner.environment();
-  ASSERT_EQ(holds(resumed, a), 1) << "version 2 does not hold A";
-  ASSERT_EQ(holds(resumed, b), 0) << "version 2 already holds B: it did not wait";
-  // Past any wait B could still have, and past the sweeps a change seen afresh would need.
-  ASSERT_TRUE(log.wait_for(std::string(kSweepLine) + std::to_string(2 * kPersist) + ": ").has_value());
-  daemon->signal(SIGTERM);
-  EXPECT_EQ(test::exit_code(daemon->wait()), 0);
-  log.drain();
-  ASSERT_EQ(log.count("version 3: "), 1u) << "B, waiting for confirmation at the kill, never came out";
-  EXPECT_EQ(log.count("version 4: "), 0u) << "B came out in more than one version";
-  EXPECT_LE(sweep_before(log.lines(), "version 3: "), static_cast<std::uint64_t>(kPersist))
-      << "B waited longer than persist_sweeps after the restart";
-  ASSERT_TRUE(test::wait_for_version(planner, 3, log));
-  EXPECT_EQ(holds(*planner.environment(), a), 1);
-  EXPECT_EQ(holds(*planner.environment(), b), 1);
 }
 
 // cellmapd started on a state directory whose newest snapshot JSON is truncated: it resumes from the previous

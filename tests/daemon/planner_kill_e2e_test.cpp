@@ -142,7 +142,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   // One more change after the last restart, then the subscriber must end on the daemon's newest version.
   // The restarted daemon first settles on its scene (injected boxes are not persisted in the simulation).
   const dds::Participant observer = service.participant(test::domain::kKill);
-  transport::StatusReader status(observer);
+  transport::StatusReader status(observer, "kill");
   ASSERT_TRUE(test::wait_until_settled(status, "kill", test::kQuietSweeps))
       << "the restarted daemon never settled";
   collect();

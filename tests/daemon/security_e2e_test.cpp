@@ -352,6 +352,18 @@ TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
       << lines[0];
   EXPECT_EQ(code, 1);
 
+  // Valid credentials of another cell ("refusal"; the daemon's cell is cell-1 by default).
+  ASSERT_EQ(::chmod(daemon.private_key.c_str(), 0600), 0);
+  lines = run({CELLMAPD, "--domain", std::to_string(test::domain::kRefusal), "--state-dir", state.path().string(),
+               "--security", credentials.directory().string()},
+              &code);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find(" critical " + daemon.certificate.string() +
+                          ": issued for cell 'refusal', not this daemon's cell 'cell-1'"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_EQ(code, 1);
+
   lines = run({CELLMAP_TOOL, "echo", "--domain", std::to_string(test::domain::kRefusal + 1), "--security",
                credentials.directory().string()},
               &code);

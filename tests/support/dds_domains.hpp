@@ -45,7 +45,6 @@ inline constexpr int kReload = 200;
 inline constexpr int kResume = 203;
 inline constexpr int kMailbox = 205;
 inline constexpr int kGatherRestart = 214;
-inline constexpr int kPendingRestart = 215;
 
 // planner_e2e_test.
 inline constexpr int kPlanner = 170;

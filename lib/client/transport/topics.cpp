@@ -1,6 +1,7 @@
 #include "cellmap/transport/topics.hpp"
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap::transport {
 
@@ -8,7 +9,7 @@ std::string cell_partition(const std::string& cell) {
   if (cell == kEveryCell) return std::string(kPartitionPrefix) + kEveryCell;
   if (cell.empty()) throw Error("a cell id must not be empty");
   if (cell.find_first_of("*?\\") != std::string::npos)
-    throw Error("cell id '" + cell + "': '*', '?' and '\\' are DDS partition patterns");
+    throw Error("cell id '" + single_line(cell) + "': '*', '?' and '\\' are DDS partition patterns");
   return kPartitionPrefix + cell;
 }
 
