@@ -190,8 +190,10 @@ class Planners {
       started_ns_.push_back(now_ns());
       children_.push_back(std::make_unique<bench::ReportingChild>(std::vector<std::string>{
           self, "--planner", cell_name(i), "--domain", std::to_string(options.domain)}));
-      readers_.emplace_back([this, i] { read(i); });
     }
+    // The readers start once children_ is whole: a reader reading its element while the vector grows would
+    // read freed memory.
+    for (int i = 0; i < options.cells; ++i) readers_.emplace_back([this, i] { read(i); });
   }
   ~Planners() {
     for (auto& child : children_) child->stop();  // the readers then see end of file
