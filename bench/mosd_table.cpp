@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   }
   try {
     const cellmap::SegmentConfig config =
-        config_file.empty() ? cellmap::SegmentConfig{} : cellmap::load_segment_config(config_file);
+        config_file.empty() ? cellmap::SegmentConfig{} : cellmap::SegmentConfig::load(config_file);
     std::printf(
         "%-8s %7s %7s %5s %7s %6s %5s %8s %8s %8s %8s %7s | %6s %6s "
         "%6s %6s %6s %6s %6s\n",

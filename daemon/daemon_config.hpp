@@ -48,7 +48,7 @@ struct SourceConfig final {
   SensorConfig camera;
   /// Cameras: period = `sweep_period` (the frame time one sweep spans), max_frames = `sweep_frames`,
   /// pose_wait = `pose_wait`.
-  SweepGrouping grouping;
+  SweepParams grouping;
 
   [[nodiscard]] bool is_camera() const { return kind != SourceKind::kSim; }
 };

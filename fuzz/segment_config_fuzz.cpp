@@ -6,6 +6,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace cellmap;
   fuzz::accept_or_refuse(
-      [&] { (void)segment_config_from_yaml(YamlMap::parse(fuzz::text(data, size), "segment.yaml")); });
+      [&] { (void)SegmentConfig::from_yaml(YamlMap::parse(fuzz::text(data, size), "segment.yaml")); });
   return 0;
 }

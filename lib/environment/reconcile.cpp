@@ -17,7 +17,7 @@ double iou(const Region& a, const Region& b) {
   return both > 0 ? common / both : 0.0;
 }
 
-bool within_tolerance(const Box& a, const Box& b, const ReconcileOptions& options) {
+bool within_tolerance(const Box& a, const Box& b, const ReconcileParams& options) {
   return (a.center - b.center).norm() < options.position_tolerance &&
          (a.half_extents - b.half_extents).cwiseAbs().maxCoeff() < options.position_tolerance &&
          a.rotation.angularDistance(b.rotation) < options.rotation_tolerance;
@@ -105,7 +105,7 @@ void sort_by_id(Reconciled& out) {
 
 Reconciled reconcile(const std::vector<Box>& previous, const std::vector<std::uint64_t>& in_scope,
                      const std::vector<Box>& resegmented, std::uint64_t next_id,
-                     const ReconcileOptions& options) {
+                     const ReconcileParams& options) {
   for (const Box& box : previous) {
     if (box.id >= next_id) {
       throw Error("reconcile: next id " + std::to_string(next_id) + " is not above existing box id " +

@@ -175,7 +175,7 @@ TEST(Pipeline, ASparseCloudStillConnects) {
 }
 
 TEST(SegmentConfig, TheConfigFileHoldsTheDefaults) {
-  const SegmentConfig file = load_segment_config(std::string(CELLMAP_SOURCE_DIR) + "/config/segment.yaml");
+  const SegmentConfig file = SegmentConfig::load(std::string(CELLMAP_SOURCE_DIR) + "/config/segment.yaml");
   const SegmentConfig defaults;
   EXPECT_EQ(file.k, defaults.k);
   EXPECT_EQ(file.outlier_mode, defaults.outlier_mode);
@@ -206,7 +206,7 @@ TEST(SegmentConfig, TheConfigFileHoldsTheDefaults) {
 
 void expect_config_error(const std::string& yaml, const std::string& key) {
   try {
-    (void)segment_config_from_yaml(YamlMap::parse(yaml, "test.yaml"));
+    (void)SegmentConfig::from_yaml(YamlMap::parse(yaml, "test.yaml"));
     FAIL() << "accepted: " << yaml;
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("test.yaml: " + key), std::string::npos) << e.what();
@@ -227,7 +227,7 @@ TEST(SegmentConfig, UnknownKeysAndOutOfRangeValuesNameTheKey) {
 
 TEST(SegmentConfig, WorkspaceCropsAndCountsTheDrop) {
   const SegmentConfig config =
-      segment_config_from_yaml(YamlMap::parse("outliers: {mode: 'off'}\nworkspace:\n  lower: [-0.3, -0.3, "
+      SegmentConfig::from_yaml(YamlMap::parse("outliers: {mode: 'off'}\nworkspace:\n  lower: [-0.3, -0.3, "
                                               "0.0]\n  upper: [0.0, 0.3, 0.2]\n  envelope: 0.01\n",
                                               "test.yaml"));
   ASSERT_TRUE(config.workspace.has_value());
@@ -248,7 +248,7 @@ TEST(SegmentConfig, WorkspaceCropsAndCountsTheDrop) {
 TEST(SegmentConfig, FuzzFindingsAreRefusedWithOneLine) {
   const std::string file = test::fuzz_regression("segment_config", "unknown_escape.yaml");
   EXPECT_EQ(test::one_line_error_of([&] {
-              (void)load_segment_config(file);
+              (void)SegmentConfig::load(file);
             }).rfind(file + ": YAML syntax error at line 21, column 1: unknown escape character", 0),
             0u);
 }

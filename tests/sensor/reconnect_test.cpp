@@ -8,8 +8,8 @@
 namespace cellmap {
 namespace {
 
-ReconnectPolicy policy() {
-  ReconnectPolicy p;
+ReconnectParams policy() {
+  ReconnectParams p;
   p.frame_timeout = 2.0;
   p.initial_backoff = 0.5;
   p.max_backoff = 4.0;
@@ -76,7 +76,7 @@ TEST(ReconnectorTest, ErrorIsFinalUntilClosed) {
 TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
   // Times with room for a stalled, shared CI machine: the attempt is due 1 s after the loss, the waits are
   // 20 ms (too short) and 5 s (cut at the attempt).
-  ReconnectPolicy p = policy();
+  ReconnectParams p = policy();
   p.initial_backoff = 1.0;
   Reconnector r(p);
   r.lost(steady_seconds(), "unplugged");
@@ -99,7 +99,7 @@ TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
 }
 
 TEST(ReconnectorTest, RefusesBadPolicies) {
-  ReconnectPolicy p = policy();
+  ReconnectParams p = policy();
   p.max_backoff = 0.1;
   EXPECT_THROW(Reconnector{p}, Error);
   p = policy();

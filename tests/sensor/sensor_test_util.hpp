@@ -16,8 +16,8 @@ inline std::string operator/(const TempDir& dir, const std::string& name) {
 }
 
 /// Reconnect timings short enough for tests: 20 ms first back-off, 100 ms cap, 0.5 s frame timeout.
-inline ReconnectPolicy fast_retries() {
-  ReconnectPolicy policy;
+inline ReconnectParams fast_retries() {
+  ReconnectParams policy;
   policy.initial_backoff = 0.02;
   policy.max_backoff = 0.1;
   policy.frame_timeout = 0.5;

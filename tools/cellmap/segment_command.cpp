@@ -35,7 +35,7 @@ void segment_as_cell(const SegmentArgs& args) {
 
 void segment_as_points(const SegmentArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-  SegmentConfig config = args.config.empty() ? SegmentConfig{} : load_segment_config(args.config);
+  SegmentConfig config = args.config.empty() ? SegmentConfig{} : SegmentConfig::load(args.config);
   if (!args.boxes.empty()) config.box_kind = box_kind_from_string(args.boxes, "--boxes");
   const CloudFile file = load_cloud_file(args.input);
   const SegmentResult result = segment_cloud(file.points, config);

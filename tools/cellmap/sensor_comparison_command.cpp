@@ -40,7 +40,7 @@ void compare(const ComparisonArgs& args) {
             : daemon::DaemonConfig::load(args.config).pipeline;
     if (!args.boxes.empty()) config.cell->segment.box_kind = box_kind_from_string(args.boxes, "--boxes");
   } else {
-    if (!args.config.empty()) config.segment = load_segment_config(args.config);
+    if (!args.config.empty()) config.segment = SegmentConfig::load(args.config);
     if (!args.boxes.empty()) config.segment.box_kind = box_kind_from_string(args.boxes, "--boxes");
   }
   config.voxel = args.voxel;

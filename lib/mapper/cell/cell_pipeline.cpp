@@ -312,7 +312,7 @@ std::size_t CellPipeline::voxels_outside_boxes(int min_group) const {
 // area since that area was last fitted (a surface seen at grazing angles filling in, flying pixels collecting
 // their hits in space no ray clears) and those a box kept by reconcile within its tolerance leaves out.
 void CellPipeline::cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const {
-  CoverOptions options;
+  CoverParams options;
   options.voxel = map_.config().resolution;
   options.max_growth = config_.segment.join_max_growth;
   options.kind = config_.segment.box_kind;

@@ -3,8 +3,8 @@
 namespace cellmap {
 namespace {
 
-ReconcileOptions read_reconcile(YamlMap section) {
-  ReconcileOptions o;
+ReconcileParams read_reconcile(YamlMap section) {
+  ReconcileParams o;
   o.min_overlap = section.number("min_overlap", o.min_overlap, 0.0, 1.0);
   o.position_tolerance = section.number("position_tolerance", o.position_tolerance, 0.0, 1.0);
   o.rotation_tolerance = section.number("rotation_tolerance", o.rotation_tolerance, 0.0, 3.2);
@@ -24,7 +24,7 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   c.gather_sweeps = static_cast<int>(change.integer("gather_sweeps", c.gather_sweeps, 0, 1000));
   c.change = ChangeConfig::from_yaml(change);
-  c.segment = segment_config_from_yaml(root.child("segment"));
+  c.segment = SegmentConfig::from_yaml(root.child("segment"));
   // cover_every_version is the pipeline's policy too, read the same way.
   YamlMap reconcile = root.child("reconcile");
   c.cover_every_version = reconcile.get<bool>("cover_every_version", c.cover_every_version);

@@ -31,7 +31,7 @@ Box grown_to_hold(const Box& box, const Eigen::Vector3d& centre_C, double edge) 
 
 // Index of the box of `boxes` that takes the cube with the least growth, at most max_growth of its volume;
 // -1 if none may.
-int cheapest_growth(const std::vector<Box>& boxes, const Eigen::Vector3d& centre_C, const CoverOptions& o) {
+int cheapest_growth(const std::vector<Box>& boxes, const Eigen::Vector3d& centre_C, const CoverParams& o) {
   int best = -1;
   double best_added = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < boxes.size(); ++i) {
@@ -146,7 +146,7 @@ std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map, const Occup
 }
 
 void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
-           const CoverOptions& options) {
+           const CoverParams& options) {
   std::vector<Box>& boxes = reconciled.boxes;
   std::vector<Eigen::Vector3d> rest;
   for (const Eigen::Vector3d& c : centres_C) {

@@ -41,7 +41,7 @@ class OccupiedVoxels final {
                                                           const std::vector<Box>& boxes, int min_group);
 
 /// How the safety pass covers what is left out.
-struct CoverOptions final {
+struct CoverParams final {
   double voxel = 0.02;      ///< voxel edge, metres
   double max_growth = 0.1;  ///< a box may grow by this share of its volume to take a voxel (the join rule)
   BoxKind kind = BoxKind::kOriented;  ///< of the new boxes
@@ -52,6 +52,6 @@ struct CoverOptions final {
 /// then modified, or stays added if it is new), the rest are segmented into new boxes with fresh ids from
 /// `reconciled.next_id`. Keeps `reconciled`'s lists sorted by id.
 void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
-           const CoverOptions& options);
+           const CoverParams& options);
 
 }  // namespace cellmap

@@ -5,7 +5,7 @@
 
 namespace cellmap {
 
-FrameGrouper::FrameGrouper(const SweepGrouping& grouping) : grouping_(grouping) {
+FrameGrouper::FrameGrouper(const SweepParams& grouping) : grouping_(grouping) {
   grouping_.validate();
 }
 

@@ -120,7 +120,7 @@ void fit_boxes(const Cloud& cloud, const Segments& segments, const std::vector<i
   }
 }
 
-// The readers of segment_config_from_yaml's sections: each reads its keys into `c` and refuses any other.
+// The readers of SegmentConfig::from_yaml's sections: each reads its keys into `c` and refuses any other.
 void read_neighbours(YamlMap m, SegmentConfig& c) {
   c.k = static_cast<int>(m.integer("k", c.k, 3, 200));
   m.expect_all_read();
@@ -214,7 +214,7 @@ void read_workspace(YamlMap m, SegmentConfig& c) {
 
 }  // namespace
 
-SegmentConfig segment_config_from_yaml(YamlMap root) {
+SegmentConfig SegmentConfig::from_yaml(YamlMap root) {
   SegmentConfig c;
   read_neighbours(root.child("neighbours"), c);
   read_outliers(root.child("outliers"), c);
@@ -230,8 +230,8 @@ SegmentConfig segment_config_from_yaml(YamlMap root) {
   return c;
 }
 
-SegmentConfig load_segment_config(const std::string& path) {
-  return segment_config_from_yaml(YamlMap::load(path));
+SegmentConfig SegmentConfig::load(const std::string& path) {
+  return from_yaml(YamlMap::load(path));
 }
 
 namespace {

@@ -8,14 +8,14 @@
 
 namespace cellmap {
 
-void ReconnectPolicy::validate() const {
+void ReconnectParams::validate() const {
   if (!(frame_timeout > 0)) throw Error("reconnect: frame_timeout must be > 0");
   if (!(initial_backoff > 0)) throw Error("reconnect: initial_backoff must be > 0");
   if (!(max_backoff >= initial_backoff)) throw Error("reconnect: max_backoff must be >= initial_backoff");
   if (!(factor >= 1.0)) throw Error("reconnect: factor must be >= 1");
 }
 
-Reconnector::Reconnector(const ReconnectPolicy& policy) : policy_(policy), backoff_(policy.initial_backoff) {
+Reconnector::Reconnector(const ReconnectParams& policy) : policy_(policy), backoff_(policy.initial_backoff) {
   policy_.validate();
 }
 

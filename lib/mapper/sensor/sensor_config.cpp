@@ -16,8 +16,8 @@ DepthMode read_mode(YamlMap& map, const DepthMode& fallback) {
   return mode;
 }
 
-ReconnectPolicy read_reconnect(YamlMap& map) {
-  ReconnectPolicy policy;
+ReconnectParams read_reconnect(YamlMap& map) {
+  ReconnectParams policy;
   policy.frame_timeout = map.number("frame_timeout", policy.frame_timeout, 1e-3, 3600);
   YamlMap reconnect = map.child("reconnect");
   policy.initial_backoff = reconnect.number("initial_backoff", policy.initial_backoff, 1e-3, 3600);

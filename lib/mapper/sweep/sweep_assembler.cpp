@@ -8,13 +8,13 @@
 
 namespace cellmap {
 
-void SweepGrouping::validate() const {
+void SweepParams::validate() const {
   if (!(period >= 0) || !std::isfinite(period)) throw Error("sweep grouping: period must be >= 0 seconds");
   if (!(pose_wait >= 0) || !std::isfinite(pose_wait))
     throw Error("sweep grouping: pose_wait must be >= 0 seconds");
 }
 
-SweepAssembler::SweepAssembler(const SweepGrouping& grouping, const Eigen::Isometry3d& X_ES)
+SweepAssembler::SweepAssembler(const SweepParams& grouping, const Eigen::Isometry3d& X_ES)
     : grouping_(grouping), poser_(X_ES) {
   grouping_.validate();
 }

@@ -15,7 +15,7 @@ namespace cellmap {
 /// True if every corner of `inner` lies inside `outer` grown by `tolerance` (metres).
 [[nodiscard]] bool box_inside(const Box& inner, const Box& outer, double tolerance);
 
-struct ReconcileOptions final {
+struct ReconcileParams final {
   /// A new box takes an old box's id when the IoU of their bounds is at least this; else it is a new object.
   double min_overlap = 0.3;
   /// A matched box whose centre and half extents moved less than this (metres) and rotated less than
@@ -54,6 +54,6 @@ struct Reconciled final {
 [[nodiscard]] Reconciled reconcile(const std::vector<Box>& previous,
                                    const std::vector<std::uint64_t>& in_scope,
                                    const std::vector<Box>& resegmented, std::uint64_t next_id,
-                                   const ReconcileOptions& options = {});
+                                   const ReconcileParams& options = {});
 
 }  // namespace cellmap

@@ -54,7 +54,7 @@ struct CellPipelineConfig final {
   OccupancyConfig occupancy;     ///< `occupancy` section
   ChangeConfig change;           ///< `change` section (change detection)
   SegmentConfig segment;         ///< `segment` section: the keys of config/segment.yaml
-  ReconcileOptions reconcile;    ///< `reconcile` section
+  ReconcileParams reconcile;    ///< `reconcile` section
   SelfFilterConfig self_filter;  ///< `self_filter` section (used once the pipeline knows the robot)
   /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, [0, 100000]; default
   /// 15). A fresh map keeps gaining voxels for a while (surfaces seen at grazing angles need several sweeps

@@ -18,8 +18,8 @@ namespace cellmap {
 /// the next one arrives or at flush(). Frames keep their order of arrival. Not thread-safe.
 class FrameGrouper final {
  public:
-  /// @throws Error if the grouping is invalid (SweepGrouping::validate).
-  explicit FrameGrouper(const SweepGrouping& grouping);
+  /// @throws Error if the grouping is invalid (SweepParams::validate).
+  explicit FrameGrouper(const SweepParams& grouping);
 
   /// Adds a posed frame; returns the sweeps it closed (none, one, or two with max_frames 1), oldest first.
   [[nodiscard]] std::vector<FrameSweep> add(SweepFrame frame);
@@ -29,7 +29,7 @@ class FrameGrouper final {
   [[nodiscard]] std::size_t open_frames() const { return open_.frames.size(); }
 
  private:
-  SweepGrouping grouping_;
+  SweepParams grouping_;
   FrameSweep open_;
   double open_first_stamp_ = 0.0;
 };

@@ -50,13 +50,13 @@ struct SegmentConfig final {
   /// Metres: the points are centres of voxels of this edge (0 = plain points); boxes hold the whole voxels.
   double voxel = 0.0;
   std::optional<Workspace> workspace;  ///< crop region; none = no crop
-};
 
-/// Reads a config document (keys as in config/segment.yaml; every key optional, missing = default).
-/// @throws Error naming the key for unknown keys, wrong types and out-of-range values.
-[[nodiscard]] SegmentConfig segment_config_from_yaml(YamlMap root);
-/// Loads a config file. @throws Error naming the file and key.
-[[nodiscard]] SegmentConfig load_segment_config(const std::string& path);
+  /// Reads a config document (keys as in config/segment.yaml; every key optional, missing = default).
+  /// @throws Error naming the key for unknown keys, wrong types and out-of-range values.
+  [[nodiscard]] static SegmentConfig from_yaml(YamlMap root);
+  /// Loads a config file. @throws Error naming the file and key.
+  [[nodiscard]] static SegmentConfig load(const std::string& path);
+};
 
 /// Counters and timings of one run. Every input point is in exactly one of: a box, or one of the drop
 /// counters (outside_workspace, outliers_sparse, outliers_dense, isolated).

@@ -11,7 +11,7 @@
 namespace cellmap {
 
 /// Timings of the reconnect state machine, seconds.
-struct ReconnectPolicy final {
+struct ReconnectParams final {
   double frame_timeout = 2.0;    ///< connected but no frame for this long → disconnected
   double initial_backoff = 0.5;  ///< wait before the first retry
   double max_backoff = 10.0;     ///< the wait doubles after each failed attempt, up to this
@@ -31,7 +31,7 @@ struct ReconnectPolicy final {
 class Reconnector final {
  public:
   /// @throws Error if the policy is invalid.
-  explicit Reconnector(const ReconnectPolicy& policy = {});
+  explicit Reconnector(const ReconnectParams& policy = {});
 
   /// An open succeeded at `now`; the frame timeout starts counting.
   void connected(double now);
@@ -60,10 +60,10 @@ class Reconnector final {
   [[nodiscard]] double next_attempt() const { return next_attempt_; }
   /// The wait that the next failure will schedule.
   [[nodiscard]] double backoff() const { return backoff_; }
-  [[nodiscard]] const ReconnectPolicy& policy() const { return policy_; }
+  [[nodiscard]] const ReconnectParams& policy() const { return policy_; }
 
  private:
-  ReconnectPolicy policy_;
+  ReconnectParams policy_;
   SourceState state_ = SourceState::kClosed;
   std::string reason_;
   double last_frame_ = 0.0;

@@ -41,7 +41,7 @@ struct V4l2Config final {
   DepthMode mode{848, 480, 30, "Z16"};  ///< format must be "Z16"
   /// Intrinsics, depth_scale and range; when absent, realsense_d435_intrinsics(mode.width, mode.height).
   std::optional<PinholeIntrinsics> intrinsics;
-  ReconnectPolicy reconnect;
+  ReconnectParams reconnect;
   int buffers = 4;  ///< mmap streaming buffers (2..32)
 };
 

@@ -17,7 +17,7 @@
 namespace cellmap {
 
 /// How frames are grouped into sweeps. Seconds.
-struct SweepGrouping final {
+struct SweepParams final {
   /// A sweep spans at most this much frame time: a frame stamped at or after the sweep's first stamp + period
   /// closes the sweep and starts the next one (0: every frame is its own sweep, handed out when the next
   /// frame arrives or the source stops streaming).
@@ -40,7 +40,7 @@ class SweepAssembler final {
  public:
   /// @param X_ES  hand-eye extrinsic: the sensor pose in the end-effector frame.
   /// @throws Error if the grouping is invalid or X_ES is not a rigid transform.
-  SweepAssembler(const SweepGrouping& grouping, const Eigen::Isometry3d& X_ES);
+  SweepAssembler(const SweepParams& grouping, const Eigen::Isometry3d& X_ES);
 
   /// Queues a frame (points in the sensor frame S) that arrived at `now`. Its depth image is released.
   void add(Frame frame, double now);
@@ -67,7 +67,7 @@ class SweepAssembler final {
   // Poses waiting frames; a frame still pending that arrived before `give_up_before` is dropped.
   void pose_waiting(const PoseBuffer& poses, double give_up_before, std::vector<Sweep>& done);
 
-  SweepGrouping grouping_;
+  SweepParams grouping_;
   SensorPoser poser_;
   std::deque<Waiting> waiting_;
   Sweep open_;
