@@ -145,12 +145,8 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
   if (confirmed.empty()) return changes;
 
   // Grouped in sorted order so that the result is deterministic.
-  std::vector<Key> seeds;
-  seeds.reserve(confirmed.size());
-  for (const auto& entry : confirmed) seeds.push_back(entry.first);
-  std::sort(seeds.begin(), seeds.end(), zyx_less);
   KeySet grouped;
-  for (const Key& seed : seeds) {
+  for (const Key& seed : sorted_keys(confirmed)) {
     if (!grouped.insert(seed).second) continue;
     std::optional<ChangeRegion> region = grow_region(seed, confirmed, map, grouped);
     if (region) changes.regions.push_back(std::move(*region));
