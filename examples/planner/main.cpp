@@ -132,10 +132,7 @@ std::string describe(const PathState& state, const Environment& env, const Envir
   return line.str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Example planner: re-checks a path against every new environment version of a cell"};
+struct Options {
   int domain = 0;
   std::string cell = "cell-1";
   // Defaults fit the simulated cell (config/cell.yaml): 0.25 m above the table, between the fixture and the
@@ -148,24 +145,63 @@ int main(int argc, char** argv) {
   bool every = false;
   std::string security_dir;  // DDS Security credentials (`cellmap security init`); empty: off
   std::string role = "planner";
-  app.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
-  app.add_option("--cell", cell, "cell id to follow");
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--cell", o.cell, "cell id to follow");
   app.add_option(
-      "--control-points", control_points,
+      "--control-points", o.control_points,
       "B-spline control points of the carried box's centre, x,y,z;x,y,z;... in the cell frame (m)");
-  app.add_option("--half-extents", half_extents, "half extents A,B,C of the carried box (m)");
-  app.add_option("--margin", margin, "safety margin: closer than this counts as blocked (m)");
-  app.add_option("--checkpoints", checkpoints, "checkpoints along the path");
-  app.add_flag("--json", json, "one JSON object per line instead of text");
-  app.add_flag("--every", every, "one line per new version, not only when the path's state changes");
+  app.add_option("--half-extents", o.half_extents, "half extents A,B,C of the carried box (m)");
+  app.add_option("--margin", o.margin, "safety margin: closer than this counts as blocked (m)");
+  app.add_option("--checkpoints", o.checkpoints, "checkpoints along the path");
+  app.add_flag("--json", o.json, "one JSON object per line instead of text");
+  app.add_flag("--every", o.every, "one line per new version, not only when the path's state changes");
   auto* security_option =
-      app.add_option("--security", security_dir, "DDS Security on, with the credentials in DIR");
-  app.add_option("--role", role, "the role whose credentials to use")
+      app.add_option("--security", o.security_dir, "DDS Security on, with the credentials in DIR");
+  app.add_option("--role", o.role, "the role whose credentials to use")
       ->needs(security_option)
       ->capture_default_str();
+}
+
+// Prints the path's state for every new version of the cell until SIGINT or SIGTERM (`stop_signals`).
+void follow(const Options& o, const sigset_t& stop_signals) {
+  const std::vector<Eigen::VectorXd> extents = parse_points(o.half_extents, "--half-extents");
+  if (extents.size() != 1 || (extents[0].array() < 0.0).any())
+    throw Error("--half-extents: expected one A,B,C >= 0");
+  const PathWatch watch(parse_points(o.control_points, "--control-points"), extents[0], o.margin,
+                        o.checkpoints);
+
+  std::optional<PathState> last;  // touched only by the subscriber's thread
+  const auto on_change = [&](const Environment& env, const EnvironmentDelta& delta) {
+    const PathState state = watch.check(env);
+    const bool changed = !last || last->blocked != state.blocked || last->box != state.box;
+    last = state;
+    if (changed || o.every)
+      std::cout << describe(state, env, delta, o.json) << std::endl;  // flushed: read by scripts
+  };
+  std::optional<cellmap::security::Setting> security;
+  if (!o.security_dir.empty())
+    security = cellmap::security::Setting{o.security_dir, cellmap::security::parse_role(o.role)};
+  const cellmap::dds::Participant participant(static_cast<std::uint32_t>(o.domain), security);
+  const cellmap::transport::EnvironmentSubscriber subscriber(participant, o.cell, on_change);
+  std::cerr << "following cell '" << o.cell << "' on DDS domain " << o.domain << std::endl;
+
+  int signal = 0;
+  sigwait(&stop_signals, &signal);
+  if (!subscriber.last_error().empty()) std::cerr << "last problem: " << subscriber.last_error() << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Example planner: re-checks a path against every new environment version of a cell"};
+  Options options;
+  add_options(app, options);
   CLI11_PARSE(app, argc, argv);
 
-  // SIGINT/SIGTERM are taken by sigwait below; blocked before the DDS threads start so they inherit it.
+  // SIGINT/SIGTERM are taken by sigwait in follow(); blocked before the DDS threads start so they inherit it.
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
   sigaddset(&stop_signals, SIGINT);
@@ -173,29 +209,7 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   try {
-    const std::vector<Eigen::VectorXd> extents = parse_points(half_extents, "--half-extents");
-    if (extents.size() != 1 || (extents[0].array() < 0.0).any())
-      throw Error("--half-extents: expected one A,B,C >= 0");
-    const PathWatch watch(parse_points(control_points, "--control-points"), extents[0], margin, checkpoints);
-
-    std::optional<PathState> last;  // touched only by the subscriber's thread
-    const auto on_change = [&](const Environment& env, const EnvironmentDelta& delta) {
-      const PathState state = watch.check(env);
-      const bool changed = !last || last->blocked != state.blocked || last->box != state.box;
-      last = state;
-      if (changed || every)
-        std::cout << describe(state, env, delta, json) << std::endl;  // flushed: read by scripts
-    };
-    std::optional<cellmap::security::Setting> security;
-    if (!security_dir.empty())
-      security = cellmap::security::Setting{security_dir, cellmap::security::parse_role(role)};
-    const cellmap::dds::Participant participant(static_cast<std::uint32_t>(domain), security);
-    const cellmap::transport::EnvironmentSubscriber subscriber(participant, cell, on_change);
-    std::cerr << "following cell '" << cell << "' on DDS domain " << domain << std::endl;
-
-    int signal = 0;
-    sigwait(&stop_signals, &signal);
-    if (!subscriber.last_error().empty()) std::cerr << "last problem: " << subscriber.last_error() << "\n";
+    follow(options, stop_signals);
   } catch (const Error& e) {
     std::cerr << "cellmap_example_planner: " << e.what() << "\n";
     return 1;
