@@ -267,44 +267,54 @@ struct Ray {
   std::uint32_t origin;
 };
 
-// Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic
-// (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
-// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `cursor` instead
-// of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
-// nothing. The walk stops where it leaves the cursor's grid (it never comes back on that axis).
+// The per-axis state of a walk from `origin` towards `ray`'s end, with OctoMap's computeRayKeys arithmetic:
+// single-precision direction, double-precision crossing distances (an axis the ray does not move along
+// never comes first).
+struct WalkStart {
+  float length;       // distance from the origin to the ray's end
+  int step[3];        // -1, 0 or +1 key per crossing
+  double t_max[3];    // distance to the first crossing
+  double t_delta[3];  // distance between crossings
+};
+
+WalkStart walk_start(const Origin& origin, const Ray& ray, const octomap::OcTree& grid) {
+  const double resolution = grid.getResolution();
+  WalkStart w{};
+  float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
+  const float norm_sq =
+      direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
+  w.length = static_cast<float>(std::sqrt(static_cast<double>(norm_sq)));
+  for (float& d : direction) d /= w.length;
+  for (int i = 0; i < 3; ++i) {
+    w.step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
+    if (w.step[i] != 0) {
+      double border = grid.keyToCoord(origin.key[i]);
+      border += static_cast<float>(w.step[i] * resolution * 0.5);
+      w.t_max[i] = (border - origin.p[i]) / direction[i];
+      w.t_delta[i] = resolution / std::fabs(direction[i]);
+    } else {
+      w.t_max[i] = std::numeric_limits<double>::max();
+      w.t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+  return w;
+}
+
+// Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic (walk_start,
+// the same tie-breaking between axes and the same stop rule) so that the crossed voxels match OctoMap's, but
+// it hands each voxel to `cursor` instead of storing the ray. The origin voxel is included, the end voxel is
+// not; a ray within one voxel marks nothing. The walk stops where it leaves the cursor's grid (it never comes
+// back on that axis).
 template <class Cursor>
 void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
   if (origin.key == ray.end_key || !cursor.start(origin.key, ray.end_key)) return;
   cursor.mark();
-
-  float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
-  const float norm_sq =
-      direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
-  const float length = static_cast<float>(std::sqrt(static_cast<double>(norm_sq)));
-  for (float& d : direction) d /= length;
-
-  const double resolution = grid.getResolution();
-  int step[3];
-  double t_max[3];
-  double t_delta[3];
-  for (int i = 0; i < 3; ++i) {
-    step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
-    if (step[i] != 0) {
-      double border = grid.keyToCoord(origin.key[i]);
-      border += static_cast<float>(step[i] * resolution * 0.5);
-      t_max[i] = (border - origin.p[i]) / direction[i];
-      t_delta[i] = resolution / std::fabs(direction[i]);
-    } else {
-      t_max[i] = std::numeric_limits<double>::max();
-      t_delta[i] = std::numeric_limits<double>::max();
-    }
-  }
-  // The loop keeps everything in scalars and chooses the axis with selects rather than branches: the choice
-  // is unpredictable, and a mispredicted branch (or an array indexed by it) per voxel costs more than the
-  // rest.
-  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
-  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
-  const int sx = step[0], sy = step[1], sz = step[2];
+  const WalkStart w = walk_start(origin, ray, grid);
+  // The loop keeps everything in scalars, and the axis choice is a branch: the walk is latency-bound, and a
+  // predicted branch lets the next step start before the comparison ends (selects were slower).
+  double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
+  const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
+  const int sx = w.step[0], sy = w.step[1], sz = w.step[2];
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
   int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
@@ -331,7 +341,7 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
     tz = z_axis ? tz + dz : tz;
     if (cursor.done()) return;
     choose();
-    if (t_next > length) return;
+    if (t_next > w.length) return;
     cursor.mark();
   }
 }
