@@ -267,44 +267,55 @@ struct Ray {
   std::uint32_t origin;
 };
 
-// Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic
-// (single-precision direction, double-precision crossing distances, the same tie-breaking between axes and
-// the same stop rule) so that the crossed voxels match OctoMap's, but it hands each voxel to `cursor` instead
-// of storing the ray. The origin voxel is included, the end voxel is not; a ray within one voxel marks
-// nothing. The walk stops where it leaves the cursor's grid (it never comes back on that axis).
+// The per-axis state of a walk from `origin` towards `ray`'s end, with OctoMap's computeRayKeys arithmetic:
+// single-precision direction, double-precision crossing distances (an axis the ray does not move along
+// never comes first).
+struct WalkStart {
+  float length;       // distance from the origin to the ray's end
+  int step[3];        // -1, 0 or +1 key per crossing
+  double t_max[3];    // distance to the first crossing
+  double t_delta[3];  // distance between crossings
+};
+
+WalkStart walk_start(const Origin& origin, const Ray& ray, const octomap::OcTree& grid) {
+  const double resolution = grid.getResolution();
+  WalkStart w{};
+  float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
+  const float norm_sq =
+      direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
+  w.length = static_cast<float>(std::sqrt(static_cast<double>(norm_sq)));
+  for (float& d : direction) d /= w.length;
+  for (int i = 0; i < 3; ++i) {
+    w.step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
+    if (w.step[i] != 0) {
+      double border = grid.keyToCoord(origin.key[i]);
+      border += static_cast<float>(w.step[i] * resolution * 0.5);
+      w.t_max[i] = (border - origin.p[i]) / direction[i];
+      w.t_delta[i] = resolution / std::fabs(direction[i]);
+    } else {
+      w.t_max[i] = std::numeric_limits<double>::max();
+      w.t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+  return w;
+}
+
+// Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic (walk_start,
+// the same tie-breaking between axes and the same stop rule) so that the crossed voxels match OctoMap's, but
+// it hands each voxel to `cursor` instead of storing the ray. The origin voxel is included, the end voxel is
+// not; a ray within one voxel marks nothing. The walk stops where it leaves the cursor's grid (it never comes
+// back on that axis).
 template <class Cursor>
 void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
   if (origin.key == ray.end_key || !cursor.start(origin.key, ray.end_key)) return;
   cursor.mark();
-
-  float direction[3] = {ray.end[0] - origin.p[0], ray.end[1] - origin.p[1], ray.end[2] - origin.p[2]};
-  const float norm_sq =
-      direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
-  const float length = static_cast<float>(std::sqrt(static_cast<double>(norm_sq)));
-  for (float& d : direction) d /= length;
-
-  const double resolution = grid.getResolution();
-  int step[3];
-  double t_max[3];
-  double t_delta[3];
-  for (int i = 0; i < 3; ++i) {
-    step[i] = direction[i] > 0.0f ? 1 : (direction[i] < 0.0f ? -1 : 0);
-    if (step[i] != 0) {
-      double border = grid.keyToCoord(origin.key[i]);
-      border += static_cast<float>(step[i] * resolution * 0.5);
-      t_max[i] = (border - origin.p[i]) / direction[i];
-      t_delta[i] = resolution / std::fabs(direction[i]);
-    } else {
-      t_max[i] = std::numeric_limits<double>::max();
-      t_delta[i] = std::numeric_limits<double>::max();
-    }
-  }
-  // The loop keeps everything in scalars and chooses the axis with selects rather than branches: the choice
-  // is unpredictable, and a mispredicted branch (or an array indexed by it) per voxel costs more than the
-  // rest.
-  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
-  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
-  const int sx = step[0], sy = step[1], sz = step[2];
+  const WalkStart w = walk_start(origin, ray, grid);
+  // The loop keeps everything in scalars; the compiler makes the axis choice a branch, which lets the next
+  // step start before the comparison ends. A branch-free choice (min and masks) measured slower: every step
+  // then waits for the comparison.
+  double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
+  const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
+  const int sx = w.step[0], sy = w.step[1], sz = w.step[2];
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
   int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
@@ -331,7 +342,7 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
     tz = z_axis ? tz + dz : tz;
     if (cursor.done()) return;
     choose();
-    if (t_next > length) return;
+    if (t_next > w.length) return;
     cursor.mark();
   }
 }
@@ -527,6 +538,139 @@ RayEnd ray_to(const octomap::OcTree& grid, const Origin& origin, const Key& end,
                                                                                  : RayEnd::kOutside;
 }
 
+// The rays of a sweep: per scan, one to each distinct endpoint voxel; the hits among the ends; the key box of
+// all origins and ends.
+struct SweepRays {
+  std::vector<Origin> origins;
+  std::vector<Ray> rays;
+  std::vector<Key> hits;
+  KeyBox box;
+};
+
+// Scan `s`'s origin, as OctoMap sees it. @throws Error if it is not finite or outside the key range.
+Origin scan_origin(const Scan& scan, std::size_t s, const octomap::OcTree& grid) {
+  Origin origin{};
+  for (int i = 0; i < 3; ++i) origin.p[i] = static_cast<float>(scan.origin_C[i]);
+  if (!scan.origin_C.allFinite() ||
+      !grid.coordToKeyChecked(origin.p[0], origin.p[1], origin.p[2], origin.key)) {
+    throw Error("occupancy: scan " + std::to_string(s) + " of the sweep has its origin outside the map");
+  }
+  return origin;
+}
+
+// Adds a ray from origin `s` to each of `ends`; those within range are hits when `hit`.
+void add_rays(const octomap::OcTree& grid, double max_range, std::uint32_t s, const std::vector<Key>& ends,
+              bool hit, SweepRays& out) {
+  for (const Key& k : ends) {
+    Ray ray{};
+    const RayEnd end = ray_to(grid, out.origins[s], k, max_range, ray);
+    if (end == RayEnd::kOutside) continue;
+    if (hit && end == RayEnd::kVoxel) out.hits.push_back(k);
+    ray.origin = s;
+    out.box.extend(ray.end_key);
+    out.rays.push_back(ray);
+  }
+}
+
+// Per scan: distinct endpoint voxels; those within range are hits, every one gets a ray.
+SweepRays sweep_rays(const Sweep& sweep, const octomap::OcTree& grid, double max_range, int threads) {
+  SweepRays out;
+  for (std::size_t s = 0; s < sweep.scans.size(); ++s) {
+    const Scan& scan = sweep.scans[s];
+    out.origins.push_back(scan_origin(scan, s, grid));
+    out.box.extend(out.origins.back().key);
+    const ScanKeys keys = scan_keys(scan, grid, threads);
+    if (keys.box.empty()) continue;
+    const DistinctKeys ends = distinct(keys);
+    add_rays(grid, max_range, static_cast<std::uint32_t>(s), ends.points, true, out);
+    add_rays(grid, max_range, static_cast<std::uint32_t>(s), ends.clear, false, out);
+  }
+  return out;
+}
+
+// Walks the rays on `threads` threads, each into its own bit set over `bricks`, and returns their union
+// (which does not depend on the split).
+std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& bricks,
+                                      const octomap::OcTree& grid, int threads) {
+  std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
+  run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+    sets[t].assign(bricks.bits() / 64, 0);
+    DenseCursor cursor(bricks, sets[t].data());
+    for (std::size_t r = begin; r < end; ++r)
+      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+  });
+  std::vector<std::uint64_t>& crossed = sets[0];
+  for (std::size_t t = 1; t < sets.size(); ++t) {
+    for (std::size_t w = 0; w < crossed.size(); ++w) crossed[w] |= sets[t][w];
+  }
+  return std::move(crossed);
+}
+
+// Walks the rays on `threads` threads, listing the packed keys they cross: sorted, each once.
+std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcTree& grid, int threads) {
+  std::vector<std::vector<std::uint64_t>> lists(static_cast<std::size_t>(threads));
+  run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+    SparseCursor cursor(lists[t]);
+    for (std::size_t r = begin; r < end; ++r)
+      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+  });
+  std::vector<std::uint64_t> all;
+  for (const auto& list : lists) all.insert(all.end(), list.begin(), list.end());
+  return sorted_unique(std::move(all));
+}
+
+// Fills `update` from the dense bit sets: the hits' bits, the crossed voxels that are no hit, the non-empty
+// bricks in the OcTree's depth-first order (sorted by index, not as 1 KB structs).
+void dense_bricks(const BrickGrid& bricks, const std::vector<Key>& hits,
+                  const std::vector<std::uint64_t>& crossed, KeyUpdate& update) {
+  std::vector<std::uint64_t> occupied(bricks.bits() / 64, 0);
+  for (const Key& k : hits) set_bit(occupied, bricks.index(k));
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton of the base, brick)
+  for (std::uint64_t b = 0; b < bricks.bricks(); ++b) {
+    std::uint64_t any = 0;
+    for (std::size_t i = std::size_t(b) * kBrickWords; i < std::size_t(b + 1) * kBrickWords; ++i) {
+      any |= occupied[i] | crossed[i];
+    }
+    if (any != 0) order.emplace_back(morton(bricks.brick_base(b)), b);
+  }
+  std::sort(order.begin(), order.end());
+  update.bricks.resize(order.size());
+  for (std::size_t n = 0; n < order.size(); ++n) {
+    KeyBrick& brick = update.bricks[n];
+    brick.base = bricks.brick_base(order[n].second);
+    for (int w = 0; w < kBrickWords; ++w) {
+      const std::size_t i = std::size_t(order[n].second) * kBrickWords + std::size_t(w);
+      brick.occupied[std::size_t(w)] = occupied[i];
+      brick.free[std::size_t(w)] = crossed[i] & ~occupied[i];
+      update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
+      update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
+    }
+  }
+}
+
+// Fills `update` from sorted key lists: the hits, the crossed keys (sorted, each once) that are no hit.
+void sparse_bricks(const std::vector<Key>& hits, const std::vector<std::uint64_t>& crossed,
+                   KeyUpdate& update) {
+  std::vector<std::uint64_t> packed_hits;
+  for (const Key& k : hits) packed_hits.push_back(pack(k));
+  const std::vector<std::uint64_t> occupied = sorted_unique(std::move(packed_hits));
+  std::map<std::uint64_t, KeyBrick> bricks;  // by packed brick base
+  auto mark = [&](std::uint64_t p, bool hit) {
+    const Key k = unpack(p);
+    KeyBrick& brick = bricks[pack(brick_base(k))];
+    brick.base = brick_base(k);
+    const int i = KeyBrick::local_index(k);
+    (hit ? brick.occupied : brick.free)[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
+    ++(hit ? update.occupied_count : update.free_count);
+  };
+  for (const std::uint64_t p : occupied) mark(p, true);
+  for (const std::uint64_t p : crossed) {
+    if (!std::binary_search(occupied.begin(), occupied.end(), p)) mark(p, false);
+  }
+  for (auto& entry : bricks) update.bricks.push_back(entry.second);
+  sort_depth_first(update.bricks);
+}
+
 }  // namespace
 
 int KeyBrick::local_index(const octomap::OcTreeKey& key) {
@@ -552,119 +696,15 @@ std::vector<octomap::OcTreeKey> KeyUpdate::free_keys() const {
 KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, double max_range, int threads) {
   if (!(max_range > 0.0)) throw Error("occupancy: max_range must be > 0, got " + std::to_string(max_range));
   threads = std::max(threads, 1);
-
-  // 1. Per scan: distinct endpoint voxels; those within range are hits, every one gets a ray.
-  std::vector<Origin> origins;
-  std::vector<Ray> rays;
-  std::vector<Key> hits;
-  KeyBox box;
-  for (std::size_t s = 0; s < sweep.scans.size(); ++s) {
-    const Scan& scan = sweep.scans[s];
-    Origin origin{};
-    for (int i = 0; i < 3; ++i) origin.p[i] = static_cast<float>(scan.origin_C[i]);
-    if (!scan.origin_C.allFinite() ||
-        !grid.coordToKeyChecked(origin.p[0], origin.p[1], origin.p[2], origin.key)) {
-      throw Error("occupancy: scan " + std::to_string(s) + " of the sweep has its origin outside the map");
-    }
-    origins.push_back(origin);
-    box.extend(origin.key);
-
-    const ScanKeys keys = scan_keys(scan, grid, threads);
-    if (keys.box.empty()) continue;
-    const DistinctKeys ends = distinct(keys);
-    for (const std::vector<Key>* list : {&ends.points, &ends.clear}) {
-      const bool hit = list == &ends.points;
-      for (const Key& k : *list) {
-        Ray ray{};
-        const RayEnd end = ray_to(grid, origin, k, max_range, ray);
-        if (end == RayEnd::kOutside) continue;
-        if (hit && end == RayEnd::kVoxel) hits.push_back(k);
-        ray.origin = static_cast<std::uint32_t>(s);
-        box.extend(ray.end_key);
-        rays.push_back(ray);
-      }
-    }
-  }
+  SweepRays rays = sweep_rays(sweep, grid, max_range, threads);
   KeyUpdate update;
-  if (rays.empty()) return update;
-  box.grow();
-
-  // 2. Walk the rays on `threads` threads, each into its own set; the union does not depend on the split.
-  const BrickGrid grid_bits(box);
-  const bool dense = grid_bits.dense();
-  std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
-  const std::uint64_t bits = grid_bits.bits();
-  run_parallel(threads, rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
-    std::vector<std::uint64_t>& set = sets[t];
-    if (dense) {
-      set.assign(bits / 64, 0);
-      DenseCursor cursor(grid_bits, set.data());
-      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
-    } else {
-      SparseCursor cursor(set);
-      for (std::size_t r = begin; r < end; ++r) walk_ray(origins[rays[r].origin], rays[r], grid, cursor);
-    }
-  });
-
-  // 3. Union the threads' sets, remove the hits from the free voxels, and keep the non-empty bricks.
-  if (dense) {
-    std::vector<std::uint64_t> occupied(bits / 64, 0);
-    for (const Key& k : hits) set_bit(occupied, grid_bits.index(k));
-    std::vector<std::uint64_t>& free = sets[0];
-    for (std::size_t t = 1; t < sets.size(); ++t) {
-      for (std::size_t w = 0; w < free.size(); ++w) free[w] |= sets[t][w];
-    }
-    // The non-empty bricks, in the OcTree's depth-first order (sorted by index, not as 1 KB structs).
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton of the base, brick)
-    for (std::uint64_t b = 0; b < grid_bits.bricks(); ++b) {
-      std::uint64_t any = 0;
-      for (int w = 0; w < kBrickWords; ++w) {
-        const std::size_t i = std::size_t(b) * kBrickWords + std::size_t(w);
-        any |= occupied[i] | free[i];
-      }
-      if (any != 0) order.emplace_back(morton(grid_bits.brick_base(b)), b);
-    }
-    std::sort(order.begin(), order.end());
-    update.bricks.resize(order.size());
-    for (std::size_t n = 0; n < order.size(); ++n) {
-      KeyBrick& brick = update.bricks[n];
-      brick.base = grid_bits.brick_base(order[n].second);
-      for (int w = 0; w < kBrickWords; ++w) {
-        const std::size_t i = std::size_t(order[n].second) * kBrickWords + std::size_t(w);
-        brick.occupied[std::size_t(w)] = occupied[i];
-        brick.free[std::size_t(w)] = free[i] & ~occupied[i];
-        update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
-        update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
-      }
-    }
+  if (rays.rays.empty()) return update;
+  rays.box.grow();
+  const BrickGrid bricks(rays.box);
+  if (bricks.dense()) {
+    dense_bricks(bricks, rays.hits, walk_dense(rays, bricks, grid, threads), update);
   } else {
-    std::vector<std::uint64_t> all;
-    for (auto& set : sets) all.insert(all.end(), set.begin(), set.end());
-    std::vector<std::uint64_t> packed_hits;
-    for (const Key& k : hits) packed_hits.push_back(pack(k));
-    const std::vector<std::uint64_t> occupied = sorted_unique(std::move(packed_hits));
-    const std::vector<std::uint64_t> crossed = sorted_unique(std::move(all));
-    std::map<std::uint64_t, KeyBrick> bricks;  // by packed brick base
-    auto brick_of = [&](const Key& k) -> KeyBrick& {
-      KeyBrick& brick = bricks[pack(brick_base(k))];
-      brick.base = brick_base(k);
-      return brick;
-    };
-    for (const std::uint64_t p : occupied) {
-      const Key k = unpack(p);
-      const int i = KeyBrick::local_index(k);
-      brick_of(k).occupied[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
-      ++update.occupied_count;
-    }
-    for (const std::uint64_t p : crossed) {
-      if (std::binary_search(occupied.begin(), occupied.end(), p)) continue;
-      const Key k = unpack(p);
-      const int i = KeyBrick::local_index(k);
-      brick_of(k).free[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
-      ++update.free_count;
-    }
-    for (auto& entry : bricks) update.bricks.push_back(entry.second);
-    sort_depth_first(update.bricks);
+    sparse_bricks(rays.hits, walk_sparse(rays, grid, threads), update);
   }
   return update;
 }
