@@ -360,12 +360,10 @@ Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
   return t;
 }
 
-// Latency from each version's confirming frame (the last frame of the sweep that made it, at the time its
-// replay delivered it) to its arrival at the subscriber, ms; the first version (the settled map) left out.
-std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps,
-                                        const std::map<std::uint64_t, std::int64_t>& arrivals,
-                                        std::int64_t start_ns) {
-  std::vector<double> latencies;
+// The sweeps that made a version, the first version (the settled map) left out: each one's last frame is
+// the frame that confirmed the version's change.
+std::vector<const Traces::Sweep*> confirming_sweeps(const std::vector<Traces::Sweep>& sweeps) {
+  std::vector<const Traces::Sweep*> confirming;
   std::uint64_t version = 0;
   bool first = true;
   for (const Traces::Sweep& s : sweeps) {
@@ -375,9 +373,21 @@ std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps
       first = false;
       continue;
     }
-    const auto arrival = arrivals.find(version);
+    confirming.push_back(&s);
+  }
+  return confirming;
+}
+
+// Latency from each version's confirming frame (the last frame of the sweep that made it, at the time its
+// replay delivered it) to its arrival at the subscriber, ms; the first version left out.
+std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps,
+                                        const std::map<std::uint64_t, std::int64_t>& arrivals,
+                                        std::int64_t start_ns) {
+  std::vector<double> latencies;
+  for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
+    const auto arrival = arrivals.find(s->version);
     if (arrival == arrivals.end()) continue;
-    const double delivered_ns = static_cast<double>(start_ns) + s.stamp * 1e9;
+    const double delivered_ns = static_cast<double>(start_ns) + s->stamp * 1e9;
     latencies.push_back((static_cast<double>(arrival->second) - delivered_ns) / 1e6);
   }
   return latencies;
@@ -387,23 +397,15 @@ std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps
 // what a confirming sweep costs once its last frame is in.
 void print_close(const std::vector<Traces::Sweep>& sweeps) {
   std::vector<double> scans, fuse, change, segment, persist, publish, whole;
-  std::uint64_t version = sweeps.empty() ? 0 : sweeps.front().version;
-  bool first = true;
-  for (const Traces::Sweep& s : sweeps) {
-    const bool made_version = s.version != version;
-    version = s.version;
-    if (!made_version || !s.report) continue;
-    if (first) {
-      first = false;
-      continue;
-    }
-    scans.push_back(1e3 * s.report->t_filter);
-    fuse.push_back(1e3 * s.report->t_fuse);
-    change.push_back(1e3 * s.report->t_change);
-    segment.push_back(1e3 * s.report->t_segment);
-    persist.push_back(1e3 * s.persist.wall);
-    publish.push_back(1e3 * s.publish.wall);
-    whole.push_back(1e3 * handling_wall(s));
+  for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
+    if (!s->report) continue;
+    scans.push_back(1e3 * s->report->t_filter);
+    fuse.push_back(1e3 * s->report->t_fuse);
+    change.push_back(1e3 * s->report->t_change);
+    segment.push_back(1e3 * s->report->t_segment);
+    persist.push_back(1e3 * s->persist.wall);
+    publish.push_back(1e3 * s->publish.wall);
+    whole.push_back(1e3 * handling_wall(*s));
   }
   const auto p50_max = [](const std::vector<double>& v) {
     char text[32];
