@@ -327,8 +327,15 @@ struct Totals {
   std::size_t fused = 0;
   double filter = 0, fuse = 0, change = 0, segment = 0, persist = 0, publish = 0;  // CPU seconds
   double fuse_wall = 0;
+  double busy_wall = 0;      // seconds the processing thread spent on sweeps (every stage, wall)
   std::size_t versions = 0;  // sweeps that published a version
 };
+
+// Wall seconds the processing thread spent on one sweep, stage by stage.
+double handling_wall(const Traces::Sweep& s) {
+  const SweepReport& r = *s.report;
+  return r.t_filter + r.t_fuse + r.t_change + r.t_segment + s.persist.wall + s.publish.wall;
+}
 
 Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
   Totals t;
@@ -346,18 +353,17 @@ Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
     t.segment += s.report->cpu_segment;
     t.persist += s.persist.cpu;
     t.publish += s.publish.cpu;
+    t.busy_wall += handling_wall(s);
     if (s.version != version) ++t.versions;
     version = s.version;
   }
   return t;
 }
 
-// Latency from each version's confirming frame (the last frame of the sweep that made it, at the time its
-// replay delivered it) to its arrival at the subscriber, ms; the first version (the settled map) left out.
-std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps,
-                                        const std::map<std::uint64_t, std::int64_t>& arrivals,
-                                        std::int64_t start_ns) {
-  std::vector<double> latencies;
+// The sweeps that made a version, the first version (the settled map) left out: each one's last frame is
+// the frame that confirmed the version's change.
+std::vector<const Traces::Sweep*> confirming_sweeps(const std::vector<Traces::Sweep>& sweeps) {
+  std::vector<const Traces::Sweep*> confirming;
   std::uint64_t version = 0;
   bool first = true;
   for (const Traces::Sweep& s : sweeps) {
@@ -367,12 +373,50 @@ std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps
       first = false;
       continue;
     }
-    const auto arrival = arrivals.find(version);
+    confirming.push_back(&s);
+  }
+  return confirming;
+}
+
+// Latency from each version's confirming frame (the last frame of the sweep that made it, at the time its
+// replay delivered it) to its arrival at the subscriber, ms; the first version left out.
+std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps,
+                                        const std::map<std::uint64_t, std::int64_t>& arrivals,
+                                        std::int64_t start_ns) {
+  std::vector<double> latencies;
+  for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
+    const auto arrival = arrivals.find(s->version);
     if (arrival == arrivals.end()) continue;
-    const double delivered_ns = static_cast<double>(start_ns) + s.stamp * 1e9;
+    const double delivered_ns = static_cast<double>(start_ns) + s->stamp * 1e9;
     latencies.push_back((static_cast<double>(arrival->second) - delivered_ns) / 1e6);
   }
   return latencies;
+}
+
+// The handling of the sweeps that made a version after the first, stage by stage (wall ms, p50 and max):
+// what a confirming sweep costs once its last frame is in.
+void print_close(const std::vector<Traces::Sweep>& sweeps) {
+  std::vector<double> scans, fuse, change, segment, persist, publish, whole;
+  for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
+    if (!s->report) continue;
+    scans.push_back(1e3 * s->report->t_filter);
+    fuse.push_back(1e3 * s->report->t_fuse);
+    change.push_back(1e3 * s->report->t_change);
+    segment.push_back(1e3 * s->report->t_segment);
+    persist.push_back(1e3 * s->persist.wall);
+    publish.push_back(1e3 * s->publish.wall);
+    whole.push_back(1e3 * handling_wall(*s));
+  }
+  const auto p50_max = [](const std::vector<double>& v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.0f/%.0f", percentile(v, 0.5), percentile(v, 1.0));
+    return std::string(text);
+  };
+  std::printf(
+      "close of a confirming sweep, wall ms p50/max (%zu versions after the first): scans %s, fusion %s, "
+      "change %s, re-segmentation %s, persist %s, publish %s, whole %s\n",
+      whole.size(), p50_max(scans).c_str(), p50_max(fuse).c_str(), p50_max(change).c_str(),
+      p50_max(segment).c_str(), p50_max(persist).c_str(), p50_max(publish).c_str(), p50_max(whole).c_str());
 }
 
 void print_stage(const char* stage, double cpu, std::size_t frames, const char* note) {
@@ -458,6 +502,9 @@ int run(const Options& options) {
   std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
               percentile(waits, 1.0));
   std::printf("sweeps processed: %zu, versions published: %zu\n", sweeps.size(), t.versions);
+  std::printf("processing thread busy %.0f %% of the run (wall time handling sweeps)\n",
+              100.0 * t.busy_wall / run_seconds);
+  print_close(sweeps);
   std::printf("CPU per fused frame by stage (each on its thread, with the helper threads it started):\n");
   print_stage("acquisition", acquisition, played,
               "(camera threads, per frame played: read, decode, pose, group)");
