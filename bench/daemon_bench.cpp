@@ -423,21 +423,17 @@ void print_stage(const char* stage, double cpu, std::size_t frames, const char* 
   std::printf("  %-18s %9.2f ms %s\n", stage, frames ? 1e3 * cpu / static_cast<double>(frames) : NAN, note);
 }
 
-int run(const Options& options) {
-  const fs::path dir = fs::temp_directory_path() / ("cellmap-bench-daemon-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } cleanup{dir};
+// A temporary directory, removed with everything in it.
+struct ScratchDir {
+  fs::path path = fs::temp_directory_path() / ("cellmap-bench-daemon-" + std::to_string(::getpid()));
+  ScratchDir() { fs::create_directories(path); }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
 
-  const Recording recording(options, dir);
-  std::vector<Camera> cameras{
-      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
-      {"realsense", d435_848x480(), 0.0}};
+void write_recordings(const Options& options, const Recording& recording, std::vector<Camera>& cameras) {
   const auto render_start = Clock::now();
   for (Camera& camera : cameras) recording.write(camera);
   std::printf(
@@ -447,25 +443,38 @@ int run(const Options& options) {
       recording.frames(), options.rate, options.seconds, options.no_return_range, recording.changes(),
       options.warmup, options.change_every,
       std::chrono::duration<double>(Clock::now() - render_start).count());
+}
 
-  // Before any thread (the subscriber's reader, the daemon's): they all inherit the blocked signals.
-  const daemon::Signals signals;
-  SubscriberProcess subscriber(options.domain);
+daemon::DaemonConfig daemon_config(const Options& options, const std::vector<Camera>& cameras,
+                                   const fs::path& dir) {
   std::string yaml = "cell: " + std::string(kCell) + "\ndomain: " + std::to_string(options.domain) +
                      "\nstate_dir: " + (dir / "state").string() +
                      "\nlog_level: warn\nchange: {settle_sweeps: " + std::to_string(options.settle_sweeps) +
                      "}\nsources:\n";
   for (const Camera& camera : cameras) yaml += source_yaml(camera, dir, options.sweep_frames);
-  daemon::DaemonConfig config = daemon::DaemonConfig::parse(yaml, "bench", dir);
-  spdlog::set_level(spdlog::level::warn);
+  return daemon::DaemonConfig::parse(yaml, "bench", dir);
+}
 
+// What one run of the daemon over the recordings left.
+struct DaemonRun {
+  std::vector<Traces::Sweep> sweeps;
+  std::int64_t start_ns = 0;
+  double seconds = 0.0;
+  double cpu = 0.0;  // the whole process
+  double load_start = 0.0;
+  bool finished = false;  // the last frames were processed before giving up
+};
+
+// Runs the daemon until the last recorded frames were processed (or long after the recording ended).
+DaemonRun run_daemon(const Options& options, const Recording& recording, const daemon::DaemonConfig& config,
+                     const daemon::Signals& signals) {
   Traces traces;
   daemon::RunOptions run_options;
   run_options.on_sweep = [&traces](const daemon::SweepTrace& trace) { traces.add(trace); };
   daemon::Daemon daemon(config, run_options);
 
-  // Stops the daemon once the last frames were processed (or long after the recording ended).
   const double last_stamp = recording.stamp_of(recording.frames() - 1);
+  DaemonRun result;
   std::atomic<bool> finished{false};
   std::thread stopper([&] {
     const auto give_up = Clock::now() + std::chrono::duration<double>(options.seconds * 3 + 60);
@@ -476,20 +485,23 @@ int run(const Options& options) {
     ::kill(::getpid(), SIGTERM);
   });
   const double cpu_start = process_cpu_seconds();
-  const double load_start = load_average();
-  const std::int64_t start_ns = now_ns();
+  result.load_start = load_average();
+  result.start_ns = now_ns();
   daemon.run(signals);
-  const double run_seconds = static_cast<double>(now_ns() - start_ns) / 1e9;
-  const double cpu_total = process_cpu_seconds() - cpu_start;
+  result.seconds = static_cast<double>(now_ns() - result.start_ns) / 1e9;
+  result.cpu = process_cpu_seconds() - cpu_start;
   stopper.join();
+  result.finished = finished;
+  result.sweeps = traces.sweeps();
+  return result;
+}
 
-  const std::vector<Traces::Sweep> sweeps = traces.sweeps();
-  const Totals t = add_up(sweeps);
+void print_frames(const Options& options, const Recording& recording, const std::vector<Camera>& cameras,
+                  const DaemonRun& run, const Totals& t) {
   const std::size_t played = recording.frames() * cameras.size();
-  const double acquisition = sweeps.empty() ? 0.0 : sweeps.back().acquisition_cpu;
   std::printf(
       "\ncellmapd, %zu cameras at %.1f Hz for %.1f s (run %.1f s, load average %.2f at start, %.2f at end)\n",
-      cameras.size(), options.rate, options.seconds, run_seconds, load_start, load_average());
+      cameras.size(), options.rate, options.seconds, run.seconds, run.load_start, load_average());
   for (const Camera& camera : cameras) {
     const std::size_t fused = t.fused_by_camera.count(camera.name) ? t.fused_by_camera.at(camera.name) : 0;
     std::printf("  %-10s frames fused %5zu of %5zu, %6.1f per second\n", camera.name.c_str(), fused,
@@ -497,14 +509,17 @@ int run(const Options& options) {
   }
   std::printf("frames dropped: %zu of %zu\n", played - t.fused, played);
   std::vector<double> waits;  // from a sweep's last frame being due to its processing
-  for (const Traces::Sweep& s : sweeps)
-    waits.push_back(static_cast<double>(s.taken_ns - start_ns) / 1e6 - s.stamp * 1e3);
+  for (const Traces::Sweep& s : run.sweeps)
+    waits.push_back(static_cast<double>(s.taken_ns - run.start_ns) / 1e6 - s.stamp * 1e3);
   std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
               percentile(waits, 1.0));
-  std::printf("sweeps processed: %zu, versions published: %zu\n", sweeps.size(), t.versions);
+  std::printf("sweeps processed: %zu, versions published: %zu\n", run.sweeps.size(), t.versions);
   std::printf("processing thread busy %.0f %% of the run (wall time handling sweeps)\n",
-              100.0 * t.busy_wall / run_seconds);
-  print_close(sweeps);
+              100.0 * t.busy_wall / run.seconds);
+}
+
+void print_cpu(const DaemonRun& run, const Totals& t, std::size_t played) {
+  const double acquisition = run.sweeps.empty() ? 0.0 : run.sweeps.back().acquisition_cpu;
   std::printf("CPU per fused frame by stage (each on its thread, with the helper threads it started):\n");
   print_stage("acquisition", acquisition, played,
               "(camera threads, per frame played: read, decode, pose, group)");
@@ -515,19 +530,23 @@ int run(const Options& options) {
   print_stage("re-segmentation", t.segment, t.fused, "(sweeps with a change, and the first version)");
   print_stage("persist", t.persist, t.fused, "(processing thread: version and map state to disk)");
   print_stage("publish", t.publish, t.fused, "(processing thread: snapshot and delta)");
-  print_stage("whole process", cpu_total, t.fused, "(every thread, DDS included)");
+  print_stage("whole process", run.cpu, t.fused, "(every thread, DDS included)");
   std::printf("  per version: persist %.1f ms CPU, publish %.2f ms CPU\n",
               t.versions ? 1e3 * t.persist / static_cast<double>(t.versions) : NAN,
               t.versions ? 1e3 * t.publish / static_cast<double>(t.versions) : NAN);
+}
 
+void print_latency(const DaemonRun& run, const SubscriberProcess& subscriber) {
   const std::map<std::uint64_t, std::int64_t> arrivals = subscriber.arrivals();
   std::printf("versions received by the subscriber: %zu (the last: %llu)\n", arrivals.size(),
               arrivals.empty() ? 0ULL : static_cast<unsigned long long>(arrivals.rbegin()->first));
-  const std::vector<double> latencies = confirm_to_delta_ms(sweeps, arrivals, start_ns);
+  const std::vector<double> latencies = confirm_to_delta_ms(run.sweeps, arrivals, run.start_ns);
   std::printf(
       "confirm-to-delta latency: %zu versions after the first, p50 %.1f ms, p99 %.1f ms, max %.1f ms\n",
       latencies.size(), percentile(latencies, 0.5), percentile(latencies, 0.99), percentile(latencies, 1.0));
+}
 
+void print_ratios(const std::vector<Camera>& cameras, const Totals& t, std::size_t played) {
   const auto [anchor, bench_fusion] = fusion_per_frame(cameras);
   const double daemon_fusion = t.fused ? t.fuse / static_cast<double>(t.fused) : NAN;
   std::printf(
@@ -537,7 +556,31 @@ int run(const Options& options) {
   std::printf("ratio daemon fusion per frame (vs discretized insert): %.2fx\n", anchor / daemon_fusion);
   std::printf("ratio frames fused (vs frames played): %.3fx\n",
               played ? static_cast<double>(t.fused) / static_cast<double>(played) : NAN);
-  return finished ? 0 : 1;
+}
+
+int run(const Options& options) {
+  const ScratchDir dir;
+  const Recording recording(options, dir.path);
+  std::vector<Camera> cameras{
+      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
+      {"realsense", d435_848x480(), 0.0}};
+  write_recordings(options, recording, cameras);
+
+  // Before any thread (the subscriber's reader, the daemon's): they all inherit the blocked signals.
+  const daemon::Signals signals;
+  SubscriberProcess subscriber(options.domain);
+  const daemon::DaemonConfig config = daemon_config(options, cameras, dir.path);
+  spdlog::set_level(spdlog::level::warn);
+  const DaemonRun daemon_run = run_daemon(options, recording, config, signals);
+
+  const Totals t = add_up(daemon_run.sweeps);
+  const std::size_t played = recording.frames() * cameras.size();
+  print_frames(options, recording, cameras, daemon_run, t);
+  print_close(daemon_run.sweeps);
+  print_cpu(daemon_run, t, played);
+  print_latency(daemon_run, subscriber);
+  print_ratios(cameras, t, played);
+  return daemon_run.finished ? 0 : 1;
 }
 
 }  // namespace
