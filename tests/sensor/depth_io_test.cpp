@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+#include <string>
+
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "sensor/sensor_test_util.hpp"
@@ -67,6 +71,19 @@ TEST(DepthIoTest, FuzzFindingsAreRefusedWithOneLine) {
               (void)read_intrinsics_yaml(file);
             }).rfind(file + ": YAML syntax error at line 8, column 1: unknown escape character", 0),
             0u);
+}
+
+// libtiff's message about an InkNames tag that disagrees with the samples per pixel spans two lines; the
+// refusal quoting it must not. The fuzz input's first byte picks TIFF, the rest is the file.
+TEST(DepthIoTest, ATiffFuzzFindingIsRefusedWithOneLine) {
+  TempDir dir("ink");
+  std::ifstream in(test::fuzz_regression("depth_image", "tiff-warning-message-over-two-lines"),
+                   std::ios::binary);
+  const std::string input((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(input.size(), 1u);
+  write_file_atomically(dir / "ink.tiff", input.substr(1));
+  const std::string message = test::one_line_error_of([&] { (void)read_depth_image(dir / "ink.tiff"); });
+  EXPECT_NE(message.find("ink.tiff: cannot read TIFF"), std::string::npos) << message;
 }
 
 }  // namespace

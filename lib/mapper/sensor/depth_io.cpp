@@ -13,6 +13,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/config/yaml_map.hpp"
 
 namespace cellmap {
@@ -30,7 +31,7 @@ int keep_tiff_message(TIFF*, void* user_data, const char*, const char* format, v
   if (message->empty()) {
     char text[512];
     std::vsnprintf(text, sizeof text, format, args);
-    *message = text;
+    *message = single_line(text);  // libtiff splits some messages over lines
   }
   return 1;  // handled: do not call the global handler (it would print to stderr)
 }
