@@ -327,14 +327,21 @@ struct Totals {
   std::size_t fused = 0;
   double filter = 0, fuse = 0, change = 0, segment = 0, persist = 0, publish = 0;  // CPU seconds
   double fuse_wall = 0;
-  double busy_wall = 0;      // seconds the processing thread spent on sweeps (every stage, wall)
-  std::size_t versions = 0;  // sweeps that published a version
+  double gathering_wall = 0;   // seconds the gathering thread spent on frames (self filter, voxels; wall)
+  double processing_wall = 0;  // seconds the processing thread spent on sweeps (every stage, wall)
+  std::size_t versions = 0;    // sweeps that published a version
 };
 
-// Wall seconds the processing thread spent on one sweep, stage by stage.
-double handling_wall(const Traces::Sweep& s) {
+// Wall seconds the gathering thread spent on one sweep's frames as they came.
+double gathering_wall(const SweepReport& r) {
+  return r.t_filter + r.t_fuse - r.t_update;
+}
+
+// Wall seconds the processing thread spent on one sweep once it was gathered, stage by stage: what a
+// confirming frame waits for after its sweep ended.
+double closing_wall(const Traces::Sweep& s) {
   const SweepReport& r = *s.report;
-  return r.t_filter + r.t_fuse + r.t_change + r.t_segment + s.persist.wall + s.publish.wall;
+  return r.t_update + r.t_change + r.t_segment + s.persist.wall + s.publish.wall;
 }
 
 Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
@@ -353,7 +360,8 @@ Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
     t.segment += s.report->cpu_segment;
     t.persist += s.persist.cpu;
     t.publish += s.publish.cpu;
-    t.busy_wall += handling_wall(s);
+    t.gathering_wall += gathering_wall(*s.report);
+    t.processing_wall += closing_wall(s);
     if (s.version != version) ++t.versions;
     version = s.version;
   }
@@ -393,19 +401,18 @@ std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps
   return latencies;
 }
 
-// The handling of the sweeps that made a version after the first, stage by stage (wall ms, p50 and max):
-// what a confirming sweep costs once its last frame is in.
+// The processing of the sweeps that made a version after the first, stage by stage (wall ms, p50 and max):
+// what a confirming sweep costs once it was gathered (its frames were fused as they came).
 void print_close(const std::vector<Traces::Sweep>& sweeps) {
-  std::vector<double> scans, fuse, change, segment, persist, publish, whole;
+  std::vector<double> update, change, segment, persist, publish, whole;
   for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
     if (!s->report) continue;
-    scans.push_back(1e3 * s->report->t_filter);
-    fuse.push_back(1e3 * s->report->t_fuse);
+    update.push_back(1e3 * s->report->t_update);
     change.push_back(1e3 * s->report->t_change);
     segment.push_back(1e3 * s->report->t_segment);
     persist.push_back(1e3 * s->persist.wall);
     publish.push_back(1e3 * s->publish.wall);
-    whole.push_back(1e3 * handling_wall(*s));
+    whole.push_back(1e3 * closing_wall(*s));
   }
   const auto p50_max = [](const std::vector<double>& v) {
     char text[32];
@@ -413,10 +420,10 @@ void print_close(const std::vector<Traces::Sweep>& sweeps) {
     return std::string(text);
   };
   std::printf(
-      "close of a confirming sweep, wall ms p50/max (%zu versions after the first): scans %s, fusion %s, "
+      "close of a confirming sweep, wall ms p50/max (%zu versions after the first): map update %s, "
       "change %s, re-segmentation %s, persist %s, publish %s, whole %s\n",
-      whole.size(), p50_max(scans).c_str(), p50_max(fuse).c_str(), p50_max(change).c_str(),
-      p50_max(segment).c_str(), p50_max(persist).c_str(), p50_max(publish).c_str(), p50_max(whole).c_str());
+      whole.size(), p50_max(update).c_str(), p50_max(change).c_str(), p50_max(segment).c_str(),
+      p50_max(persist).c_str(), p50_max(publish).c_str(), p50_max(whole).c_str());
 }
 
 void print_stage(const char* stage, double cpu, std::size_t frames, const char* note) {
@@ -514,8 +521,10 @@ void print_frames(const Options& options, const Recording& recording, const std:
   std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
               percentile(waits, 1.0));
   std::printf("sweeps processed: %zu, versions published: %zu\n", run.sweeps.size(), t.versions);
-  std::printf("processing thread busy %.0f %% of the run (wall time handling sweeps)\n",
-              100.0 * t.busy_wall / run.seconds);
+  std::printf(
+      "gathering thread busy %.0f %% of the run (wall time fusing frames as they came), processing thread "
+      "%.0f %% (map update, change, re-segmentation, persist, publish)\n",
+      100.0 * t.gathering_wall / run.seconds, 100.0 * t.processing_wall / run.seconds);
 }
 
 void print_cpu(const DaemonRun& run, const Totals& t, std::size_t played) {
@@ -524,8 +533,8 @@ void print_cpu(const DaemonRun& run, const Totals& t, std::size_t played) {
   print_stage("acquisition", acquisition, played,
               "(camera threads, per frame played: read, decode, pose, group)");
   print_stage("self filter", t.filter, t.fused,
-              "(frames to cell-frame scans, no-return rays; replays carry no robot)");
-  print_stage("fusion", t.fuse, t.fused, "");
+              "(gathering thread: frames to cell-frame scans, no-return rays; replays carry no robot)");
+  print_stage("fusion", t.fuse, t.fused, "(gathering thread as frames come, map update at a sweep's end)");
   print_stage("change", t.change, t.fused, "");
   print_stage("re-segmentation", t.segment, t.fused, "(sweeps with a change, and the first version)");
   print_stage("persist", t.persist, t.fused, "(processing thread: version and map state to disk)");

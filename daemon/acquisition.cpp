@@ -56,7 +56,7 @@ class SimAcquisition final : public Acquisition {
       const auto start = Clock::now();
       // Sweeps as fast as processed still cover one pass of the plan each in the motion's time.
       const double duration = sweep_period_ > 0 ? sweep_period_.load() : cell_.pass_duration();
-      if (deliver(stamp, duration)) stamp += duration;
+      if (deliver(stamp, duration, stop)) stamp += duration;
       cpu_ = cpu_seconds_with_helpers();  // the renderer splits frames over threads
       if (max_sweeps > 0 && ++sweeps >= max_sweeps) return;
       // The period is read on every turn: a period changed by SIGHUP applies at once, not after the old one.
@@ -75,11 +75,19 @@ class SimAcquisition final : public Acquisition {
   void set_sweep_period(double seconds) override { sweep_period_ = seconds; }
 
  private:
-  // Applies the edits that arrived, renders the next sweep and hands it over; false if that failed.
-  bool deliver(double stamp, double duration) {
+  // Applies the edits that arrived, renders the next sweep and hands it over; false if that failed. A
+  // simulated sweep's frames wait for room rather than be dropped: the simulation can wait for the thread
+  // that fuses them (a line scanner's sweep has more frames than the queue holds), so a sweep is fused
+  // whole or, should the sweeps wait too long for re-segmentation, dropped whole.
+  bool deliver(double stamp, double duration, const std::atomic<bool>& stop) {
     try {
       apply_edits();
-      output_.mailbox.put(cell_.next_sweep(stamp, duration));
+      for (SweepFrame& frame : cell_.next_sweep(stamp, duration).frames) {
+        while (!stop && !output_.frames.wait_for_room(milliseconds(100))) {
+        }
+        output_.frames.put(std::move(frame));
+      }
+      output_.frames.end_sweep();
       dropped_ = cell_.dropped_frames();
       for (const std::string& sensor : sensors_) output_.health.set_sensor(sensor, SourceState::kConnected);
       return true;
@@ -113,7 +121,7 @@ class SimAcquisition final : public Acquisition {
 };
 
 // A replay played as fast as processed must lose no sweep.
-bool lossless(const SourceConfig& source) {
+bool played_fastest(const SourceConfig& source) {
   const auto* replay = std::get_if<ReplayConfig>(&source.camera.source);
   return replay != nullptr && replay->playback == ReplayConfig::Playback::kFastest;
 }
@@ -208,7 +216,7 @@ class CameraAcquisition final : public Acquisition {
                                   [](const SourceConfig& s) { return !is_replay(s); });
     if (live)
       robot_.emplace(config.robot, pose_tolerance_, participant, config.cell, refuse(output.refusals));
-    lossless_ = std::all_of(config.sources.begin(), config.sources.end(), lossless);
+    lossless_ = std::all_of(config.sources.begin(), config.sources.end(), played_fastest);
     for (const SourceConfig& source : config.sources)
       loops_.push_back(std::make_unique<CameraLoop>(source, robot_ ? &*robot_ : nullptr, output));
   }
@@ -244,6 +252,7 @@ class CameraAcquisition final : public Acquisition {
     for (const auto& loop : loops_) cpu += loop->cpu_seconds();
     return cpu;
   }
+  [[nodiscard]] bool lossless() const override { return lossless_; }
 
  private:
   static bool is_replay(const SourceConfig& s) {
@@ -272,36 +281,37 @@ class CameraAcquisition final : public Acquisition {
     }
   }
 
-  // Groups the frames and delivers the sweeps they closed (and the open one when a camera stopped
-  // streaming); true once max_sweeps went out.
+  // Delivers the frames with the ends of the sweeps they close (and of the open one when a camera stopped
+  // streaming); true once max_sweeps were ended.
   bool group(std::vector<SweepFrame> frames, bool flush, const std::atomic<bool>& stop,
              std::uint64_t max_sweeps) {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<FrameSweep> sweeps;
     for (SweepFrame& frame : frames) {
-      for (FrameSweep& sweep : grouper_.add(std::move(frame))) sweeps.push_back(std::move(sweep));
-    }
-    if (flush) {
-      if (std::optional<FrameSweep> open = grouper_.flush()) sweeps.push_back(std::move(*open));
-    }
-    for (FrameSweep& sweep : sweeps) {
-      // A replay played as fast as processed must lose no sweep: wait for the processing thread.
-      while (lossless_ && !stop && !output_.mailbox.wait_for_room(milliseconds(100))) {
+      const FramePlace place = grouper_.place(frame.frame.stamp);
+      if (place.ends_open_sweep && end_sweep(max_sweeps)) return true;
+      // A replay played as fast as processed must lose no frame: wait for the thread that fuses them.
+      while (lossless_ && !stop && !output_.frames.wait_for_room(milliseconds(100))) {
       }
-      output_.mailbox.put(std::move(sweep));
-      if (max_sweeps > 0 && ++delivered_ >= max_sweeps) return true;
+      output_.frames.put(std::move(frame));
+      if (place.completes_sweep && end_sweep(max_sweeps)) return true;
     }
-    return false;
+    return flush && grouper_.flush() && end_sweep(max_sweeps);
+  }
+
+  // Ends the open sweep in the queue; true once max_sweeps were ended.
+  bool end_sweep(std::uint64_t max_sweeps) {
+    output_.frames.end_sweep();
+    return max_sweeps > 0 && ++delivered_ >= max_sweeps;
   }
 
   AcquisitionOutput output_;
   std::mutex mutex_;  // guards grouper_ and delivered_
   FrameGrouper grouper_;
-  std::uint64_t delivered_ = 0;
+  std::uint64_t delivered_ = 0;  // sweeps ended
   double pose_tolerance_;
   std::optional<Robot> robot_model_;
   std::optional<RobotInput> robot_;  // live cameras only
-  bool lossless_ = false;  // replays played as fast as processed: no sweep is dropped from the mailbox
+  bool lossless_ = false;            // replays played as fast as processed: no frame is dropped
   std::vector<std::unique_ptr<CameraLoop>> loops_;
 };
 

@@ -1,6 +1,7 @@
 #pragma once
-// cellmapd's acquisition: sweeps from the configured sensors (the simulated cell's, or the cameras' posed
-// frames grouped into sweeps) into the processing thread's mailbox (a bounded backlog).
+// cellmapd's acquisition: the frames of the configured sensors (the simulated cell's sweeps, or the cameras'
+// posed frames grouped into sweeps as they come) into the frame queue of the thread that fuses them, with
+// the ends of the sweeps between them.
 
 #include <atomic>
 #include <cstdint>
@@ -11,15 +12,15 @@
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/transport/dds.hpp"
 #include "daemon_config.hpp"
+#include "frame_queue.hpp"
 #include "health.hpp"
 #include "input_refusals.hpp"
-#include "bounded_mailbox.hpp"
 
 namespace cellmap::daemon {
 
 /// Where the acquisition thread delivers and reports; shared with the processing thread (all thread-safe).
 struct AcquisitionOutput {
-  BoundedMailbox<FrameSweep>& mailbox;
+  FrameQueue& frames;
   Health& health;
   /// The DDS inputs the source refused (scene edits, robot poses): outside the limits or not applicable.
   InputRefusals& refusals;
@@ -32,9 +33,10 @@ class Acquisition {
  public:
   virtual ~Acquisition() = default;
 
-  /// Delivers sweeps into the mailbox and reports the sensor's state to the health until `stop` is set or,
-  /// with `max_sweeps` > 0, until that many sweeps were delivered or a recording ended before. Faults it can
-  /// ride out (a sweep that failed, a camera that went away) are logged and reported, and it goes on.
+  /// Delivers frames and sweep ends into the frame queue and reports the sensor's state to the health until
+  /// `stop` is set or, with `max_sweeps` > 0, until that many sweeps were ended or a recording ended before.
+  /// Faults it can ride out (a sweep that failed, a camera that went away) are logged and reported, and it
+  /// goes on.
   /// @throws std::exception on a fault it cannot ride out: the caller logs it and the daemon degrades.
   virtual void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) = 0;
   /// For the start log line: "sim (sensor 'kinect', 17 obstacles)", "replay (camera 'wrist')",
@@ -52,6 +54,9 @@ class Acquisition {
   /// SIGHUP: seconds between sweep starts from the next sweep on; ignored by cameras (their sweep grouping
   /// is fixed when they start). Thread-safe.
   virtual void set_sweep_period(double /*seconds*/) {}
+  /// Whether no frame may be dropped (replays played as fast as processed): the source then waits for room
+  /// in the frame queue, and so must whoever takes its frames further. Fixed at construction.
+  [[nodiscard]] virtual bool lossless() const { return false; }
 };
 
 /// The sensors `config.sources` name: the simulated cell, editable over cellmap/sim/scene_edits (edits for

@@ -23,16 +23,20 @@ class BoundedMailbox {
   explicit BoundedMailbox(std::size_t capacity = 1) : capacity_(capacity > 0 ? capacity : 1) {}
 
   /// Appends `item`, dropping (and counting) the oldest item when `capacity` wait; wakes one waiting take().
-  void put(T item) {
+  /// Returns the item it dropped, if any (for the caller to count what it held).
+  std::optional<T> put(T item) {
+    std::optional<T> dropped;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (items_.size() >= capacity_) {
+        dropped = std::move(items_.front());
         items_.pop_front();
         ++dropped_;
       }
       items_.push_back(std::move(item));
     }
     ready_.notify_one();
+    return dropped;
   }
 
   /// Waits up to `timeout` for an item and takes the oldest; empty on timeout, or after close() when none is

@@ -84,13 +84,14 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
                 publisher_.publish(env, delta);
                 watch.add_to(publish_cost_);
               }),
-      mailbox_(config_.sweep_backlog),
+      frames_(config_.frame_backlog),
+      sweeps_(config_.sweep_backlog),
       health_(config_.cell, sensor_names(config_)),
       refusals_([](const std::string& line) { spdlog::warn("{}", line); }) {
   log_dds_security(participant_, config_.domain);
   keeper_.resume(pipeline_);
   published_version_ = keeper_.published().version();
-  acquisition_ = make_acquisition(config_, participant_, {mailbox_, health_, refusals_, published_version_});
+  acquisition_ = make_acquisition(config_, participant_, {frames_, health_, refusals_, published_version_});
   use_self_filter();
   spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
                store_.directory().string(), acquisition_->describe(), keeper_.published().version());
@@ -116,6 +117,7 @@ void Daemon::use_self_filter() {
 
 void Daemon::run(const Signals& signals) {
   std::thread acquisition([this] { acquire(); });
+  std::thread gathering([this] { gather(); });
   std::thread processing([this] { process(); });
   while (!stop_) {
     const std::optional<int> signal = signals.wait_for(milliseconds(200));
@@ -129,8 +131,10 @@ void Daemon::run(const Signals& signals) {
       stop_ = true;
     }
   }
-  mailbox_.close();
+  frames_.close();
+  sweeps_.close();
   acquisition.join();
+  gathering.join();
   processing.join();
   health_.stop();
   publish_status();
@@ -149,19 +153,62 @@ void Daemon::acquire() {
   }
 }
 
+void Daemon::gather() {
+  OpenSweep open = pipeline_.open_sweep();
+  for (;;) {
+    // Read before take(): a frame put just before acquisition ended is then still taken.
+    const bool acquisition_was_done = acquisition_done_;
+    std::optional<FrameItem> item = frames_.take(milliseconds(100));
+    if (!item) {
+      if (stop_ || acquisition_was_done) break;
+    } else if (item->frame) {
+      add_frame(open, std::move(*item->frame));
+    } else if (open.frames() > 0) {
+      hand_over(open.close());
+    }
+  }
+  gathering_done_ = true;
+}
+
+void Daemon::add_frame(OpenSweep& open, SweepFrame frame) {
+  const std::string sensor = frame.frame.sensor;
+  const double stamp = frame.frame.stamp;
+  try {
+    open.add(std::move(frame));
+  } catch (const Error& e) {
+    const std::string reason = "frame of '" + sensor + "' at " + std::to_string(stamp) + " s: " + e.what();
+    health_.sweep_failed(reason);
+    ++frame_faults_;
+    // At frame rate a fault that persists would flood the log: once a second, with the count.
+    if (Clock::now() >= next_frame_fault_log_) {
+      spdlog::error("{} ({} frames failed so far); keeping version {}", reason, frame_faults_,
+                    published_version_.load());
+      next_frame_fault_log_ = Clock::now() + std::chrono::seconds(1);
+    }
+  }
+}
+
+void Daemon::hand_over(GatheredSweep sweep) {
+  // A replay played as fast as processed must lose no sweep: wait for the processing thread.
+  while (acquisition_->lossless() && !stop_ && !sweeps_.wait_for_room(milliseconds(100))) {
+  }
+  if (std::optional<GatheredSweep> dropped = sweeps_.put(std::move(sweep)))
+    frames_in_dropped_sweeps_ += dropped->frames.frames.size();
+}
+
 void Daemon::process() {
   auto next_status = Clock::now();
   std::uint64_t processed = 0;
   for (;;) {
-    // Read before take(): a sweep put just before acquisition ended is then still taken.
-    const bool acquisition_was_done = acquisition_done_;
-    std::optional<FrameSweep> sweep = mailbox_.take(milliseconds(100));
+    // Read before take(): a sweep put just before gathering ended is then still taken.
+    const bool gathering_was_done = gathering_done_;
+    std::optional<GatheredSweep> sweep = sweeps_.take(milliseconds(100));
     if (sweep) {
       handle(*sweep, ++processed);
       if (options_.max_sweeps > 0 && processed >= options_.max_sweeps) stop_ = true;
-    } else if (stop_ || acquisition_was_done) {
-      // With --sweeps, acquisition ends after N sweeps; some may have been dropped from the mailbox, so
-      // processing ends when the mailbox is empty, not only after N.
+    } else if (stop_ || gathering_was_done) {
+      // With --sweeps, acquisition ends after N sweeps; some may have been dropped on the way, so
+      // processing ends when nothing is left to process, not only after N.
       stop_ = true;
       break;
     }
@@ -176,10 +223,10 @@ void Daemon::process() {
   }
 }
 
-void Daemon::handle(FrameSweep& sweep, std::uint64_t number) {
+void Daemon::handle(GatheredSweep& sweep, std::uint64_t number) {
   SweepTrace trace;
   trace.number = number;
-  trace.sweep = &sweep;
+  trace.sweep = &sweep.frames;
   trace.report = run_pipeline(sweep, number);
   flush(trace);
   if (!options_.on_sweep) return;
@@ -188,18 +235,18 @@ void Daemon::handle(FrameSweep& sweep, std::uint64_t number) {
   options_.on_sweep(trace);
 }
 
-std::optional<SweepReport> Daemon::run_pipeline(FrameSweep& sweep, std::uint64_t number) {
+std::optional<SweepReport> Daemon::run_pipeline(GatheredSweep& sweep, std::uint64_t number) {
   try {
     SweepReport report = pipeline_.process(sweep);
     health_.sweep_processed(number, wall_clock_ns());
     spdlog::info(
         "sweep {}: {} frames, {} points, {} on the robot, {} hit / {} free voxels, {} flipped, {} change "
-        "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s, change {:.3f} s, segment {:.3f} s; "
-        "{} sweeps dropped",
+        "regions, {} boxes; self filter {:.3f} s, fuse {:.3f} s (map update {:.3f} s), change {:.3f} s, "
+        "segment {:.3f} s; {} sweeps dropped, {} frames dropped",
         number, report.frames, report.points, report.robot_points, report.hit_voxels, report.free_voxels,
-        report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_change,
-        report.t_segment, mailbox_.dropped());
-    layers_.after_sweep(number, sweep, pipeline_.map(), report.changes);
+        report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_update,
+        report.t_change, report.t_segment, sweeps_.dropped(), dropped_frames());
+    layers_.after_sweep(number, sweep.frames, pipeline_.map(), report.changes);
     return report;
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
@@ -219,11 +266,14 @@ void Daemon::flush(SweepTrace& trace) {
   published_version_ = keeper_.published().version();
 }
 
+std::uint64_t Daemon::dropped_frames() const {
+  return frames_.dropped() + frames_in_dropped_sweeps_ + acquisition_->dropped_frames();
+}
+
 void Daemon::publish_status() {
   health_.set_version_fault(keeper_.fault());
   transport::CellStatus status = health_.status();
-  // Sweeps the processing thread had no time for, plus camera frames that had no robot pose.
-  status.dropped_frames = mailbox_.dropped() + acquisition_->dropped_frames();
+  status.dropped_frames = dropped_frames();
   status.boxes = keeper_.published().boxes().size();
   status.version = keeper_.published().version();
   status.refused_inputs = refusals_.count();

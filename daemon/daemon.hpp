@@ -1,11 +1,13 @@
 #pragma once
 // cellmapd's wiring: the state directory, the cell pipeline, DDS, the sweep source and the threads.
 //
-// Threads: acquisition (sweeps from the source → a bounded mailbox, oldest taken first), processing (cell
-// pipeline → version kept, saved and published → status), and the caller's (signals: SIGTERM/SIGINT stop,
-// SIGHUP reloads).
+// Threads: acquisition (frames and sweep ends from the source → a bounded frame queue), gathering (each frame
+// cut by the self filter and its observed voxels gathered into its sweep as it arrives → a bounded backlog of
+// gathered sweeps, oldest taken first), processing (map update, change detection, re-segmentation → version
+// kept, saved and published → status), and the caller's (signals: SIGTERM/SIGINT stop, SIGHUP reloads).
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -13,13 +15,14 @@
 #include <optional>
 
 #include "acquisition.hpp"
+#include "bounded_mailbox.hpp"
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "daemon_config.hpp"
+#include "frame_queue.hpp"
 #include "health.hpp"
 #include "input_refusals.hpp"
-#include "bounded_mailbox.hpp"
 #include "layer_publisher.hpp"
 #include "signals.hpp"
 #include "versions.hpp"
@@ -35,7 +38,7 @@ struct StepCost {
 /// One sweep the processing thread handled, for measuring the daemon (`cellmap bench daemon`).
 struct SweepTrace {
   std::uint64_t number = 0;           ///< sweeps handled so far, this one included
-  const FrameSweep* sweep = nullptr;  ///< the sweep; valid during the call only
+  const FrameSweep* sweep = nullptr;  ///< the sweep's frames (without points); valid during the call only
   std::optional<SweepReport> report;  ///< what the pipeline did; nullopt if the sweep failed
   StepCost persist;              ///< saving the version the sweep made (boxes and map state), if it made one
   StepCost publish;              ///< publishing it (snapshot and delta)
@@ -65,10 +68,17 @@ class Daemon final {
 
  private:
   void acquire();
+  void gather();
+  // Adds a frame to the open sweep; a frame that fails is logged, reported and left out.
+  void add_frame(OpenSweep& open, SweepFrame frame);
+  // Hands the gathered sweep to the processing thread (waiting for room if the source is lossless).
+  void hand_over(GatheredSweep sweep);
   void process();
-  void handle(FrameSweep& sweep, std::uint64_t number);
+  void handle(GatheredSweep& sweep, std::uint64_t number);
   // Runs the pipeline on the sweep and logs what it did; nullopt if the sweep failed (logged, reported).
-  std::optional<SweepReport> run_pipeline(FrameSweep& sweep, std::uint64_t number);
+  std::optional<SweepReport> run_pipeline(GatheredSweep& sweep, std::uint64_t number);
+  // Frames never fused: dropped from the frame queue, in sweeps dropped from the backlog, or by the source.
+  [[nodiscard]] std::uint64_t dropped_frames() const;
   // Saves and publishes what the sweep changed: keeper_.flush(), its cost split into saving and publishing.
   void flush(SweepTrace& trace);
   // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the
@@ -84,13 +94,18 @@ class Daemon final {
   LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
   CellPipeline pipeline_;
   VersionKeeper keeper_;
-  BoundedMailbox<FrameSweep> mailbox_;
+  FrameQueue frames_;
+  BoundedMailbox<GatheredSweep> sweeps_;
+  std::atomic<std::uint64_t> frames_in_dropped_sweeps_{0};
+  std::uint64_t frame_faults_ = 0;  // frames that failed to fuse (gathering thread)
+  std::chrono::steady_clock::time_point next_frame_fault_log_;  // gathering thread
   Health health_;
   InputRefusals refusals_;
-  std::atomic<std::uint64_t> published_version_{0};  // for the acquisition thread's log lines
+  std::atomic<std::uint64_t> published_version_{0};  // for the acquisition and gathering threads' log lines
   std::unique_ptr<Acquisition> acquisition_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> acquisition_done_{false};
+  std::atomic<bool> gathering_done_{false};
   std::string status_fault_;  // the last reason a status was not published, logged once
   StepCost publish_cost_;     // of the publications during the current flush()
 };

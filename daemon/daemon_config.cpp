@@ -185,6 +185,8 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   c.state_dir = root.get<std::string>("state_dir", c.state_dir.string());
   c.sweep_period = root.number("sweep_period", c.sweep_period, 0.0, 3600.0);
   c.status_period = root.number("status_period", c.status_period, 0.05, 3600.0);
+  c.frame_backlog =
+      static_cast<std::size_t>(root.integer("frame_backlog", static_cast<long>(c.frame_backlog), 1, 10000));
   c.sweep_backlog =
       static_cast<std::size_t>(root.integer("sweep_backlog", static_cast<long>(c.sweep_backlog), 1, 1000));
   c.delta_depth = static_cast<std::uint32_t>(root.integer("delta_depth", c.delta_depth, 1, 10000));

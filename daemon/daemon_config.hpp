@@ -64,7 +64,10 @@ struct DaemonConfig final {
   std::filesystem::path state_dir = "state";  ///< `state_dir` (--state-dir overrides); relative to the cwd
   double sweep_period = 0.5;   ///< `sweep_period`: seconds between sweep starts (0 = as fast as processed)
   double status_period = 1.0;  ///< `status_period`: seconds between status messages
-  /// `sweep_backlog`: sweeps that wait for the processing thread; when it is full the oldest is dropped.
+  /// `frame_backlog`: frames that wait to be fused into their sweep; when it is full the oldest is dropped.
+  std::size_t frame_backlog = 16;
+  /// `sweep_backlog`: fused sweeps that wait for change detection and re-segmentation; when it is full the
+  /// oldest is dropped.
   std::size_t sweep_backlog = 8;
   std::uint32_t delta_depth = 16;  ///< `delta_depth`: deltas kept for late joiners
   std::string log_level = "info";  ///< `log_level`: trace | debug | info | warn | error

@@ -1,6 +1,6 @@
-// cellmapd's acquisition of the simulated cell: sweeps into the mailbox, scene edits over real DDS applied
-// when they are for this cell (or every cell), ignored when they are for another, refused and counted when
-// they leave the cell.
+// cellmapd's acquisition of the simulated cell: sweeps into the frame queue, scene edits over real DDS
+// applied when they are for this cell (or every cell), ignored when they are for another, refused and counted
+// when they leave the cell.
 #include "acquisition.hpp"
 
 #include <gtest/gtest.h>
@@ -32,6 +32,20 @@ std::size_t points_above_table(const FrameSweep& sweep, const Eigen::Vector3d& c
   return inside;
 }
 
+// The sweeps in `frames`: the frames up to each end of a sweep.
+std::vector<FrameSweep> take_sweeps(FrameQueue& frames) {
+  std::vector<FrameSweep> sweeps(1);
+  while (std::optional<FrameItem> item = frames.take(0ms)) {
+    if (item->frame) {
+      sweeps.back().frames.push_back(std::move(*item->frame));
+    } else {
+      sweeps.emplace_back();
+    }
+  }
+  if (sweeps.back().frames.empty()) sweeps.pop_back();
+  return sweeps;
+}
+
 transport::SceneEdit add_box(const std::string& cell, const std::string& name,
                              const Eigen::Vector3d& centre) {
   transport::SceneEdit edit;
@@ -48,13 +62,13 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
   DaemonConfig config =
       DaemonConfig::parse("cell: bench-7\nsweep_period: 0\nsource: {noise: false}\n", "test.yaml", ".");
   const dds::Participant participant(test::domain::kSimAcquisition);
-  BoundedMailbox<FrameSweep> mailbox;
+  FrameQueue frames(1000);
   Health health(config.cell, {config.sources[0].sensor});
   std::vector<std::string> refusal_lines;
   InputRefusals refusals([&](const std::string& line) { refusal_lines.push_back(line); });
   const std::atomic<std::uint64_t> version{0};
   const std::unique_ptr<Acquisition> acquisition =
-      make_acquisition(config, participant, {mailbox, health, refusals, version});
+      make_acquisition(config, participant, {frames, health, refusals, version});
   EXPECT_EQ(acquisition->describe().rfind("sim (sensor 'kinect', ", 0), 0u) << acquisition->describe();
 
   // Two free spots on the table (top at z = 0.75), both in the Kinect's view.
@@ -70,11 +84,14 @@ TEST(SimAcquisitionTest, DeliversSweepsAndAppliesOnlyThisCellsSceneEdits) {
 
   const std::atomic<bool> stop{false};
   acquisition->run(stop, 2);  // returns after two sweeps
-  const std::optional<FrameSweep> sweep = mailbox.take(0ms);
-  ASSERT_TRUE(sweep.has_value());
-  EXPECT_EQ(mailbox.dropped(), 1u);  // the first was replaced: nobody took it
-  EXPECT_GT(points_above_table(*sweep, mine, half), 100u) << "the edit for this cell was not applied";
-  EXPECT_EQ(points_above_table(*sweep, theirs, half), 0u) << "the edit for another cell was applied";
+  const std::vector<FrameSweep> sweeps = take_sweeps(frames);
+  ASSERT_EQ(sweeps.size(), 2u);
+  EXPECT_EQ(frames.dropped(), 0u) << "a simulated sweep's frames wait for room";
+  for (const FrameSweep& sweep : sweeps) {
+    EXPECT_GT(sweep.frames.size(), 1u);
+    EXPECT_GT(points_above_table(sweep, mine, half), 100u) << "the edit for this cell was not applied";
+    EXPECT_EQ(points_above_table(sweep, theirs, half), 0u) << "the edit for another cell was applied";
+  }
   EXPECT_EQ(refusals.count(), 1u);
   ASSERT_EQ(refusal_lines.size(), 1u);
   EXPECT_NE(refusal_lines[0].find("'far'"), std::string::npos) << refusal_lines[0];

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -243,16 +244,26 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
   EXPECT_EQ(test::exit_code(daemon->wait()), 0);
 }
 
-// sweep_period 0: the simulated cell sweeps as fast as it renders, while fusing a sweep into a 1 cm grid
-// takes seconds. With `sweep_backlog: 1` the mailbox keeps only the newest sweep: every sweep is processed or
-// counted as dropped, in the per-sweep log line and in the status's dropped_frames. (Measured: 8 sweeps
-// rendered, 2 processed.)
+// The number right before the first `label` in `line` ("…: 5 frames, …" with " frames, " → 5); 0 if absent.
+std::uint64_t number_before(const std::string& line, const std::string& label) {
+  const std::size_t at = line.find(label);
+  if (at == std::string::npos) return 0;
+  std::size_t begin = at;
+  while (begin > 0 && std::isdigit(static_cast<unsigned char>(line[begin - 1]))) --begin;
+  return std::strtoull(line.substr(begin, at - begin).c_str(), nullptr, 10);
+}
+
+// sweep_period 0: the simulated cell sweeps as fast as the daemon fuses its frames, while the first version
+// (settle_sweeps 0: the first sweep makes it) segments the whole cell at 1 cm, which takes seconds. With
+// `sweep_backlog: 1` only the newest gathered sweep waits meanwhile: every sweep is processed or dropped
+// whole, its frames counted in the status's dropped_frames and in the per-sweep log line. (Measured: 8
+// sweeps rendered, 2 processed.)
 TEST(CellmapdStatusE2eTest, SweepsArrivingFasterThanProcessedAreDroppedAndCounted) {
   constexpr std::uint64_t kSweeps = 8;
   test::ServiceFixture service("mailbox");
   std::ofstream(service.config_file(), std::ios::trunc)
       << "cell: mailbox\nsweep_period: 0\nsweep_backlog: 1\nstatus_period: 0.2\nsource: {noise: false}\n"
-         "occupancy: {resolution: 0.01}\n";
+         "occupancy: {resolution: 0.01}\nchange: {settle_sweeps: 0}\n";
   auto daemon = service.start_daemon(test::domain::kMailbox, /*log_on_stdout=*/true, kSweeps);
   test::DaemonLog log(*daemon);
   const dds::Participant participant = service.participant(test::domain::kMailbox);
@@ -262,14 +273,18 @@ TEST(CellmapdStatusE2eTest, SweepsArrivingFasterThanProcessedAreDroppedAndCounte
   ASSERT_TRUE(stopped.has_value()) << "no final stopped status";
   EXPECT_EQ(test::exit_code(daemon->wait()), 0);
   log.drain();
-  EXPECT_GE(stopped->dropped_frames, 1u) << "no sweep was dropped: was anything queued?";
-  EXPECT_EQ(stopped->sweeps + stopped->dropped_frames, kSweeps);
-  // The last sweep's line counts every drop (the last sweep delivered is never replaced).
+  // The last sweep's line counts every drop (the last sweep gathered is never replaced).
   std::string last_sweep;
   for (const std::string& line : log.lines())
     if (sweep_number(line) > 0) last_sweep = line;
   EXPECT_EQ(sweep_number(last_sweep), stopped->sweeps);
-  EXPECT_NE(last_sweep.find("; " + std::to_string(stopped->dropped_frames) + " sweeps dropped"),
+  const std::uint64_t frames_per_sweep = number_before(last_sweep, " frames, ");
+  ASSERT_GT(frames_per_sweep, 1u) << last_sweep;
+  const std::uint64_t dropped_sweeps = number_before(last_sweep, " sweeps dropped");
+  EXPECT_GE(dropped_sweeps, 1u) << "no sweep was dropped: was anything queued? " << last_sweep;
+  EXPECT_EQ(stopped->sweeps + dropped_sweeps, kSweeps);
+  EXPECT_EQ(stopped->dropped_frames, dropped_sweeps * frames_per_sweep) << "whole sweeps are dropped";
+  EXPECT_NE(last_sweep.find(", " + std::to_string(stopped->dropped_frames) + " frames dropped"),
             std::string::npos)
       << last_sweep;
 }

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "bounded_mailbox.hpp"
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/sim/simulator.hpp"
 #include "daemon/robot_surface.hpp"
 #include "daemon_config.hpp"
-#include "bounded_mailbox.hpp"
 #include "simulated_cell.hpp"
 #include "support/test_support.hpp"
 
@@ -198,8 +198,8 @@ TEST(WorkingCellTest, JointStampsLate20MsWithTheDefaultPaddingMakeNoRobotBox) {
 }
 
 // The arm cell as config/arm-cell.yaml has it (both cameras, 0.5 s sweeps, settling 34 sweeps) for `sweeps`
-// sweeps through the daemon's mailbox, with `backlog` sweeps of room (`sweep_backlog`), while the processing
-// thread is stalled from sweep `stall_from` to `stall_to` (it takes nothing, as during the first
+// sweeps, gathered and queued as in the daemon with `backlog` sweeps of room (`sweep_backlog`), while the
+// processing thread is stalled from sweep `stall_from` to `stall_to` (it takes nothing, as during the first
 // segmentation on a loaded machine); the number of versions.
 int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stall_to, int sweeps) {
   const std::string config_dir = std::string(CELLMAP_SOURCE_DIR) + "/config";
@@ -208,12 +208,15 @@ int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stal
   SimulatedCell cell(config.sources, config.robot);
   CellPipeline pipeline(config.pipeline);
   pipeline.filter_robot(cell.robot());
-  BoundedMailbox<FrameSweep> mailbox(backlog);
+  OpenSweep open = pipeline.open_sweep();
+  BoundedMailbox<GatheredSweep> mailbox(backlog);
   int versions = 0;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
-    mailbox.put(cell.next_sweep(sweep * config.sweep_period, config.sweep_period));
+    for (SweepFrame& frame : cell.next_sweep(sweep * config.sweep_period, config.sweep_period).frames)
+      open.add(std::move(frame));
+    mailbox.put(open.close());
     if (sweep >= stall_from && sweep <= stall_to) continue;
-    while (std::optional<FrameSweep> next = mailbox.take(std::chrono::milliseconds(0)))
+    while (std::optional<GatheredSweep> next = mailbox.take(std::chrono::milliseconds(0)))
       versions += pipeline.process(*next).change ? 1 : 0;
   }
   std::cout << "arm cell, processing stalled for sweeps " << stall_from << " to " << stall_to << ", backlog "

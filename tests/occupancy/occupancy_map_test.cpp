@@ -62,6 +62,22 @@ TEST(OccupancyMapTest, MatchesOctomapsOwnInsertOverSeveralSweeps) {
   EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
 }
 
+// Clear-only ray ends 0.2 m before the points of `scan` that lie in box B (box_room's second box), those
+// points taken out: the line of sight up to the robot, as the self filter leaves it.
+void make_box_b_clear_only(Scan& scan) {
+  Cloud kept;
+  for (const auto& p : scan.points_C) {
+    if (p.x > 0.3f && p.x < 0.7f && p.z > 2.35f && p.z < 2.85f && p.y > 0.65f && p.y < 0.99f) {
+      const Eigen::Vector3d p_C(p.x, p.y, p.z);
+      const Eigen::Vector3d end_C = p_C - 0.2 * (p_C - scan.origin_C).normalized();
+      scan.clear_C.push_back(pcl::PointXYZ(float(end_C.x()), float(end_C.y()), float(end_C.z())));
+    } else {
+      kept.push_back(p);
+    }
+  }
+  scan.points_C = kept;
+}
+
 // Clear-only rays through the map: the same tree as OctoMap's updateNode fed with computeRayKeys free keys.
 TEST(OccupancyMapTest, ClearOnlyRaysMatchOctomapsUpdateNode) {
   OccupancyConfig config;
@@ -81,19 +97,7 @@ TEST(OccupancyMapTest, ClearOnlyRaysMatchOctomapsUpdateNode) {
     }
     Scan scan = testing::render_scan(testing::box_room(), camera_at({0.011 * sweep, -0.2, 0.02}, -0.25),
                                      testing::kinect_intrinsics(96, 72));
-    if (sweep > 0) {  // later sweeps: points on box B become clear-only rays ending 0.2 m before them
-      Cloud kept;
-      for (const auto& p : scan.points_C) {
-        const Eigen::Vector3d p_C(p.x, p.y, p.z);
-        if (p.x > 0.3f && p.x < 0.7f && p.z > 2.35f && p.z < 2.85f && p.y > 0.65f && p.y < 0.99f) {
-          const Eigen::Vector3d end_C = p_C - 0.2 * (p_C - scan.origin_C).normalized();
-          scan.clear_C.push_back(pcl::PointXYZ(float(end_C.x()), float(end_C.y()), float(end_C.z())));
-        } else {
-          kept.push_back(p);
-        }
-      }
-      scan.points_C = kept;
-    }
+    if (sweep > 0) make_box_b_clear_only(scan);  // later sweeps: box B's points become clear-only rays
     ASSERT_EQ(scan.clear_C.empty(), sweep == 0);
     Sweep one;
     one.scans.push_back(scan);
@@ -152,6 +156,72 @@ std::size_t log_odds_differences(const octomap::OcTree& a, const octomap::OcTree
     }
   }
   return differences;
+}
+
+// A sweep's scans gathered one by one as its frames arrive make the map the whole sweep makes at once,
+// log-odds for log-odds, with the same flips: over several sweeps of three overlapping views (one with
+// clear-only rays through voxels another view hits), while a box leaves.
+TEST(OccupancyMapTest, ScansGatheredOneByOneMakeTheWholeSweepsMap) {
+  OccupancyConfig config;
+  config.resolution = 0.05;
+  OccupancyMap whole(config), gathered(config);
+  ObservedVoxels voxels(config);
+  const std::vector<Eigen::Isometry3d> poses = {camera_at({0.011, -0.2, 0.02}, -0.25),
+                                                camera_at({0.4, -0.3, 0.3}, -0.35),
+                                                camera_at({-0.37, -0.1, 0.21}, -0.1)};
+  std::vector<AlignedBox> scene = testing::box_room();
+  std::size_t flips = 0;
+  for (int sweep = 0; sweep < 5; ++sweep) {
+    if (sweep == 3) scene.pop_back();  // box B leaves
+    Sweep frames = sweep_of(scene, poses, 96, 72);
+    make_box_b_clear_only(frames.scans[0]);
+    ASSERT_EQ(frames.scans[0].clear_C.empty(), sweep >= 3);
+    const OccupancyUpdate expected = whole.integrate(frames);
+    for (Scan& scan : frames.scans) voxels.add(std::move(scan));
+    EXPECT_EQ(voxels.scans(), 3u);
+    EXPECT_GT(voxels.bricks(), 0u);
+    const OccupancyUpdate update = gathered.integrate(voxels);
+    EXPECT_EQ(voxels.scans(), 0u);
+    EXPECT_EQ(voxels.bricks(), 0u) << "integrate() empties the gathered voxels for the next sweep";
+    EXPECT_EQ(update.hit_voxels, expected.hit_voxels);
+    EXPECT_EQ(update.free_voxels, expected.free_voxels);
+    EXPECT_EQ(update.appeared, expected.appeared);
+    EXPECT_EQ(update.vanished, expected.vanished);
+    flips += update.appeared.size() + update.vanished.size();
+  }
+  EXPECT_GT(flips, 100u) << "the sweeps flipped too little to compare";
+  const TreeAgreement agreement = compare_trees(gathered.tree(), whole.tree());
+  EXPECT_GT(agreement.voxels, 5000u);
+  EXPECT_EQ(agreement.same_log_odds, agreement.voxels);
+  EXPECT_EQ(agreement.occupied_a, agreement.occupied_b);
+}
+
+TEST(OccupancyMapTest, GatheredVoxelsOfAnotherResolutionAreRefused) {
+  OccupancyConfig coarse;
+  coarse.resolution = 0.05;
+  OccupancyMap map;  // 2 cm
+  ObservedVoxels voxels(coarse);
+  voxels.add(sweep_of(testing::box_room(), {camera_at({0.0, -0.2, 0.0}, -0.25)}, 48, 36).scans[0]);
+  EXPECT_THROW(
+      {
+        try {
+          (void)map.integrate(voxels);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      Error);
+  EXPECT_EQ(map.tree().size(), 0u) << "nothing was fused";
+}
+
+TEST(OccupancyMapTest, AScanWhoseOriginIsOutsideTheMapAddsNothing) {
+  ObservedVoxels voxels;
+  Scan scan = sweep_of(testing::box_room(), {camera_at({0.0, -0.2, 0.0}, -0.25)}, 48, 36).scans[0];
+  scan.origin_C = Eigen::Vector3d(1e6, 0.0, 0.0);
+  EXPECT_THROW(voxels.add(std::move(scan)), Error);
+  EXPECT_EQ(voxels.scans(), 0u);
+  EXPECT_EQ(voxels.bricks(), 0u);
 }
 
 // Whole free subtrees (new, or pruned after reaching the clamp bound) are updated as one node: every leaf

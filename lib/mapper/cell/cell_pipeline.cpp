@@ -1,14 +1,12 @@
 #include "cellmap/cell/cell_pipeline.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <sstream>
 #include <string_view>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/common/parallel.hpp"
 #include "coverage.hpp"
-#include "no_return.hpp"
+#include "stage_clock.hpp"
 
 namespace cellmap {
 namespace {
@@ -26,21 +24,6 @@ constexpr std::string_view kStateMagic = "cellmap-map-state 4";
 // from it shared with its top layer keeps its boxes (still covering all it holds) instead of being split
 // anew.
 constexpr double kRefitShare = 0.1;
-
-// Wall time of one stage, and CPU time of the calling thread with its helpers.
-class StageClock {
- public:
-  StageClock() : wall_(std::chrono::steady_clock::now()), cpu_(cpu_seconds_with_helpers()) {}
-  // Seconds since construction (wall, then CPU), written to `wall` and `cpu`.
-  void stop(double& wall, double& cpu) const {
-    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count();
-    cpu = cpu_seconds_with_helpers() - cpu_;
-  }
-
- private:
-  std::chrono::steady_clock::time_point wall_;
-  double cpu_;
-};
 
 bool contains_id(const std::vector<std::uint64_t>& ids, std::uint64_t id) {
   return std::find(ids.begin(), ids.end(), id) != ids.end();
@@ -115,34 +98,36 @@ std::size_t CellPipeline::settle_on(const Cloud& points_C) {
 
 void CellPipeline::filter_robot(const Robot& robot) {
   filter_ = std::make_unique<SelfFilter>(robot, config_.self_filter);
+  open_.reset();
 }
 
-SweepReport CellPipeline::process(FrameSweep& frames) {
-  Sweep sweep;
-  sweep.stamp = frames.stamp;
-  std::size_t robot_points = 0, no_return_rays = 0;
-  const StageClock filter_clock;
-  sweep.scans.reserve(frames.frames.size());
-  for (SweepFrame& f : frames.frames) {
-    if (!filter_ || !f.robot || !config_.self_filter.enabled) {
-      sweep.scans.push_back(move_to_scan(f.frame));
-    } else {
-      SelfFilterResult filtered = filter_->filter(f.frame, *f.robot);
-      robot_points += filtered.removed;
-      sweep.scans.push_back(std::move(filtered.scan));
-    }
-    if (f.no_return_range > 0.0)
-      no_return_rays +=
-          add_no_return_rays(f.frame, f.no_return_range, no_return_phase_++, sweep.scans.back());
-  }
-  double t_filter = 0, cpu_filter = 0;
-  filter_clock.stop(t_filter, cpu_filter);
-  SweepReport report = process(sweep);
-  report.frames = frames.frames.size();
-  report.robot_points = robot_points;
-  report.no_return_rays = no_return_rays;
-  report.t_filter = t_filter;
-  report.cpu_filter = cpu_filter;
+OpenSweep CellPipeline::open_sweep() const {
+  return OpenSweep(config_.occupancy, config_.self_filter.enabled ? filter_.get() : nullptr);
+}
+
+SweepReport CellPipeline::process(FrameSweep sweep) {
+  if (!open_) open_.emplace(open_sweep());
+  for (SweepFrame& frame : sweep.frames) open_->add(std::move(frame));
+  GatheredSweep gathered = open_->close();
+  return process(gathered);
+}
+
+SweepReport CellPipeline::process(GatheredSweep& sweep) {
+  SweepReport report;
+  report.points = sweep.points;
+  report.frames = sweep.frames.frames.size();
+  report.robot_points = sweep.robot_points;
+  report.no_return_rays = sweep.no_return_rays;
+  report.t_filter = sweep.t_filter;
+  report.cpu_filter = sweep.cpu_filter;
+  if (!sweep.frames.frames.empty()) viewpoint_C_ = sweep.viewpoint_C;
+
+  const StageClock update_clock;
+  const OccupancyUpdate update = map_.integrate(sweep.voxels);
+  update_clock.add_to(report.t_update, report.cpu_update);
+  report.t_fuse = sweep.t_gather + report.t_update;
+  report.cpu_fuse = sweep.cpu_gather + report.cpu_update;
+  detect_and_resegment(update, report);
   return report;
 }
 
@@ -154,26 +139,32 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
 
   const StageClock fuse_clock;
   const OccupancyUpdate update = map_.integrate(sweep);
-  fuse_clock.stop(report.t_fuse, report.cpu_fuse);
+  fuse_clock.add_to(report.t_fuse, report.cpu_fuse);
+  report.t_update = report.t_fuse;
+  report.cpu_update = report.cpu_fuse;
+  detect_and_resegment(update, report);
+  return report;
+}
+
+void CellPipeline::detect_and_resegment(const OccupancyUpdate& update, SweepReport& report) {
   report.hit_voxels = update.hit_voxels;
   report.free_voxels = update.free_voxels;
   report.flipped = update.appeared.size() + update.vanished.size();
 
   const StageClock change_clock;
   ChangeSet changes = detector_.update(update, map_);
-  change_clock.stop(report.t_change, report.cpu_change);
+  change_clock.add_to(report.t_change, report.cpu_change);
   report.regions = changes.regions.size();
   report.boxes = boxes_.size();
-  if (!resegmentation_due(changes)) return report;
+  if (!resegmentation_due(changes)) return;
 
   const StageClock segment_clock;
   // The map has settled: one segmentation of all of it makes the first version; changes from then on.
   Resegmentation resegmentation = settling_ ? resegment_everything() : resegment(changes);
   settling_ = false;
-  segment_clock.stop(report.t_segment, report.cpu_segment);
+  segment_clock.add_to(report.t_segment, report.cpu_segment);
   report.changes = std::move(changes);
   apply(std::move(resegmentation), report);
-  return report;
 }
 
 void CellPipeline::update_viewpoint(const Sweep& sweep) {

@@ -709,4 +709,41 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
   return update;
 }
 
+void KeyUpdateUnion::add(const KeyUpdate& scan_update) {
+  for (const KeyBrick& brick : scan_update.bricks) {
+    const auto [at, inserted] = index_.try_emplace(pack(brick.base), bricks_.size());
+    if (inserted) {
+      bricks_.push_back(brick);
+      continue;
+    }
+    KeyBrick& gathered = bricks_[at->second];
+    for (int w = 0; w < kBrickWords; ++w) {
+      gathered.occupied[std::size_t(w)] |= brick.occupied[std::size_t(w)];
+      gathered.free[std::size_t(w)] |= brick.free[std::size_t(w)];
+    }
+  }
+}
+
+KeyUpdate KeyUpdateUnion::take() {
+  KeyUpdate update;
+  // Sorted as (morton of the base, position) pairs rather than as 1 KB structs.
+  std::vector<std::pair<std::uint64_t, std::size_t>> order;
+  order.reserve(bricks_.size());
+  for (std::size_t b = 0; b < bricks_.size(); ++b) order.emplace_back(morton(bricks_[b].base), b);
+  std::sort(order.begin(), order.end());
+  update.bricks.reserve(order.size());
+  for (const auto& entry : order) {
+    KeyBrick& brick = update.bricks.emplace_back(bricks_[entry.second]);
+    for (int w = 0; w < kBrickWords; ++w) {
+      // A voxel one scan cleared and another hit is a hit of the sweep.
+      brick.free[std::size_t(w)] &= ~brick.occupied[std::size_t(w)];
+      update.occupied_count += std::size_t(__builtin_popcountll(brick.occupied[std::size_t(w)]));
+      update.free_count += std::size_t(__builtin_popcountll(brick.free[std::size_t(w)]));
+    }
+  }
+  bricks_.clear();
+  index_.clear();
+  return update;
+}
+
 }  // namespace cellmap

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "cellmap/sweep/sweep.hpp"
@@ -60,5 +61,24 @@ struct KeyUpdate final {
 /// @throws Error if a scan origin is not finite or outside the tree's key range, or `max_range` is not > 0.
 [[nodiscard]] KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, double max_range,
                                            int threads);
+
+/// The key update of a sweep gathered scan by scan: the union of the scans' updates, occupied winning over
+/// free across all of them, which is exactly compute_key_update() of the sweep of those scans (each scan's
+/// voxels depend on that scan alone). Memory: one brick (1 KB) per brick any scan touched. Not thread-safe.
+class KeyUpdateUnion final {
+ public:
+  /// Adds the update of one more scan of the sweep (compute_key_update of a sweep holding that scan).
+  void add(const KeyUpdate& scan_update);
+  /// Whether no scan added a voxel yet.
+  [[nodiscard]] bool empty() const { return bricks_.empty(); }
+  /// Bricks gathered so far.
+  [[nodiscard]] std::size_t size() const { return bricks_.size(); }
+  /// The sweep's update (bricks in depth-first order, counts set); the union is empty afterwards.
+  [[nodiscard]] KeyUpdate take();
+
+ private:
+  std::vector<KeyBrick> bricks_;                          // in the order first touched
+  std::unordered_map<std::uint64_t, std::size_t> index_;  // packed brick base → position in bricks_
+};
 
 }  // namespace cellmap

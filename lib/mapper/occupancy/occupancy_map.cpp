@@ -45,8 +45,41 @@ OccupancyMap::OccupancyMap(const OccupancyConfig& config) : config_(config) {
   apply_sensor_model(config_, *tree_);
 }
 
+ObservedVoxels::ObservedVoxels(const OccupancyConfig& config)
+    : config_(config), union_(std::make_unique<KeyUpdateUnion>()) {
+  config_.validate();
+  grid_ = std::make_unique<octomap::OcTree>(config_.resolution);
+}
+
+ObservedVoxels::~ObservedVoxels() = default;
+ObservedVoxels::ObservedVoxels(ObservedVoxels&&) noexcept = default;
+ObservedVoxels& ObservedVoxels::operator=(ObservedVoxels&&) noexcept = default;
+
+void ObservedVoxels::add(Scan scan) {
+  Sweep one;
+  one.scans.push_back(std::move(scan));
+  union_->add(compute_key_update(one, *grid_, config_.max_range, config_.threads));
+  ++scans_;
+}
+
+std::size_t ObservedVoxels::bricks() const {
+  return union_->size();
+}
+
 OccupancyUpdate OccupancyMap::integrate(const Sweep& sweep) {
-  const KeyUpdate keys = compute_key_update(sweep, *tree_, config_.max_range, config_.threads);
+  return apply(compute_key_update(sweep, *tree_, config_.max_range, config_.threads));
+}
+
+OccupancyUpdate OccupancyMap::integrate(ObservedVoxels& voxels) {
+  if (voxels.config_.resolution != config_.resolution) {
+    throw Error("occupancy: voxels gathered at resolution " + std::to_string(voxels.config_.resolution) +
+                " m cannot be fused into a map of " + std::to_string(config_.resolution) + " m");
+  }
+  voxels.scans_ = 0;
+  return apply(voxels.union_->take());
+}
+
+OccupancyUpdate OccupancyMap::apply(const KeyUpdate& keys) {
   OccupancyUpdate update;
   update.hit_voxels = keys.occupied_count;
   update.free_voxels = keys.free_count;

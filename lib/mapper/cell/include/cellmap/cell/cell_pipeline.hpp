@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cellmap/boxes/box.hpp"
+#include "cellmap/cell/open_sweep.hpp"
 #include "cellmap/change/change_detector.hpp"
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/environment/reconcile.hpp"
@@ -25,36 +26,12 @@ namespace cellmap {
 
 class OccupiedVoxels;
 
-/// One frame of a sweep window: posed in the cell (frame.X_CS set; cameras keep depth->intrinsics for the
-/// self filter) with the robot as it stood at the frame's stamp (JointBuffer::at); nullopt: the cell has no
-/// robot model, the frame is fused as it is.
-struct SweepFrame final {
-  Frame frame;
-  std::optional<RobotAt> robot;
-  /// Metres along its line of sight that a pixel without a return clears (the source's `no_return_range`;
-  /// cameras whose frame keeps its depth image; 0 = none). A time-of-flight camera returns from every
-  /// surface within its range but the darkest and the shiniest, so no return says the line of sight is free
-  /// that far: the only evidence that clears space in front of what lies beyond the camera's range (an
-  /// object taken away whose top the camera saw against the cell's far side). Such rays are not stopped at
-  /// the robot: a line of sight with no return passed it. Off for stereo cameras (no return on plain
-  /// surfaces) and where dark or mirror-like obstacles may stand. Each frame casts the rays of one pixel of
-  /// every 2 × 2 block, the next frame (of any such camera) the next pixel: a quarter of the cost, every
-  /// pixel used within four frames.
-  double no_return_range = 0.0;
-};
-
-/// The frames of every sensor in one sweep window, in the order taken. `stamp`: the last frame's, seconds.
-struct FrameSweep final {
-  double stamp = 0.0;
-  std::vector<SweepFrame> frames;
-};
-
 /// Everything the cell pipeline is configured with: five sections of a config file and the settling policy.
 struct CellPipelineConfig final {
   OccupancyConfig occupancy;     ///< `occupancy` section
   ChangeConfig change;           ///< `change` section (change detection)
   SegmentConfig segment;         ///< `segment` section: the keys of config/segment.yaml
-  ReconcileParams reconcile;    ///< `reconcile` section
+  ReconcileParams reconcile;     ///< `reconcile` section
   SelfFilterConfig self_filter;  ///< `self_filter` section (used once the pipeline knows the robot)
   /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, [0, 100000]; default
   /// 15). A fresh map keeps gaining voxels for a while (surfaces seen at grazing angles need several sweeps
@@ -90,18 +67,21 @@ struct SweepReport final {
   std::size_t frames = 0;          ///< frames in the sweep
   std::size_t robot_points = 0;    ///< points the self filter found on the robot (fused as clear-only rays)
   std::size_t no_return_rays = 0;  ///< clear-only rays of pixels without a return
-  double t_filter = 0;             ///< seconds the self filter took for all frames
+  double t_filter = 0;             ///< seconds the self filter took for all frames (frames to scans included)
   std::size_t hit_voxels = 0;      ///< voxels that got a hit
   std::size_t free_voxels = 0;     ///< voxels that got free-space evidence
   std::size_t flipped = 0;         ///< voxels whose occupied/free state flipped in this sweep
   std::size_t regions = 0;         ///< change regions confirmed in this sweep
   std::size_t evidence = 0;        ///< occupied voxels re-segmented
   std::size_t boxes = 0;           ///< boxes after the sweep
-  double t_fuse = 0, t_change = 0, t_segment = 0;  ///< seconds
-  /// CPU seconds of the self filter (frames to scans included), fusion, change detection and re-segmentation
-  /// on the calling thread and the helper threads it split them onto (cpu_seconds_with_helpers()): what a
-  /// stage costs, which a wall time on a shared machine hides.
-  double cpu_filter = 0, cpu_fuse = 0, cpu_change = 0, cpu_segment = 0;
+  /// Seconds of fusion (the voxels the frames observed, gathered as they came, and the map update at the
+  /// sweep's end), of the map update alone, of change detection and of re-segmentation. Of fusion only the
+  /// map update waits for the sweep's end; for a Sweep of scans fusion is all map update.
+  double t_fuse = 0, t_update = 0, t_change = 0, t_segment = 0;
+  /// CPU seconds of the same stages, and of the self filter, on the threads that ran them and the helper
+  /// threads they split them onto (cpu_seconds_with_helpers()): what a stage costs, which a wall time on a
+  /// shared machine hides.
+  double cpu_filter = 0, cpu_fuse = 0, cpu_update = 0, cpu_change = 0, cpu_segment = 0;
   ChangeSet changes;  ///< the change regions re-segmented in this sweep (gathered over gather_sweeps)
   std::optional<Reconciled> change;  ///< set when the boxes changed (a new version is due)
 };
@@ -128,14 +108,19 @@ class CellPipeline final {
                         std::uint64_t next_box_id = 1,
                         const std::optional<std::string>& map_state = std::nullopt);
 
-  /// Cuts the robot out of every frame that comes with one (SelfFilter, once filter_robot() was called and
-  /// `self_filter.enabled`), then process(Sweep) on the scans. The frames that pass unfiltered give their
-  /// points to their scans (move_to_scan: transformed where they lie, not copied), so those frames'
-  /// points_S are empty afterwards; every frame keeps its pose, stamp and depth image for the caller.
-  /// @throws Error as SelfFilter::filter.
-  SweepReport process(FrameSweep& sweep);
-  /// process(sweep) for a sweep nobody reads afterwards.
-  SweepReport process(FrameSweep&& sweep) { return process(sweep); }
+  /// Gathers the frames of `sweep` in an OpenSweep of this pipeline's (the robot cut out of every frame
+  /// that comes with one, once filter_robot() was called and `self_filter.enabled`), then
+  /// process(GatheredSweep&): what a caller that has the whole sweep at once does.
+  /// @throws Error as OpenSweep::add.
+  SweepReport process(FrameSweep sweep);
+  /// Fuses a sweep whose frames an OpenSweep gathered (open_sweep(), possibly on another thread), then
+  /// detects, re-segments and applies as process(Sweep) does. Empties `sweep.voxels`; its frames stay for
+  /// the caller.
+  SweepReport process(GatheredSweep& sweep);
+  /// An OpenSweep for this pipeline's frames: its resolution and range, and its self filter once
+  /// filter_robot() was called and `self_filter.enabled`. It refers to the filter: make it after
+  /// filter_robot(), and let it go before the pipeline.
+  [[nodiscard]] OpenSweep open_sweep() const;
   /// The robot the self filter cuts out of the frames from now on (its shapes padded once, here).
   /// @throws Error if the self-filter config is invalid.
   void filter_robot(const Robot& robot);
@@ -199,6 +184,8 @@ class CellPipeline final {
   void cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void update_viewpoint(const Sweep& sweep);
+  // Change detection and, when due, re-segmentation after the map took the sweep's update.
+  void detect_and_resegment(const OccupancyUpdate& update, SweepReport& report);
   // Whether this sweep's changes (or the end of settling) call for re-segmentation; when they do, `changes`
   // holds every change gathered since the first that waits.
   [[nodiscard]] bool resegmentation_due(ChangeSet& changes);
@@ -206,16 +193,16 @@ class CellPipeline final {
 
   CellPipelineConfig config_;
   std::unique_ptr<SelfFilter> filter_;  // set by filter_robot()
+  std::optional<OpenSweep> open_;       // gathers the frames of process(FrameSweep)
   OccupancyMap map_;
   ChangeDetector detector_;
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;
   Eigen::Vector3d viewpoint_C_ = Eigen::Vector3d::Zero();  // where normals are oriented towards
-  bool settling_ = true;          // an empty map that has not made its first version yet
-  int settled_sweeps_ = 0;        // sweeps fused while settling
-  ChangeSet gathered_;            // confirmed changes waiting to be published together
-  unsigned no_return_phase_ = 0;  // which pixel of each 2 × 2 block the next frame's no-return rays use
-  int gather_wait_ = 0;           // sweeps the gathered changes still wait
+  bool settling_ = true;    // an empty map that has not made its first version yet
+  int settled_sweeps_ = 0;  // sweeps fused while settling
+  ChangeSet gathered_;      // confirmed changes waiting to be published together
+  int gather_wait_ = 0;     // sweeps the gathered changes still wait
 };
 
 }  // namespace cellmap

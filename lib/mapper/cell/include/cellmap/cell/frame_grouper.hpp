@@ -3,34 +3,40 @@
 // grouped by their stamps into sweep windows, whichever sensor took them.
 
 #include <cstddef>
-#include <optional>
-#include <vector>
 
-#include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/sweep/sweep_assembler.hpp"
 
 namespace cellmap {
 
-/// Groups posed frames into sweeps. A sweep spans at most `grouping.period` seconds of frame time from its
-/// first frame's stamp: a frame stamped at or after that closes it and opens the next one; a frame stamped
-/// earlier (a slower sensor's) joins the open sweep, so no posed frame is lost. A sweep also closes once it
-/// holds `grouping.max_frames` frames (0: no limit). Period 0: every frame is its own sweep, handed out when
-/// the next one arrives or at flush(). Frames keep their order of arrival. Not thread-safe.
+/// Where a frame falls in the stream of sweeps (FrameGrouper::place).
+struct FramePlace final {
+  bool ends_open_sweep = false;  ///< the open sweep is complete without this frame, which opens the next
+  bool completes_sweep = false;  ///< the frame's sweep is complete with it (`grouping.max_frames` reached)
+};
+
+/// Groups posed frames into sweeps as they arrive, so that each frame can be fused at once and the end of
+/// its sweep is known when it comes. A sweep spans at most `grouping.period` seconds of frame time from its
+/// first frame's stamp: a frame stamped at or after that ends it and opens the next one; a frame stamped
+/// earlier (a slower sensor's) joins the open sweep, so no posed frame is lost. A sweep also ends once it
+/// holds `grouping.max_frames` frames (0: no limit). Period 0: every frame is a sweep of its own, ended when
+/// the next one arrives or at flush(). Holds no frames, only the open sweep's first stamp and frame count.
+/// Not thread-safe.
 class FrameGrouper final {
  public:
   /// @throws Error if the grouping is invalid (SweepParams::validate).
   explicit FrameGrouper(const SweepParams& grouping);
 
-  /// Adds a posed frame; returns the sweeps it closed (none, one, or two with max_frames 1), oldest first.
-  [[nodiscard]] std::vector<FrameSweep> add(SweepFrame frame);
-  /// Hands out the open sweep, if it holds a frame (a sensor stopped streaming; nothing more will close it).
-  [[nodiscard]] std::optional<FrameSweep> flush();
+  /// Places a frame stamped `stamp` (seconds) in the stream: whether it ends the open sweep before it and
+  /// whether its sweep is complete with it.
+  [[nodiscard]] FramePlace place(double stamp);
+  /// Ends the open sweep (a sensor stopped streaming; nothing more will end it); false if it held no frame.
+  [[nodiscard]] bool flush();
   /// Frames in the open sweep.
-  [[nodiscard]] std::size_t open_frames() const { return open_.frames.size(); }
+  [[nodiscard]] std::size_t open_frames() const { return open_frames_; }
 
  private:
   SweepParams grouping_;
-  FrameSweep open_;
+  std::size_t open_frames_ = 0;
   double open_first_stamp_ = 0.0;
 };
 

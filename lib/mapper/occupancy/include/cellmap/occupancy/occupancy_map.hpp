@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <iosfwd>
+#include <memory>
 #include <vector>
 
 #include "cellmap/common/region.hpp"
@@ -22,6 +23,42 @@ struct OccupancyUpdate final {
   std::size_t free_voxels = 0;               ///< voxels that received free-space evidence
   std::vector<octomap::OcTreeKey> appeared;  ///< voxels occupied now that were free or unknown before
   std::vector<octomap::OcTreeKey> vanished;  ///< voxels free now that were occupied before
+};
+
+class KeyUpdateUnion;
+struct KeyUpdate;
+
+/// The voxels one sweep observes, gathered scan by scan while its frames arrive, so that fusing a sweep is
+/// spread over the time it takes and its end leaves only the map update (OccupancyMap::integrate). The
+/// scans added one by one make exactly the map integrate(Sweep) makes of them all. Independent of any map:
+/// only the config's resolution (the key layout), max_range and threads are used. Movable, not copyable;
+/// not thread-safe (one instance per thread).
+class ObservedVoxels final {
+ public:
+  /// @throws Error if `config` is invalid (see OccupancyConfig::validate).
+  explicit ObservedVoxels(const OccupancyConfig& config = {});
+  ~ObservedVoxels();
+  ObservedVoxels(ObservedVoxels&&) noexcept;
+  ObservedVoxels& operator=(ObservedVoxels&&) noexcept;
+  ObservedVoxels(const ObservedVoxels&) = delete;
+  ObservedVoxels& operator=(const ObservedVoxels&) = delete;
+
+  /// Adds the voxels `scan` observes: the occupied ones at its points, the free ones along its rays and
+  /// clear-only rays (the rules of OccupancyMap::integrate). Costs what fusing the scan costs, on
+  /// config.threads threads; the scan is consumed (pass it moved: its points are not copied). @throws Error
+  /// if the scan's origin is not finite or outside the key range (nothing of it is added).
+  void add(Scan scan);
+  /// Scans added since construction or the last OccupancyMap::integrate of these voxels.
+  [[nodiscard]] std::size_t scans() const { return scans_; }
+  /// Voxels gathered so far, as bricks of 16³ voxels (1 KB each): the memory they hold.
+  [[nodiscard]] std::size_t bricks() const;
+
+ private:
+  friend class OccupancyMap;
+  OccupancyConfig config_;
+  std::unique_ptr<octomap::OcTree> grid_;  // the key layout; never holds a node
+  std::unique_ptr<KeyUpdateUnion> union_;
+  std::size_t scans_ = 0;
 };
 
 /// Occupancy of one voxel. Unknown = never observed.
@@ -48,6 +85,10 @@ class OccupancyMap final {
   /// @return the voxels whose occupied/free state flipped, for change detection.
   /// @throws Error if a scan origin is not finite or outside the map's key range.
   OccupancyUpdate integrate(const Sweep& sweep);
+  /// Fuses the sweep whose scans `voxels` gathered (the same map as integrate(Sweep) of those scans) and
+  /// empties `voxels` for the next sweep. The config's resolution must equal the one `voxels` was made with.
+  /// @throws Error if it does not (nothing is fused then).
+  OccupancyUpdate integrate(ObservedVoxels& voxels);
 
   /// Takes one cloud (metres, cell frame) as settled evidence: every voxel holding one of its points is set
   /// to the upper clamp (occupied), nothing is cleared. What a batch cloud gives the map when there are no
@@ -86,6 +127,8 @@ class OccupancyMap final {
   [[nodiscard]] const OccupancyConfig& config() const { return config_; }
 
  private:
+  OccupancyUpdate apply(const KeyUpdate& keys);
+
   OccupancyConfig config_;
   std::unique_ptr<octomap::OcTree> tree_;
 };
