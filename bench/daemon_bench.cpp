@@ -334,7 +334,7 @@ struct Totals {
 
 // Wall seconds the gathering thread spent on one sweep's frames as they came.
 double gathering_wall(const SweepReport& r) {
-  return r.t_filter + r.t_fuse - r.t_update;
+  return r.t_gathering;
 }
 
 // Wall seconds the processing thread spent on one sweep once it was gathered, stage by stage: what a

@@ -161,27 +161,31 @@ void Daemon::gather() {
     std::optional<FrameItem> item = frames_.take(milliseconds(100));
     if (!item) {
       if (stop_ || acquisition_was_done) break;
-    } else if (item->frame) {
-      add_frame(open, std::move(*item->frame));
-    } else if (open.frames() > 0) {
-      hand_over(open.close());
+      continue;
     }
+    bool sweep_ended = !item->frame;
+    std::vector<SweepFrame> batch;
+    if (item->frame) batch.push_back(std::move(*item->frame));
+    // Frames of the same sweep waiting behind it are gathered side by side, a thread each.
+    while (!sweep_ended && batch.size() < std::size_t(config_.pipeline.occupancy.threads)) {
+      std::optional<FrameItem> next = frames_.take(milliseconds(0));
+      if (!next) break;
+      sweep_ended = !next->frame;
+      if (next->frame) batch.push_back(std::move(*next->frame));
+    }
+    add_frames(open, std::move(batch));
+    if (sweep_ended && open.frames() > 0) hand_over(open.close());
   }
   gathering_done_ = true;
 }
 
-void Daemon::add_frame(OpenSweep& open, SweepFrame frame) {
-  const std::string sensor = frame.frame.sensor;
-  const double stamp = frame.frame.stamp;
-  try {
-    open.add(std::move(frame));
-  } catch (const Error& e) {
-    const std::string reason = "frame of '" + sensor + "' at " + std::to_string(stamp) + " s: " + e.what();
-    health_.sweep_failed(reason);
+void Daemon::add_frames(OpenSweep& open, std::vector<SweepFrame> frames) {
+  for (const std::string& fault : open.add(std::move(frames))) {
+    health_.sweep_failed(fault);
     ++frame_faults_;
     // At frame rate a fault that persists would flood the log: once a second, with the count.
     if (Clock::now() >= next_frame_fault_log_) {
-      spdlog::error("{} ({} frames failed so far); keeping version {}", reason, frame_faults_,
+      spdlog::error("{} ({} frames left out so far); keeping version {}", fault, frame_faults_,
                     published_version_.load());
       next_frame_fault_log_ = Clock::now() + std::chrono::seconds(1);
     }

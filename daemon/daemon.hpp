@@ -69,8 +69,8 @@ class Daemon final {
  private:
   void acquire();
   void gather();
-  // Adds a frame to the open sweep; a frame that fails is logged, reported and left out.
-  void add_frame(OpenSweep& open, SweepFrame frame);
+  // Adds frames to the open sweep; a frame that fails is logged, reported and left out.
+  void add_frames(OpenSweep& open, std::vector<SweepFrame> frames);
   // Hands the gathered sweep to the processing thread (waiting for room if the source is lossless).
   void hand_over(GatheredSweep sweep);
   void process();

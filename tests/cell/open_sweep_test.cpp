@@ -97,6 +97,42 @@ TEST(OpenSweepTest, FramesGatheredOnAnotherThreadMakeWhatTheWholeSweepMakes) {
       << "the maps (log-odds, viewpoint, pending flips) differ";
 }
 
+// Frames waiting together are gathered side by side: the same map as one by one, no-return rays included
+// (their pixel phases go frame by frame as before), and a frame that fails is left out alone.
+TEST(OpenSweepTest, FramesGatheredSideBySideMakeWhatOneByOneMakes) {
+  const KinectSweeps cell;
+  CellPipeline one_by_one(defaults()), side_by_side(defaults());
+  OpenSweep single = one_by_one.open_sweep(), batched = side_by_side.open_sweep();
+  for (std::uint64_t index = 0; index < 3; ++index) {
+    FrameSweep frames = cell.sweep(index);
+    ASSERT_GE(frames.frames.size(), 3u);
+    for (SweepFrame& frame : frames.frames) frame.no_return_range = 2.0;
+    SweepFrame broken = frames.frames.back();
+    broken.frame.sensor = "broken";
+    broken.frame.X_CS.translation() = Eigen::Vector3d(1e6, 0.0, 0.0);
+    frames.frames.insert(frames.frames.begin() + 1, broken);
+    std::vector<SweepFrame> batch = frames.frames;
+    for (SweepFrame& frame : frames.frames) {
+      if (frame.frame.sensor == "broken") {
+        EXPECT_THROW(single.add(std::move(frame)), Error);
+      } else {
+        single.add(std::move(frame));
+      }
+    }
+    const std::vector<std::string> faults = batched.add(std::move(batch));
+    ASSERT_EQ(faults.size(), 1u);
+    EXPECT_EQ(faults[0].rfind("frame of 'broken' at ", 0), 0u) << faults[0];
+    EXPECT_EQ(batched.frames(), single.frames());
+    GatheredSweep a = single.close(), b = batched.close();
+    EXPECT_EQ(b.no_return_rays, a.no_return_rays);
+    EXPECT_GT(b.no_return_rays, 0u);
+    EXPECT_LE(b.t_gathering, b.t_filter + b.t_gather + 1e-3) << "side by side counts once";
+    (void)one_by_one.process(a);
+    (void)side_by_side.process(b);
+  }
+  EXPECT_TRUE(side_by_side.map_state() == one_by_one.map_state());
+}
+
 TEST(OpenSweepTest, AGatheredFrameKeepsItsPoseAndStampNotItsPoints) {
   const KinectSweeps cell;
   FrameSweep frames = cell.sweep(0);

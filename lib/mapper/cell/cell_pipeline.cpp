@@ -120,6 +120,7 @@ SweepReport CellPipeline::process(GatheredSweep& sweep) {
   report.no_return_rays = sweep.no_return_rays;
   report.t_filter = sweep.t_filter;
   report.cpu_filter = sweep.cpu_filter;
+  report.t_gathering = sweep.t_gathering;
   if (!sweep.frames.frames.empty()) viewpoint_C_ = sweep.viewpoint_C;
 
   const StageClock update_clock;

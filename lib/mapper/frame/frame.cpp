@@ -29,31 +29,36 @@ void valid_depths(const DepthImage& image, std::vector<double>& z) {
   }
 }
 
-// Whether valid depth `zq` of a neighbour is nearer than `zp` by more than `limit`.
-inline bool nearer(double zp, double zq, double limit) {
-  return zq > 0 && zp - zq > limit;
-}
-
-// Whether a valid 8-neighbour of pixel (u, v) is nearer by more than max_jump of the pixel's depth.
+// Per pixel, the nearest valid depth (> 0) of `z` among the pixel and its 8 neighbours inside the image,
+// +infinity where there is none, written to `nearest`: two passes of a 3-wide minimum (rows, then columns)
+// that the compiler vectorizes. A pixel lies behind a depth edge exactly when its depth minus this minimum
+// exceeds the limit: the difference is largest for the nearest neighbour (subtraction rounds monotonically),
+// and the pixel itself (difference 0) never exceeds a limit ≥ 0.
 // Written here rather than taken from PCL: its ShadowPoints filter needs normals of an organized cloud
 // first, and the test on raw neighbours is a few comparisons per pixel.
-bool behind_depth_edge(const std::vector<double>& z, int width, int height, int u, int v, double max_jump) {
-  const double zp = z[static_cast<std::size_t>(v) * width + u];
-  const double limit = max_jump * zp;
-  if (u > 0 && v > 0 && u + 1 < width && v + 1 < height) {  // inside: no bounds to check
-    const double* above = &z[static_cast<std::size_t>(v - 1) * width + u];
-    const double* row = above + width;
-    const double* below = row + width;
-    return nearer(zp, above[-1], limit) || nearer(zp, above[0], limit) || nearer(zp, above[1], limit) ||
-           nearer(zp, row[-1], limit) || nearer(zp, row[1], limit) || nearer(zp, below[-1], limit) ||
-           nearer(zp, below[0], limit) || nearer(zp, below[1], limit);
-  }
-  for (int nv = std::max(0, v - 1); nv <= std::min(height - 1, v + 1); ++nv) {
-    for (int nu = std::max(0, u - 1); nu <= std::min(width - 1, u + 1); ++nu) {
-      if (nearer(zp, z[static_cast<std::size_t>(nv) * width + nu], limit)) return true;
+void nearest_around(const std::vector<double>& z, int width, int height, std::vector<double>& rows,
+                    std::vector<double>& nearest) {
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const std::size_t w = static_cast<std::size_t>(width);
+  rows.resize(z.size());
+  nearest.resize(z.size());
+  for (int v = 0; v < height; ++v) {
+    const double* in = &z[static_cast<std::size_t>(v) * w];
+    double* out = &rows[static_cast<std::size_t>(v) * w];
+    const auto valid = [](double d) { return d > 0 ? d : kNone; };
+    for (std::size_t u = 0; u < w; ++u) {
+      const double left = u > 0 ? valid(in[u - 1]) : kNone;
+      const double right = u + 1 < w ? valid(in[u + 1]) : kNone;
+      out[u] = std::min(std::min(left, valid(in[u])), right);
     }
   }
-  return false;
+  for (int v = 0; v < height; ++v) {
+    const double* row = &rows[static_cast<std::size_t>(v) * w];
+    const double* above = v > 0 ? row - w : row;
+    const double* below = v + 1 < height ? row + w : row;
+    double* out = &nearest[static_cast<std::size_t>(v) * w];
+    for (std::size_t u = 0; u < w; ++u) out[u] = std::min(std::min(above[u], row[u]), below[u]);
+  }
 }
 
 }  // namespace
@@ -72,14 +77,15 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const double inv_fx = 1.0 / k.fx;
   const double inv_fy = 1.0 / k.fy;
-  // Kept per thread: a frame's worth of doubles, fresh memory (zeroed and page-faulted) on every frame else.
-  thread_local std::vector<double> depths;
+  // Kept per thread: frames' worth of doubles, fresh memory (zeroed and page-faulted) on every frame else.
+  thread_local std::vector<double> depths, rows, nearest;
   valid_depths(image, depths);
+  if (k.max_depth_jump > 0) nearest_around(depths, k.width, k.height, rows, nearest);
   for (int v = 0; v < k.height; ++v) {
     for (int u = 0; u < k.width; ++u) {
-      const double z = depths[static_cast<std::size_t>(v) * k.width + u];
-      if (z == 0 ||
-          (k.max_depth_jump > 0 && behind_depth_edge(depths, k.width, k.height, u, v, k.max_depth_jump))) {
+      const std::size_t p = static_cast<std::size_t>(v) * k.width + u;
+      const double z = depths[p];
+      if (z == 0 || (k.max_depth_jump > 0 && z - nearest[p] > k.max_depth_jump * z)) {
         if (organized) points.emplace_back(nan, nan, nan);
         continue;
       }

@@ -710,7 +710,22 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
 }
 
 void KeyUpdateUnion::add(const KeyUpdate& scan_update) {
-  for (const KeyBrick& brick : scan_update.bricks) {
+  add(scan_update.bricks);
+}
+
+void KeyUpdateUnion::merge(KeyUpdateUnion& other) {
+  if (bricks_.empty()) {
+    std::swap(bricks_, other.bricks_);
+    std::swap(index_, other.index_);
+  } else {
+    add(other.bricks_);
+  }
+  other.bricks_.clear();
+  other.index_.clear();
+}
+
+void KeyUpdateUnion::add(const std::vector<KeyBrick>& bricks) {
+  for (const KeyBrick& brick : bricks) {
     const auto [at, inserted] = index_.try_emplace(pack(brick.base), bricks_.size());
     if (inserted) {
       bricks_.push_back(brick);

@@ -69,6 +69,8 @@ class KeyUpdateUnion final {
  public:
   /// Adds the update of one more scan of the sweep (compute_key_update of a sweep holding that scan).
   void add(const KeyUpdate& scan_update);
+  /// Adds what `other` gathered (other scans of the same sweep, e.g. on another thread); empties `other`.
+  void merge(KeyUpdateUnion& other);
   /// Whether no scan added a voxel yet.
   [[nodiscard]] bool empty() const { return bricks_.empty(); }
   /// Bricks gathered so far.
@@ -77,6 +79,8 @@ class KeyUpdateUnion final {
   [[nodiscard]] KeyUpdate take();
 
  private:
+  void add(const std::vector<KeyBrick>& bricks);
+
   std::vector<KeyBrick> bricks_;                          // in the order first touched
   std::unordered_map<std::uint64_t, std::size_t> index_;  // packed brick base → position in bricks_
 };

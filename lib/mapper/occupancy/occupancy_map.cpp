@@ -7,6 +7,7 @@
 #include <ostream>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "cellmap/common/error.hpp"
 #include "key_update.hpp"
@@ -55,11 +56,18 @@ ObservedVoxels::~ObservedVoxels() = default;
 ObservedVoxels::ObservedVoxels(ObservedVoxels&&) noexcept = default;
 ObservedVoxels& ObservedVoxels::operator=(ObservedVoxels&&) noexcept = default;
 
-void ObservedVoxels::add(Scan scan) {
+void ObservedVoxels::add(Scan scan, int threads) {
   Sweep one;
   one.scans.push_back(std::move(scan));
-  union_->add(compute_key_update(one, *grid_, config_.max_range, config_.threads));
+  union_->add(compute_key_update(one, *grid_, config_.max_range, threads > 0 ? threads : config_.threads));
   ++scans_;
+}
+
+void ObservedVoxels::merge(ObservedVoxels& other) {
+  if (other.config_.resolution != config_.resolution || other.config_.max_range != config_.max_range)
+    throw Error("occupancy: voxels gathered at another resolution or range cannot be merged");
+  union_->merge(*other.union_);
+  scans_ += std::exchange(other.scans_, 0);
 }
 
 std::size_t ObservedVoxels::bricks() const {

@@ -78,6 +78,8 @@ struct SweepReport final {
   /// sweep's end), of the map update alone, of change detection and of re-segmentation. Of fusion only the
   /// map update waits for the sweep's end; for a Sweep of scans fusion is all map update.
   double t_fuse = 0, t_update = 0, t_change = 0, t_segment = 0;
+  /// Wall seconds gathering the frames took (GatheredSweep::t_gathering; 0 for a Sweep of scans).
+  double t_gathering = 0;
   /// CPU seconds of the same stages, and of the self filter, on the threads that ran them and the helper
   /// threads they split them onto (cpu_seconds_with_helpers()): what a stage costs, which a wall time on a
   /// shared machine hides.

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "cellmap/frame/frame.hpp"
@@ -51,8 +52,10 @@ struct GatheredSweep final {
   std::size_t robot_points = 0;    ///< points the self filter found on the robot (fused as clear-only rays)
   std::size_t no_return_rays = 0;  ///< clear-only rays of pixels without a return
   /// Seconds (wall, and CPU with helper threads) of the self filter with the frames' conversion to scans,
-  /// and of gathering the scans' voxels, summed over the frames.
+  /// and of gathering the scans' voxels, summed over the frames (frames gathered side by side each count).
   double t_filter = 0, cpu_filter = 0, t_gather = 0, cpu_gather = 0;
+  /// Wall seconds the gathering of the frames took (frames gathered side by side counted once).
+  double t_gathering = 0;
 };
 
 /// The sweep whose frames are still coming. Not thread-safe: one thread adds and closes; it may be another
@@ -67,20 +70,38 @@ class OpenSweep final {
 
   /// Cuts the robot out of `frame` (when it comes with the robot's pose and a filter is set), converts it to
   /// its scan (its points moved, not copied; clear-only rays for its pixels without a return) and gathers
-  /// the voxels that scan observes. @throws Error as SelfFilter::filter or ObservedVoxels::add (the frame is
-  /// then not part of the sweep).
+  /// the voxels that scan observes, on the occupancy config's `threads`. @throws Error as SelfFilter::filter
+  /// or ObservedVoxels::add (the frame is then not part of the sweep).
   void add(SweepFrame frame);
+  /// add() for each frame of `batch` (frames of this sweep that wait, in the order taken), up to `threads`
+  /// of them side by side on one thread each: frames that wait are gathered faster that way than one after
+  /// the other on split threads. A frame that cannot be gathered is left out; the others are not affected.
+  /// @return one line per frame left out ("frame of 'wrist' at 12.345 s: reason").
+  [[nodiscard]] std::vector<std::string> add(std::vector<SweepFrame> batch);
   /// Frames added since the last close().
   [[nodiscard]] std::size_t frames() const { return open_.frames.frames.size(); }
   /// The gathered sweep, stamped with its last frame's stamp; the next frame opens a new sweep.
   [[nodiscard]] GatheredSweep close();
 
  private:
-  GatheredSweep fresh() const;
+  // What gathering one frame brought.
+  struct Gathered {
+    SweepFrame frame;
+    std::size_t points = 0, robot_points = 0, no_return_rays = 0;
+    Eigen::Vector3d origin_C = Eigen::Vector3d::Zero();
+    double t_filter = 0, cpu_filter = 0, t_gather = 0, cpu_gather = 0;
+  };
+  // Gathers `frame` into `voxels` on `threads` threads, its no-return rays with `phase`.
+  [[nodiscard]] Gathered gather(SweepFrame frame, unsigned phase, ObservedVoxels& voxels, int threads) const;
+  void record(Gathered gathered);
+  // The no-return phase of `frame`: the next one for a frame that casts no-return rays.
+  [[nodiscard]] unsigned next_phase(const SweepFrame& frame);
+  [[nodiscard]] GatheredSweep fresh() const;
 
   OccupancyConfig occupancy_;
   const SelfFilter* filter_;
   GatheredSweep open_;
+  std::vector<ObservedVoxels> side_by_side_;  // one per thread of a batch; merged into open_ at close()
   Eigen::Vector3d origin_sum_C_ = Eigen::Vector3d::Zero();
   unsigned no_return_phase_ = 0;  // which pixel of each 2 × 2 block the next frame's no-return rays use
 };

@@ -44,10 +44,14 @@ class ObservedVoxels final {
   ObservedVoxels& operator=(const ObservedVoxels&) = delete;
 
   /// Adds the voxels `scan` observes: the occupied ones at its points, the free ones along its rays and
-  /// clear-only rays (the rules of OccupancyMap::integrate). Costs what fusing the scan costs, on
-  /// config.threads threads; the scan is consumed (pass it moved: its points are not copied). @throws Error
-  /// if the scan's origin is not finite or outside the key range (nothing of it is added).
-  void add(Scan scan);
+  /// clear-only rays (the rules of OccupancyMap::integrate). Costs what fusing the scan costs, on `threads`
+  /// threads (0: config.threads; a caller that adds scans to several instances side by side gives each one);
+  /// the scan is consumed (pass it moved: its points are not copied). @throws Error if the scan's origin is
+  /// not finite or outside the key range (nothing of it is added).
+  void add(Scan scan, int threads = 0);
+  /// Adds what `other` gathered (other scans of the same sweep, e.g. on another thread) and empties it.
+  /// @throws Error if `other` was made at another resolution or range (nothing is added then).
+  void merge(ObservedVoxels& other);
   /// Scans added since construction or the last OccupancyMap::integrate of these voxels.
   [[nodiscard]] std::size_t scans() const { return scans_; }
   /// Voxels gathered so far, as bricks of 16³ voxels (1 KB each): the memory they hold.
