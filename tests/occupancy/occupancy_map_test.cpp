@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <set>
+
 #include "cellmap/common/error.hpp"
 #include "occupancy/box_scene.hpp"
 #include "tree_agreement.hpp"
@@ -160,7 +163,8 @@ std::size_t log_odds_differences(const octomap::OcTree& a, const octomap::OcTree
 
 // A sweep's scans gathered one by one as its frames arrive make the map the whole sweep makes at once,
 // log-odds for log-odds, with the same flips: over several sweeps of three overlapping views (one with
-// clear-only rays through voxels another view hits), while a box leaves.
+// clear-only rays through voxels another view hits), while a box leaves. The flips are all the occupied
+// set's changes.
 TEST(OccupancyMapTest, ScansGatheredOneByOneMakeTheWholeSweepsMap) {
   OccupancyConfig config;
   config.resolution = 0.05;
@@ -171,6 +175,10 @@ TEST(OccupancyMapTest, ScansGatheredOneByOneMakeTheWholeSweepsMap) {
                                                 camera_at({-0.37, -0.1, 0.21}, -0.1)};
   std::vector<AlignedBox> scene = testing::box_room();
   std::size_t flips = 0;
+  std::set<std::uint64_t> occupied;
+  const auto packed = [](const octomap::OcTreeKey& k) {
+    return std::uint64_t{k[0]} | std::uint64_t{k[1]} << 16 | std::uint64_t{k[2]} << 32;
+  };
   for (int sweep = 0; sweep < 5; ++sweep) {
     if (sweep == 3) scene.pop_back();  // box B leaves
     Sweep frames = sweep_of(scene, poses, 96, 72);
@@ -188,6 +196,12 @@ TEST(OccupancyMapTest, ScansGatheredOneByOneMakeTheWholeSweepsMap) {
     EXPECT_EQ(update.appeared, expected.appeared);
     EXPECT_EQ(update.vanished, expected.vanished);
     flips += update.appeared.size() + update.vanished.size();
+    // The flips reported are every change of the occupied set: a set kept by them is the map's.
+    for (const octomap::OcTreeKey& key : update.vanished) EXPECT_EQ(occupied.erase(packed(key)), 1u);
+    for (const octomap::OcTreeKey& key : update.appeared) EXPECT_TRUE(occupied.insert(packed(key)).second);
+    std::set<std::uint64_t> now;
+    for (const octomap::OcTreeKey& key : gathered.occupied_keys()) now.insert(packed(key));
+    EXPECT_EQ(now, occupied) << "sweep " << sweep;
   }
   EXPECT_GT(flips, 100u) << "the sweeps flipped too little to compare";
   const TreeAgreement agreement = compare_trees(gathered.tree(), whole.tree());

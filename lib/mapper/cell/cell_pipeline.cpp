@@ -35,6 +35,7 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
                            std::uint64_t next_box_id, const std::optional<std::string>& map_state)
     : config_(config),
       map_(config.occupancy),
+      occupied_(std::make_unique<OccupiedVoxels>()),
       detector_(config.change),
       boxes_(std::move(boxes)),
       next_box_id_(next_box_id) {
@@ -48,6 +49,10 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
                 std::to_string(config_.gather_sweeps));
   if (map_state) restore(*map_state);
 }
+
+CellPipeline::~CellPipeline() = default;
+CellPipeline::CellPipeline(CellPipeline&&) noexcept = default;
+CellPipeline& CellPipeline::operator=(CellPipeline&&) noexcept = default;
 
 void CellPipeline::restore(const std::string& map_state) {
   settling_ = false;  // a restored map has settled before
@@ -75,6 +80,7 @@ void CellPipeline::restore(const std::string& map_state) {
     throw Error(std::string("map state: ") + e.what());
   }
   map_.read(in);
+  *occupied_ = OccupiedVoxels(map_);
 }
 
 std::string CellPipeline::map_state() const {
@@ -93,7 +99,9 @@ std::size_t CellPipeline::settle_on(const Cloud& points_C) {
   for (const pcl::PointXYZ& p : points_C) points.push_back(p.getVector3fMap().cast<double>());
   viewpoint_C_ = points_C.sensor_origin_.head<3>().cast<double>();
   settling_ = false;
-  return map_.mark_occupied(points);
+  const std::size_t outside = map_.mark_occupied(points);
+  *occupied_ = OccupiedVoxels(map_);
+  return outside;
 }
 
 void CellPipeline::filter_robot(const Robot& robot) {
@@ -148,6 +156,7 @@ SweepReport CellPipeline::process(const Sweep& sweep) {
 }
 
 void CellPipeline::detect_and_resegment(const OccupancyUpdate& update, SweepReport& report) {
+  occupied_->apply(update);
   report.hit_voxels = update.hit_voxels;
   report.free_voxels = update.free_voxels;
   report.flipped = update.appeared.size() + update.vanished.size();
@@ -199,19 +208,18 @@ void CellPipeline::apply(Resegmentation resegmentation, SweepReport& report) {
 }
 
 Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
-  const OccupiedVoxels voxels(map_);
   Scope scope = scope_of(changes);
   add_boxes_within(scope);
-  add_emptied_boxes(voxels, scope);
+  add_emptied_boxes(scope);
   std::vector<Box> kept;
   for (const Box& box : boxes_) {
     if (!contains_id(scope.boxes, box.id)) kept.push_back(box);
   }
   Resegmentation result;
-  const std::vector<Box> fitted = fit_boxes(scope.area, kept, voxels, result.evidence);
+  const std::vector<Box> fitted = fit_boxes(scope.area, kept, result.evidence);
   result.reconciled = reconcile(boxes_, scope.boxes, fitted, next_box_id_, config_.reconcile);
   // Noise alone makes no version: what it added is taken up by the next version a change makes.
-  if (config_.cover_every_version && result.reconciled.changed()) cover_the_rest(voxels, result.reconciled);
+  if (config_.cover_every_version && result.reconciled.changed()) cover_the_rest(result.reconciled);
   return result;
 }
 
@@ -250,24 +258,24 @@ void CellPipeline::add_boxes_within(Scope& scope) const {
 // Boxes that hold no obstacle voxel any more join the scope (and, with nothing to fit, go): the rest of an
 // object's old place that cleared piece by piece after its change was published (hidden by the robot then),
 // each piece beside voxels not yet cleared and so never a change region of its own.
-void CellPipeline::add_emptied_boxes(const OccupiedVoxels& voxels, Scope& scope) const {
+void CellPipeline::add_emptied_boxes(Scope& scope) const {
   for (const Box& box : boxes_) {
     if (contains_id(scope.boxes, box.id)) continue;
-    const std::vector<Eigen::Vector3d> held = map_.occupied_centres({bounds_of(box)});
-    const bool holds_evidence = std::any_of(held.begin(), held.end(), [&](const Eigen::Vector3d& c) {
-      return box.contains(c) && voxels.in_group_of(c, config_.change.min_voxels);
-    });
+    const bool holds_evidence =
+        map_.any_occupied_in(bounds_of(box), [&](const octomap::OcTreeKey& key, const Eigen::Vector3d& c) {
+          return box.contains(c) && occupied_->in_group_of(key, config_.change.min_voxels);
+        });
     if (!holds_evidence) scope.boxes.push_back(box.id);
   }
 }
 
 std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                         const OccupiedVoxels& voxels, std::size_t& evidence) const {
+                                         std::size_t& evidence) const {
   Cloud cloud;
   for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
     // A group of fewer than change.min_voxels voxels touching nothing else is noise (flying pixels that
     // collected their hits where no ray clears them), as for change detection: not an obstacle.
-    if (!voxels.in_group_of(c, config_.change.min_voxels)) continue;
+    if (!occupied_->in_group_of(map_, c, config_.change.min_voxels)) continue;
     // Evidence a kept box already holds needs no new box (e.g. the table around a new object).
     const bool covered = std::any_of(kept.begin(), kept.end(), [&](const Box& box) {
       return holds_cube(box, c, map_.config().resolution);
@@ -289,26 +297,25 @@ Resegmentation CellPipeline::resegment_everything() const {
   std::vector<std::uint64_t> scope;
   for (const Box& box : boxes_) scope.push_back(box.id);
   Resegmentation result;
-  const OccupiedVoxels voxels(map_);
-  const std::vector<Box> fitted = fit_boxes({whole}, {}, voxels, result.evidence);
+  const std::vector<Box> fitted = fit_boxes({whole}, {}, result.evidence);
   result.reconciled = reconcile(boxes_, scope, fitted, next_box_id_, config_.reconcile);
-  cover_the_rest(voxels, result.reconciled);
+  cover_the_rest(result.reconciled);
   return result;
 }
 
 std::size_t CellPipeline::voxels_outside_boxes(int min_group) const {
-  return voxels_outside(map_, OccupiedVoxels(map_), boxes_, min_group).size();
+  return voxels_outside(map_, *occupied_, boxes_, min_group).size();
 }
 
 // Every obstacle voxel wholly inside a box at every version: also those that noise added outside the changed
 // area since that area was last fitted (a surface seen at grazing angles filling in, flying pixels collecting
 // their hits in space no ray clears) and those a box kept by reconcile within its tolerance leaves out.
-void CellPipeline::cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const {
+void CellPipeline::cover_the_rest(Reconciled& reconciled) const {
   CoverParams options;
   options.voxel = map_.config().resolution;
   options.max_growth = config_.segment.join_max_growth;
   options.kind = config_.segment.box_kind;
-  cover(reconciled, voxels_outside(map_, voxels, reconciled.boxes, config_.change.min_voxels), options);
+  cover(reconciled, voxels_outside(map_, *occupied_, reconciled.boxes, config_.change.min_voxels), options);
 }
 
 }  // namespace cellmap

@@ -32,7 +32,7 @@ CloudBoxes boxes_of_cloud(const Cloud& points_C, const CellPipelineConfig& confi
   for (const pcl::PointXYZ& p : points_C) {
     const Eigen::Vector3d p_C = p.getVector3fMap().cast<double>();
     if (map.state(p_C) != VoxelState::occupied) continue;  // outside the key range: counted above
-    if (!voxels.in_group_of(p_C, config.change.min_voxels)) {
+    if (!voxels.in_group_of(map, p_C, config.change.min_voxels)) {
       ++result.noise_points;
     } else if (std::none_of(result.boxes.boxes.begin(), result.boxes.boxes.end(),
                             [&](const Box& box) { return box.contains(p_C, kTolerance); })) {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <tuple>
 #include <unordered_map>
 
 namespace cellmap {
@@ -102,7 +104,23 @@ bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge) {
 }
 
 OccupiedVoxels::OccupiedVoxels(const OccupancyMap& map)
-    : map_(map), keys_(map.occupied_keys()), set_(keys_.begin(), keys_.end()) {}
+    : keys_(map.occupied_keys()), set_(keys_.begin(), keys_.end()) {}
+
+void OccupiedVoxels::apply(const OccupancyUpdate& update) {
+  if (update.appeared.empty() && update.vanished.empty()) return;
+  const auto zyx = [](const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
+    return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+  };
+  std::vector<octomap::OcTreeKey> kept;
+  kept.reserve(keys_.size());
+  std::set_difference(keys_.begin(), keys_.end(), update.vanished.begin(), update.vanished.end(),
+                      std::back_inserter(kept), zyx);
+  keys_.clear();
+  std::merge(kept.begin(), kept.end(), update.appeared.begin(), update.appeared.end(),
+             std::back_inserter(keys_), zyx);
+  for (const octomap::OcTreeKey& key : update.vanished) set_.erase(key);
+  set_.insert(update.appeared.begin(), update.appeared.end());
+}
 
 bool OccupiedVoxels::in_group_of(const octomap::OcTreeKey& seed, int size) const {
   if (set_.count(seed) == 0) return false;
@@ -121,10 +139,10 @@ bool OccupiedVoxels::in_group_of(const octomap::OcTreeKey& seed, int size) const
   return static_cast<int>(found.size()) >= size;
 }
 
-bool OccupiedVoxels::in_group_of(const Eigen::Vector3d& centre_C, int size) const {
-  return in_group_of(map_.tree().coordToKey(octomap::point3d(static_cast<float>(centre_C.x()),
-                                                             static_cast<float>(centre_C.y()),
-                                                             static_cast<float>(centre_C.z()))),
+bool OccupiedVoxels::in_group_of(const OccupancyMap& map, const Eigen::Vector3d& centre_C, int size) const {
+  return in_group_of(map.tree().coordToKey(octomap::point3d(static_cast<float>(centre_C.x()),
+                                                            static_cast<float>(centre_C.y()),
+                                                            static_cast<float>(centre_C.z()))),
                      size);
 }
 

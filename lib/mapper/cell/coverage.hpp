@@ -17,19 +17,24 @@ namespace cellmap {
 /// Whether `box` holds the whole axis-aligned cube of edge `edge` around `centre_C` (0.1 µm tolerance).
 [[nodiscard]] bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge);
 
-/// The occupied voxels of a map at one moment, hashed for neighbour queries.
+/// The occupied voxels of a map, hashed for neighbour queries; kept up with the map sweep by sweep from the
+/// flips each update reports, so that a version does not pay a pass over the whole map for them.
 class OccupiedVoxels final {
  public:
+  OccupiedVoxels() = default;
+  /// Every occupied voxel of `map` now.
   explicit OccupiedVoxels(const OccupancyMap& map);
+  /// Follows the map through one update: `update` is what OccupancyMap::integrate returned for the map
+  /// these voxels are of (appeared and vanished sorted by key (z, y, x)).
+  void apply(const OccupancyUpdate& update);
   /// Whether the voxel `key` is occupied and one of a 26-connected group of at least `size` occupied voxels.
   [[nodiscard]] bool in_group_of(const octomap::OcTreeKey& key, int size) const;
-  /// As above, for the voxel whose centre is `centre_C`.
-  [[nodiscard]] bool in_group_of(const Eigen::Vector3d& centre_C, int size) const;
+  /// As above, for the voxel of `map` whose centre is `centre_C`.
+  [[nodiscard]] bool in_group_of(const OccupancyMap& map, const Eigen::Vector3d& centre_C, int size) const;
   /// Every occupied voxel, sorted by key (z, y, x).
   [[nodiscard]] const std::vector<octomap::OcTreeKey>& keys() const { return keys_; }
 
  private:
-  const OccupancyMap& map_;
   std::vector<octomap::OcTreeKey> keys_;
   std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> set_;
 };

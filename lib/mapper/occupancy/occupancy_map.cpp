@@ -214,6 +214,32 @@ std::vector<Eigen::Vector3d> OccupancyMap::occupied_centres(const std::vector<Re
   return centres;
 }
 
+bool OccupancyMap::any_occupied_in(
+    const Region& region,
+    const std::function<bool(const octomap::OcTreeKey& key, const Eigen::Vector3d& centre_C)>& accept) const {
+  if (region.volume() <= 0) return false;
+  const octomap::point3d min(static_cast<float>(region.min.x()), static_cast<float>(region.min.y()),
+                             static_cast<float>(region.min.z()));
+  const octomap::point3d max(static_cast<float>(region.max.x()), static_cast<float>(region.max.y()),
+                             static_cast<float>(region.max.z()));
+  for (auto it = tree_->begin_leafs_bbx(min, max), end = tree_->end_leafs_bbx(); it != end; ++it) {
+    if (!tree_->isNodeOccupied(*it)) continue;
+    // A pruned leaf stands for a block of equal voxels: each one is asked.
+    const int span = 1 << (tree_->getTreeDepth() - it.getDepth());
+    const octomap::OcTreeKey base = it.getIndexKey();
+    for (int dz = 0; dz < span; ++dz) {
+      for (int dy = 0; dy < span; ++dy) {
+        for (int dx = 0; dx < span; ++dx) {
+          const octomap::OcTreeKey key(base[0] + dx, base[1] + dy, base[2] + dz);
+          const Eigen::Vector3d c = centre(key);
+          if (region.contains(c) && accept(key, c)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
 void OccupancyMap::write(std::ostream& out) const {
   out.precision(17);
   out << "cellmap-occupancy resolution " << config_.resolution << "\n";

@@ -109,6 +109,9 @@ class CellPipeline final {
   explicit CellPipeline(const CellPipelineConfig& config, std::vector<Box> boxes = {},
                         std::uint64_t next_box_id = 1,
                         const std::optional<std::string>& map_state = std::nullopt);
+  ~CellPipeline();
+  CellPipeline(CellPipeline&&) noexcept;
+  CellPipeline& operator=(CellPipeline&&) noexcept;
 
   /// Gathers the frames of `sweep` in an OpenSweep of this pipeline's (the robot cut out of every frame
   /// that comes with one, once filter_robot() was called and `self_filter.enabled`), then
@@ -178,12 +181,12 @@ class CellPipeline final {
   // Adds to `scope` the boxes lying wholly inside its area (to a voxel).
   void add_boxes_within(Scope& scope) const;
   // Adds to `scope` the boxes that hold no obstacle voxel any more.
-  void add_emptied_boxes(const OccupiedVoxels& voxels, Scope& scope) const;
+  void add_emptied_boxes(Scope& scope) const;
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                           const OccupiedVoxels& voxels, std::size_t& evidence) const;
+                                           std::size_t& evidence) const;
   // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
-  void cover_the_rest(const OccupiedVoxels& voxels, Reconciled& reconciled) const;
+  void cover_the_rest(Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void update_viewpoint(const Sweep& sweep);
   // Change detection and, when due, re-segmentation after the map took the sweep's update.
@@ -197,6 +200,7 @@ class CellPipeline final {
   std::unique_ptr<SelfFilter> filter_;  // set by filter_robot()
   std::optional<OpenSweep> open_;       // gathers the frames of process(FrameSweep)
   OccupancyMap map_;
+  std::unique_ptr<OccupiedVoxels> occupied_;  // the map's occupied voxels, kept up sweep by sweep
   ChangeDetector detector_;
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;

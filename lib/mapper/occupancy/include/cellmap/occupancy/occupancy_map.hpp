@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <vector>
@@ -117,6 +118,12 @@ class OccupancyMap final {
   /// Centres of the occupied leaf voxels inside any of `regions` (metres, cell frame), each voxel once, in
   /// (z, y, x) key order. Cost: a bounding-box walk of the tree per region.
   [[nodiscard]] std::vector<Eigen::Vector3d> occupied_centres(const std::vector<Region>& regions) const;
+  /// Whether some occupied leaf voxel whose centre lies in `region` (metres, cell frame) satisfies
+  /// `accept(key, centre_C)`; stops at the first that does. Cost: the tree's leaves overlapping the region
+  /// up to that voxel (all of them when none does).
+  [[nodiscard]] bool any_occupied_in(
+      const Region& region,
+      const std::function<bool(const octomap::OcTreeKey& key, const Eigen::Vector3d& centre_C)>& accept) const;
 
   /// Writes the whole map, log-odds included, to `out` (a resolution line, then OctoMap's node data), so a
   /// restarted daemon continues with the same evidence. Silent (OctoMap's .bt writer prints to stderr).
