@@ -180,7 +180,9 @@ class Recording {
       scene.sensors[static_cast<std::size_t>(sensor)].intrinsics = camera.intrinsics;
       camera.X_ES = scene.sensors[static_cast<std::size_t>(sensor)].X_ES;
       if (with_crate) scene.obstacles.push_back(crate());
-      const sim::Simulator simulator(std::move(scene));
+      // Without the gantry: the recordings carry no robot pose for a self filter, so they show the cell as
+      // the filter would leave it (the robot mapped as an obstacle would make versions of its own motion).
+      const sim::Simulator simulator(std::move(scene), sim::SimOptions{true, 2, false});
       for (int stop = 0; stop < stops_; ++stop) {
         sim::SimFrame rendered =
             simulator.render(sensor, q_at(stop), 0.0, with_crate ? 1 : 0, static_cast<std::uint64_t>(stop));
