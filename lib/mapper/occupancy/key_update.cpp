@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -145,23 +146,29 @@ struct BrickGrid {
   }
 };
 
-// Walk position in a dense BrickGrid: per axis a pointer into its offset table; the bit index is the sum of
-// the three entries. A step moves one pointer (chosen without a branch: the caller passes 0 for the others).
+// Walk position in a dense BrickGrid: per axis a pointer into its offset table and the entry it points at;
+// the bit index is the sum of the three entries. A walk copies its cursor, so that this state lives in
+// registers.
 class DenseCursor {
  public:
   DenseCursor(const BrickGrid& grid, std::uint64_t* words) : grid_(grid), words_(words), bits_(grid.bits()) {}
-  // Starts at `from`, the walk ending at `to`; false if `from` is outside the grid.
-  bool start(const Key& from, const Key& to) {
-    for (int i = 0; i < 3; ++i) at_[i] = grid_.offset[i].data() + grid_.slot(i, from[i]);
-    index_ = *at_[0] + *at_[1] + *at_[2];
+  // Starts at `from`, the walk ending at `to` and moving by `step` (-1, 0 or +1 per axis); false if `from` is
+  // outside the grid.
+  bool start(const Key& from, const Key& to, const int step[3]) {
+    for (int i = 0; i < 3; ++i) {
+      at_[i] = grid_.offset[i].data() + grid_.slot(i, from[i]);
+      entry_[i] = *at_[i];
+      step_[i] = step[i];
+    }
+    index_ = entry_[0] + entry_[1] + entry_[2];
     end_ = grid_.index(to);
     return index_ < bits_;
   }
-  void step(int dx, int dy, int dz) {
-    at_[0] += dx;
-    at_[1] += dy;
-    at_[2] += dz;
-    index_ = *at_[0] + *at_[1] + *at_[2];
+  template <int kAxis>
+  void step() {
+    at_[kAxis] += step_[kAxis];
+    entry_[kAxis] = *at_[kAxis];
+    index_ = entry_[0] + entry_[1] + entry_[2];
   }
   // At the end voxel, or out of the grid (one test: a guard entry makes the index ≥ bits).
   [[nodiscard]] bool done() const { return (index_ == end_) | (index_ >= bits_); }
@@ -172,37 +179,40 @@ class DenseCursor {
   std::uint64_t* words_;
   std::uint32_t bits_;
   const std::uint32_t* at_[3] = {nullptr, nullptr, nullptr};
+  std::uint32_t entry_[3] = {0, 0, 0};
+  int step_[3] = {0, 0, 0};
   std::uint32_t index_ = 0, end_ = 0;
 };
 
 // Walk position that lists packed keys (for boxes too large for a dense bit array).
 class SparseCursor {
  public:
-  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
-  bool start(const Key& from, const Key& to) {
+  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(&out) {}
+  bool start(const Key& from, const Key& to, const int step[3]) {
     for (int i = 0; i < 3; ++i) {
       key_[i] = from[i];
       end_[i] = to[i];
+      step_[i] = step[i];
     }
     return true;
   }
-  void step(int dx, int dy, int dz) {
-    key_[0] += dx;
-    key_[1] += dy;
-    key_[2] += dz;
+  template <int kAxis>
+  void step() {
+    key_[kAxis] += step_[kAxis];
   }
   [[nodiscard]] bool done() const {
     return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) ||
            ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0;
   }
   void mark() {
-    out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
+    out_->push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
   }
 
  private:
-  std::vector<std::uint64_t>& out_;
+  std::vector<std::uint64_t>* out_;
   int key_[3] = {0, 0, 0};
   int end_[3] = {0, 0, 0};
+  int step_[3] = {0, 0, 0};
 };
 
 void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
@@ -302,48 +312,44 @@ WalkStart walk_start(const Origin& origin, const Ray& ray, const octomap::OcTree
 
 // Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic (walk_start,
 // the same tie-breaking between axes and the same stop rule) so that the crossed voxels match OctoMap's, but
-// it hands each voxel to `cursor` instead of storing the ray. The origin voxel is included, the end voxel is
-// not; a ray within one voxel marks nothing. The walk stops where it leaves the cursor's grid (it never comes
-// back on that axis).
+// it hands each voxel to `cursor` (a copy, kept in registers) instead of storing the ray. The origin voxel is
+// included, the end voxel is not; a ray within one voxel marks nothing. The walk stops where it leaves the
+// cursor's grid (it never comes back on that axis).
 template <class Cursor>
-void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
-  if (origin.key == ray.end_key || !cursor.start(origin.key, ray.end_key)) return;
-  cursor.mark();
+void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor cursor) {
+  if (origin.key == ray.end_key) return;
   const WalkStart w = walk_start(origin, ray, grid);
-  // The loop keeps everything in scalars; the compiler makes the axis choice a branch, which lets the next
-  // step start before the comparison ends. A branch-free choice (min and masks) measured slower: every step
-  // then waits for the comparison.
+  if (!cursor.start(origin.key, ray.end_key, w.step)) return;
+  cursor.mark();
   double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
   const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
-  const int sx = w.step[0], sy = w.step[1], sz = w.step[2];
+  const double length = w.length;
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
   int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
                    std::abs(int(ray.end_key[2]) - int(origin.key[2]));
-  // OctoMap steps, stops at the end voxel, then stops if the next crossing (the smallest crossing distance)
-  // lies past the end point (rounding at a corner), and else marks the voxel. The next crossing is also what
-  // chooses the next step, so each turn chooses once and tests once.
-  bool x_axis = false, y_axis = false, z_axis = false;
-  double t_next = 0.0;
-  auto choose = [&] {
-    // OctoMap's tie-breaking: the later axis wins ties.
-    const bool x_before_y = tx < ty;
-    const double t_xy = x_before_y ? tx : ty;
-    z_axis = !(t_xy < tz);
-    x_axis = !z_axis && x_before_y;
-    y_axis = !z_axis && !x_before_y;
-    t_next = z_axis ? tz : t_xy;
-  };
-  choose();
-  while (steps_left-- > 0) {
-    cursor.step(x_axis ? sx : 0, y_axis ? sy : 0, z_axis ? sz : 0);
-    tx = x_axis ? tx + dx : tx;
-    ty = y_axis ? ty + dy : ty;
-    tz = z_axis ? tz + dz : tz;
-    if (cursor.done()) return;
-    choose();
-    if (t_next > w.length) return;
+  // OctoMap steps along the axis of the nearest crossing, stops at the end voxel, then stops if the next
+  // crossing lies past the end point (rounding at a corner), and else marks the voxel. Testing the chosen
+  // crossing before the step is the same rule (the first step's crossing is the nearest of all, so a walk
+  // that would stop after it marks nothing either way). Each axis has its own code path: the choice is a
+  // branch, which lets the next step start before the comparison ends (a branch-free choice measured
+  // slower: every step then waits for the comparison).
+  auto advance = [&](double& t, double delta, auto axis) {
+    if (t > length) return false;
+    t += delta;
+    cursor.template step<decltype(axis)::value>();
+    if (cursor.done()) return false;
     cursor.mark();
+    return true;
+  };
+  using X = std::integral_constant<int, 0>;
+  using Y = std::integral_constant<int, 1>;
+  using Z = std::integral_constant<int, 2>;
+  while (steps_left-- > 0) {
+    // OctoMap's tie-breaking: the later axis wins ties.
+    const bool more = tx < ty ? (tx < tz ? advance(tx, dx, X{}) : advance(tz, dz, Z{}))
+                              : (ty < tz ? advance(ty, dy, Y{}) : advance(tz, dz, Z{}));
+    if (!more) return;
   }
 }
 
