@@ -368,8 +368,7 @@ constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
 // OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
 // resolution) + the tree's key offset. Branch-free, so that a run of points costs the same whether or not
-// neighbouring points share a voxel (a branch on that is mispredicted at every voxel border); on SSE2 (every
-// x86-64) a point's three coordinates are converted together.
+// neighbouring points share a voxel (a branch on that is mispredicted at every voxel border).
 class KeyConverter {
  public:
   explicit KeyConverter(const octomap::OcTree& grid)
@@ -393,37 +392,66 @@ class KeyConverter {
     return inside ? packed : kNoKey;
   }
 
-  // key(p.x, p.y, p.z), bit for bit.
-  [[nodiscard]] std::uint64_t key(const pcl::PointXYZ& p) const {
+  // out[i] = key(p[i].x, p[i].y, p[i].z) for i < count, bit for bit; `redo` has room for `count` indices.
+  void keys(const pcl::PointXYZ* p, std::size_t count, std::uint64_t* out, std::uint32_t* redo) const {
+    std::size_t i = 0;
 #if defined(__SSE2__)
-    const __m128d factor = _mm_set1_pd(factor_);
-    const __m128d low = _mm_set1_pd(-double(max_val_));
-    const __m128d high = _mm_set1_pd(double(max_val_));
-    const __m128 xyzw = _mm_loadu_ps(p.data);  // the fourth lane is PCL's padding, ignored
-    const __m128d xy = _mm_mul_pd(_mm_cvtps_pd(xyzw), factor);
-    const __m128d zw = _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(xyzw, xyzw)), factor);
-    const __m128d xy_in = _mm_and_pd(_mm_cmpge_pd(xy, low), _mm_cmplt_pd(xy, high));
-    const __m128d zw_in = _mm_and_pd(_mm_cmpge_pd(zw, low), _mm_cmplt_pd(zw, high));
-    const bool inside = (_mm_movemask_pd(xy_in) == 3) & ((_mm_movemask_pd(zw_in) & 1) == 1);
-    const __m128i floored = _mm_unpacklo_epi64(floor(_mm_and_pd(xy, xy_in)), floor(_mm_and_pd(zw, zw_in)));
-    const __m128i keys = _mm_add_epi32(floored, _mm_set1_epi32(max_val_));  // x, y, z, (padding)
-    const auto xy_keys = std::uint64_t(_mm_cvtsi128_si64(keys));
-    const auto z_key = std::uint64_t(std::uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(keys, 8))));
-    const std::uint64_t packed =
-        (xy_keys & 0xffff) | ((xy_keys >> 16) & 0xffff0000) | ((z_key & 0xffff) << 32);
-    return inside ? packed : kNoKey;
+    std::size_t redo_count = 0;
+    for (; i + 4 <= count; i += 4) redo_count = four_keys(p, i, out, redo, redo_count);
+    for (std::size_t r = 0; r < redo_count; ++r) out[redo[r]] = key(p[redo[r]].x, p[redo[r]].y, p[redo[r]].z);
 #else
-    return key(p.x, p.y, p.z);
+    (void)redo;
 #endif
+    for (; i < count; ++i) out[i] = key(p[i].x, p[i].y, p[i].z);
   }
 
  private:
 #if defined(__SSE2__)
-  // floor() of two doubles in int32 lanes 0 and 1 (lanes 2 and 3 are not used).
-  static __m128i floor(__m128d s) {
-    const __m128i truncated = _mm_cvttpd_epi32(s);
-    const __m128i rounded_up = _mm_castpd_si128(_mm_cmpgt_pd(_mm_cvtepi32_pd(truncated), s));
-    return _mm_add_epi32(truncated, _mm_shuffle_epi32(rounded_up, _MM_SHUFFLE(3, 3, 2, 0)));  // -1 there
+  // Points i .. i + 3 at once in single precision (four lanes per instruction instead of two): u = x ×
+  // factor + 32768 differs from OctoMap's double x × factor + 32768 by less than 2^-8 + 2^-9 inside the key
+  // range (rounding of the factor, the product and the sum), so trunc(u), which is floor(u) for u ≥ 0, is
+  // OctoMap's key unless an integer lies within 2^-7 of u. The indices of points with such a coordinate
+  // (about 8 %: depths in whole millimetres often put z × 50 next to an integer) are appended to `redo`
+  // without a branch, to be redone with key(); returns the new count.
+  std::size_t four_keys(const pcl::PointXYZ* p, std::size_t i, std::uint64_t* out, std::uint32_t* redo,
+                        std::size_t redo_count) const {
+    const __m128 p0 = _mm_loadu_ps(p[i].data), p1 = _mm_loadu_ps(p[i + 1].data);
+    const __m128 p2 = _mm_loadu_ps(p[i + 2].data), p3 = _mm_loadu_ps(p[i + 3].data);
+    const __m128 xy01 = _mm_unpacklo_ps(p0, p1), xy23 = _mm_unpacklo_ps(p2, p3);  // x0 x1 y0 y1, x2 x3 y2 y3
+    const __m128 z01 = _mm_unpackhi_ps(p0, p1), z23 = _mm_unpackhi_ps(p2, p3);    // z0 z1 _ _, z2 z3 _ _
+    __m128 near = _mm_setzero_ps();
+    __m128 inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    const __m128i kx = axis_keys(_mm_movelh_ps(xy01, xy23), near, inside);
+    const __m128i ky = axis_keys(_mm_movehl_ps(xy23, xy01), near, inside);
+    const __m128i kz = axis_keys(_mm_movelh_ps(z01, z23), near, inside);
+    const __m128i xy = _mm_or_si128(kx, _mm_slli_epi32(ky, 16));
+    const __m128i outside = _mm_xor_si128(_mm_castps_si128(inside), _mm_set1_epi32(-1));
+    // Packed z:y:x per point; an outside point's key is all ones (kNoKey).
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                     _mm_or_si128(_mm_unpacklo_epi32(xy, kz), _mm_unpacklo_epi32(outside, outside)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i + 2),
+                     _mm_or_si128(_mm_unpackhi_epi32(xy, kz), _mm_unpackhi_epi32(outside, outside)));
+    const int lanes = _mm_movemask_ps(near);
+    for (int lane = 0; lane < 4; ++lane) {
+      redo[redo_count] = std::uint32_t(i) + std::uint32_t(lane);
+      redo_count += std::size_t((lanes >> lane) & 1);
+    }
+    return redo_count;
+  }
+
+  // trunc(v × factor + 32768) of four coordinates (the key where `inside` and not `near`); clears `inside`
+  // where out of the key range (or not finite) and sets `near` where single precision may be off by one.
+  __m128i axis_keys(__m128 v, __m128& near, __m128& inside) const {
+    const __m128 offset = _mm_set1_ps(float(max_val_));
+    const __m128 tolerance = _mm_set1_ps(0x1p-7f);
+    const __m128 u = _mm_add_ps(_mm_mul_ps(v, _mm_set1_ps(float(factor_))), offset);
+    const __m128i truncated = _mm_cvttps_epi32(u);
+    const __m128 fraction = _mm_sub_ps(u, _mm_cvtepi32_ps(truncated));  // exact
+    near = _mm_or_ps(near, _mm_or_ps(_mm_cmple_ps(fraction, tolerance),
+                                     _mm_cmpge_ps(fraction, _mm_sub_ps(_mm_set1_ps(1.0f), tolerance))));
+    inside = _mm_and_ps(
+        inside, _mm_and_ps(_mm_cmpge_ps(u, _mm_setzero_ps()), _mm_cmplt_ps(u, _mm_add_ps(offset, offset))));
+    return truncated;
   }
 #endif
 
@@ -432,22 +460,24 @@ class KeyConverter {
 };
 
 // Appends to `keys` the packed keys of `points` [begin, end), skipping invalid points and repeats of the
-// previous key (neighbouring pixels mostly share a voxel), and extends `box` by them. Compacts block by
-// block through a small buffer, so that no frame-sized memory is written twice.
+// previous point's key (neighbouring pixels mostly share a voxel), and extends `box` by them. Converts and
+// compacts block by block through a small buffer, so that no frame-sized memory is written twice.
 void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator<pcl::PointXYZ>>& points,
                        std::size_t begin, std::size_t end, const KeyConverter& converter,
                        std::vector<std::uint64_t>& keys, KeyBox& box) {
   constexpr std::size_t kBlock = 256;
   std::uint64_t block[kBlock];
+  std::uint32_t redo[kBlock];
   std::uint64_t last = kNoKey;
   for (std::size_t block_begin = begin; block_begin < end; block_begin += kBlock) {
-    const std::size_t block_end = std::min(end, block_begin + kBlock);
+    const std::size_t count = std::min(end - block_begin, kBlock);
+    converter.keys(points.data() + block_begin, count, block, redo);
     std::size_t n = 0;
-    for (std::size_t i = block_begin; i < block_end; ++i) {
-      const std::uint64_t packed = converter.key(points[i]);
-      block[n] = packed;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint64_t packed = block[i];
+      block[n] = packed;  // n <= i: compacts in place
       n += std::size_t((packed != last) & (packed != kNoKey));
-      last = packed == kNoKey ? last : packed;
+      last = packed;
     }
     for (std::size_t i = 0; i < n; ++i) box.extend(unpack(block[i]));
     keys.insert(keys.end(), block, block + n);
