@@ -250,6 +250,35 @@ TEST(KeyUpdateTest, PointsAtVoxelBordersGetOctomapsKeys) {
   EXPECT_GT(expected.size(), 700u);
 }
 
+// Rays cut at max_range whose cut ends lie on voxel faces, edges and corners (along the axes and diagonals
+// from a voxel centre and from a voxel corner), where rounding decides whether the walk enters the end voxel
+// or stops beside it: the same free voxels as OctoMap's computeDiscreteUpdate.
+TEST(KeyUpdateTest, RaysCutOnVoxelFacesEqualOctomap) {
+  octomap::OcTree tree(0.02);
+  for (const Eigen::Vector3d& origin : {Eigen::Vector3d(0.01, 0.01, 0.01), Eigen::Vector3d(0.0, 0.0, 0.0)}) {
+    Sweep sweep;
+    Scan& scan = sweep.scans.emplace_back();
+    scan.origin_C = origin;
+    for (int x = -2; x <= 2; ++x) {
+      for (int y = -2; y <= 2; ++y) {
+        for (int z = -1; z <= 1; ++z) {
+          if (x == 0 && y == 0 && z == 0) continue;
+          const Eigen::Vector3d p = origin + 5.0 * Eigen::Vector3d(x, y, z).normalized();
+          scan.points_C.push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+        }
+      }
+    }
+    for (int k = 10; k < 60; ++k) {
+      const double max_range = 0.01 * k;
+      octomap::KeySet free, occupied;
+      tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), free, occupied, max_range);
+      const KeyUpdate ours = compute_key_update(sweep, tree, max_range, 2);
+      EXPECT_EQ(ours.free_keys(), sorted(free)) << "max_range " << max_range;
+      EXPECT_TRUE(ours.occupied_keys().empty());
+    }
+  }
+}
+
 // Whether every point of `scan` gets coordToKeyChecked's key (as an occupied voxel of the update).
 void expect_octomaps_point_keys(const octomap::OcTree& tree, Scan scan) {
   octomap::KeySet expected;

@@ -63,10 +63,22 @@ struct KeyBox {
   [[nodiscard]] bool empty() const { return hi[0] < lo[0]; }
   [[nodiscard]] std::uint64_t size(int i) const { return static_cast<std::uint64_t>(hi[i] - lo[i] + 1); }
   [[nodiscard]] std::uint64_t volume() const { return empty() ? 0 : size(0) * size(1) * size(2); }
-  [[nodiscard]] std::uint64_t index(const Key& k) const {
-    return (std::uint64_t(k[2] - lo[2]) * size(1) + std::uint64_t(k[1] - lo[1])) * size(0) +
-           std::uint64_t(k[0] - lo[0]);
+};
+
+// The dense index of packed keys in a KeyBox (x fastest), with its strides held in registers.
+class BoxIndex {
+ public:
+  explicit BoxIndex(const KeyBox& box)
+      : stride_y_(box.size(0)),
+        stride_z_(box.size(0) * box.size(1)),
+        first_(std::uint64_t(box.lo[0]) + std::uint64_t(box.lo[1]) * stride_y_ +
+               std::uint64_t(box.lo[2]) * stride_z_) {}
+  [[nodiscard]] std::uint64_t operator()(std::uint64_t packed) const {
+    return (packed & 0xffff) + ((packed >> 16) & 0xffff) * stride_y_ + (packed >> 32) * stride_z_ - first_;
   }
+
+ private:
+  std::uint64_t stride_y_, stride_z_, first_;
 };
 
 // Boxes larger than this fall back to sorting packed keys (a 2^28-bit set is 32 MB).
@@ -171,7 +183,8 @@ class DenseCursor {
     index_ = entry_[0] + entry_[1] + entry_[2];
   }
   // At the end voxel, or out of the grid (one test: a guard entry makes the index ≥ bits).
-  [[nodiscard]] bool done() const { return (index_ == end_) | (index_ >= bits_); }
+  [[nodiscard]] bool done() const { return (index_ == end_) | outside(); }
+  [[nodiscard]] bool outside() const { return index_ >= bits_; }
   void mark() { words_[index_ >> 6] |= std::uint64_t{1} << (index_ & 63); }
 
  private:
@@ -201,9 +214,9 @@ class SparseCursor {
     key_[kAxis] += step_[kAxis];
   }
   [[nodiscard]] bool done() const {
-    return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) ||
-           ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0;
+    return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) || outside();
   }
+  [[nodiscard]] bool outside() const { return ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0; }
   void mark() {
     out_->push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
   }
@@ -274,6 +287,7 @@ struct Origin {
 struct Ray {
   float end[3];
   Key end_key;
+  bool cut;  // ends at max_range, not at a voxel centre
   std::uint32_t origin;
 };
 
@@ -314,8 +328,10 @@ WalkStart walk_start(const Origin& origin, const Ray& ray, const octomap::OcTree
 // the same tie-breaking between axes and the same stop rule) so that the crossed voxels match OctoMap's, but
 // it hands each voxel to `cursor` (a copy, kept in registers) instead of storing the ray. The origin voxel is
 // included, the end voxel is not; a ray within one voxel marks nothing. The walk stops where it leaves the
-// cursor's grid (it never comes back on that axis).
-template <class Cursor>
+// cursor's grid (it never comes back on that axis). A ray to a voxel centre (kToCentre) needs no end-voxel
+// test: in its end voxel every next crossing lies at least half a voxel past the centre, so the length test
+// stops it there (rounding errors are below a micrometre).
+template <bool kToCentre, class Cursor>
 void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor cursor) {
   if (origin.key == ray.end_key) return;
   const WalkStart w = walk_start(origin, ray, grid);
@@ -329,18 +345,18 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
                    std::abs(int(ray.end_key[2]) - int(origin.key[2]));
   // OctoMap steps along the axis of the nearest crossing, stops at the end voxel, then stops if the next
-  // crossing lies past the end point (rounding at a corner), and else marks the voxel. Testing the chosen
-  // crossing before the step is the same rule (the first step's crossing is the nearest of all, so a walk
-  // that would stop after it marks nothing either way). Each axis has its own code path: the choice is a
-  // branch, which lets the next step start before the comparison ends (a branch-free choice measured
-  // slower: every step then waits for the comparison).
+  // crossing lies past the end point (rounding at a corner), and else marks the voxel. Here each turn tests
+  // the next crossing, marks the voxel the previous step entered (the origin voxel, marked already, on the
+  // first turn), then steps: the same rule (if the first crossing lies past the end point, OctoMap takes the
+  // first step, then stops without marking). Each axis has its own code path: the choice is a branch, which
+  // lets the next step start before the comparison ends (a branch-free choice measured slower: every step
+  // then waits for the comparison).
   auto advance = [&](double& t, double delta, auto axis) {
     if (t > length) return false;
+    cursor.mark();
     t += delta;
     cursor.template step<decltype(axis)::value>();
-    if (cursor.done()) return false;
-    cursor.mark();
-    return true;
+    return !(kToCentre ? cursor.outside() : cursor.done());
   };
   using X = std::integral_constant<int, 0>;
   using Y = std::integral_constant<int, 1>;
@@ -350,6 +366,15 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
     const bool more = tx < ty ? (tx < tz ? advance(tx, dx, X{}) : advance(tz, dz, Z{}))
                               : (ty < tz ? advance(ty, dy, Y{}) : advance(tz, dz, Z{}));
     if (!more) return;
+  }
+}
+
+template <class Cursor>
+void walk(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, const Cursor& cursor) {
+  if (ray.cut) {
+    walk_ray<false>(origin, ray, grid, cursor);
+  } else {
+    walk_ray<true>(origin, ray, grid, cursor);
   }
 }
 
@@ -534,15 +559,14 @@ DistinctKeys distinct(const ScanKeys& keys) {
     return out;
   }
   BitSet seen(keys.box.volume());
+  const BoxIndex index(keys.box);
   for (const auto& list : keys.points) {
     for (const std::uint64_t p : list) {
-      const Key k = unpack(p);
-      if (!seen.test_and_set(keys.box.index(k))) out.points.push_back(k);
+      if (!seen.test_and_set(index(p))) out.points.push_back(unpack(p));
     }
   }
   for (const std::uint64_t p : keys.clear) {
-    const Key k = unpack(p);
-    if (!seen.test_and_set(keys.box.index(k))) out.clear.push_back(k);
+    if (!seen.test_and_set(index(p))) out.clear.push_back(unpack(p));
   }
   return out;
 }
@@ -602,6 +626,7 @@ void add_rays(const octomap::OcTree& grid, double max_range, std::uint32_t s, co
     const RayEnd end = ray_to(grid, out.origins[s], k, max_range, ray);
     if (end == RayEnd::kOutside) continue;
     if (hit && end == RayEnd::kVoxel) out.hits.push_back(k);
+    ray.cut = end == RayEnd::kCut;
     ray.origin = s;
     out.box.extend(ray.end_key);
     out.rays.push_back(ray);
@@ -633,7 +658,7 @@ std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& br
     sets[t].assign(bricks.bits() / 64, 0);
     DenseCursor cursor(bricks, sets[t].data());
     for (std::size_t r = begin; r < end; ++r)
-      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
   });
   std::vector<std::uint64_t>& crossed = sets[0];
   for (std::size_t t = 1; t < sets.size(); ++t) {
@@ -648,7 +673,7 @@ std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcT
   run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
     SparseCursor cursor(lists[t]);
     for (std::size_t r = begin; r < end; ++r)
-      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
   });
   std::vector<std::uint64_t> all;
   for (const auto& list : lists) all.insert(all.end(), list.begin(), list.end());
