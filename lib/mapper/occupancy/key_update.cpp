@@ -369,6 +369,7 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   }
 }
 
+// Walks `ray`, with the end-voxel test only where it is needed (a ray cut at max_range).
 template <class Cursor>
 void walk(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, const Cursor& cursor) {
   if (ray.cut) {
