@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -33,6 +34,7 @@ TEST(ParallelTest, ItemTRunsOnThreadTAndHelpersAreKeptBetweenCalls) {
   EXPECT_EQ(first[0], std::this_thread::get_id());
   EXPECT_NE(first[1], first[0]);
   EXPECT_NE(first[2], first[1]);
+  EXPECT_NE(first[2], first[0]);
   EXPECT_EQ(second, first);
 }
 
@@ -44,6 +46,21 @@ TEST(ParallelTest, NestedCallsAndOtherCallingThreadsRunTheirOwnHelpers) {
   std::thread caller([&] { parallel_for(6, 3, [&](int) { ++other; }); });
   caller.join();
   EXPECT_EQ(other.load(), 6);
+}
+
+TEST(ParallelTest, AnExceptionOnTheCallingThreadWaitsForTheHelpers) {
+  std::atomic<int> helped{0};
+  EXPECT_THROW(parallel_for(3, 3,
+                            [&](int t) {
+                              if (t == 0) throw std::runtime_error("item 0");
+                              spin(0.01);
+                              ++helped;
+                            }),
+               std::runtime_error);
+  EXPECT_EQ(helped.load(), 2);
+  std::atomic<int> after{0};
+  parallel_for(3, 3, [&](int) { ++after; });
+  EXPECT_EQ(after.load(), 3);
 }
 
 TEST(ParallelTest, HelperCpuCountsForTheCallingThread) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -71,10 +72,16 @@ class HelperPool {
       ++generation_;
     }
     wake_.notify_all();
-    share(0);
+    std::exception_ptr error;  // the helpers still use `share`: wait for them before passing it on
+    try {
+      share(0);
+    } catch (...) {
+      error = std::current_exception();
+    }
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [this] { return pending_ == 0; });
     busy_ = false;
+    if (error) std::rethrow_exception(error);
     return cpu_;
   }
 
