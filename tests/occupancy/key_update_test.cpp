@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <tuple>
 #include <utility>
 
@@ -247,6 +248,87 @@ TEST(KeyUpdateTest, PointsAtVoxelBordersGetOctomapsKeys) {
   const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, 1);
   EXPECT_EQ(ours.occupied_keys(), sorted(expected));
   EXPECT_GT(expected.size(), 700u);
+}
+
+// Rays cut at max_range whose cut ends lie on voxel faces, edges and corners (along the axes and diagonals
+// from a voxel centre and from a voxel corner), where rounding decides whether the walk enters the end voxel
+// or stops beside it: the same free voxels as OctoMap's computeDiscreteUpdate.
+TEST(KeyUpdateTest, RaysCutOnVoxelFacesEqualOctomap) {
+  octomap::OcTree tree(0.02);
+  for (const Eigen::Vector3d& origin : {Eigen::Vector3d(0.01, 0.01, 0.01), Eigen::Vector3d(0.0, 0.0, 0.0)}) {
+    Sweep sweep;
+    Scan& scan = sweep.scans.emplace_back();
+    scan.origin_C = origin;
+    for (int x = -2; x <= 2; ++x) {
+      for (int y = -2; y <= 2; ++y) {
+        for (int z = -1; z <= 1; ++z) {
+          if (x == 0 && y == 0 && z == 0) continue;
+          const Eigen::Vector3d p = origin + 5.0 * Eigen::Vector3d(x, y, z).normalized();
+          scan.points_C.push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+        }
+      }
+    }
+    for (int k = 10; k < 60; ++k) {
+      const double max_range = 0.01 * k;
+      octomap::KeySet free, occupied;
+      tree.computeDiscreteUpdate(to_octomap(scan), origin_of(scan), free, occupied, max_range);
+      const KeyUpdate ours = compute_key_update(sweep, tree, max_range, 2);
+      EXPECT_EQ(ours.free_keys(), sorted(free)) << "max_range " << max_range;
+      EXPECT_TRUE(ours.occupied_keys().empty());
+    }
+  }
+}
+
+// Whether every point of `scan` gets coordToKeyChecked's key (as an occupied voxel of the update).
+void expect_octomaps_point_keys(const octomap::OcTree& tree, Scan scan) {
+  octomap::KeySet expected;
+  for (const auto& p : scan.points_C) {
+    octomap::OcTreeKey key;
+    if (std::isfinite(p.x) && tree.coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key))
+      expected.insert(key);
+  }
+  Sweep sweep;
+  sweep.scans.push_back(std::move(scan));
+  const KeyUpdate ours = compute_key_update(sweep, tree, 1000.0, 2);
+  EXPECT_EQ(ours.occupied_keys(), sorted(expected)) << "resolution " << tree.getResolution();
+}
+
+// Keys of random points, of depths in whole millimetres (z × factor often lands next to an integer), of
+// points one float step from voxel borders, near the end of the key range (where single precision is
+// coarsest) and outside it, at resolutions whose factor is not a power of two or not exactly representable:
+// every point gets coordToKeyChecked's key.
+TEST(KeyUpdateTest, PointKeysEqualCoordToKeyAtSeveralResolutions) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(-2.0f, 2.0f);
+  for (const double resolution : {0.02, 0.05, 0.013, 0.1}) {
+    const octomap::OcTree tree(resolution);
+    Scan near;
+    near.origin_C = Eigen::Vector3d(0.011, -0.003, 0.002);
+    for (int i = 0; i < 3000; ++i) {
+      near.points_C.push_back(pcl::PointXYZ(coordinate(random), coordinate(random), coordinate(random)));
+      const float z = static_cast<float>(500 + i) * 0.001f;
+      near.points_C.push_back(pcl::PointXYZ(coordinate(random) * z, coordinate(random) * z, z));
+    }
+    for (int k = -100; k <= 100; ++k) {
+      const float border = static_cast<float>(k * resolution);
+      for (const float x : {std::nextafter(border, -1e9f), border, std::nextafter(border, 1e9f)}) {
+        near.points_C.push_back(pcl::PointXYZ(x, -x, 0.5f * x));
+      }
+    }
+    const float outside = static_cast<float>(40000 * resolution);  // the key range is ±32768 voxels
+    for (const float x : {outside, -outside, std::numeric_limits<float>::quiet_NaN()}) {
+      near.points_C.push_back(pcl::PointXYZ(x, 0.1f, 0.2f));
+      near.points_C.push_back(pcl::PointXYZ(0.1f, 0.2f, x));
+    }
+    expect_octomaps_point_keys(tree, near);
+    Scan far;  // the last 200 voxels of the range, seen from close by
+    far.origin_C = Eigen::Vector3d(-32500 * resolution, 0.0, 0.0);
+    for (int i = 0; i < 4000; ++i) {
+      const float x = static_cast<float>((-32768 + 0.05 * i + 1e-4 * (i % 7)) * resolution);
+      far.points_C.push_back(pcl::PointXYZ(x, coordinate(random), coordinate(random)));
+    }
+    expect_octomaps_point_keys(tree, far);
+  }
 }
 
 TEST(KeyUpdateTest, BrickIndexRoundTrips) {

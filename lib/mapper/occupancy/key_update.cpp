@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -62,10 +63,22 @@ struct KeyBox {
   [[nodiscard]] bool empty() const { return hi[0] < lo[0]; }
   [[nodiscard]] std::uint64_t size(int i) const { return static_cast<std::uint64_t>(hi[i] - lo[i] + 1); }
   [[nodiscard]] std::uint64_t volume() const { return empty() ? 0 : size(0) * size(1) * size(2); }
-  [[nodiscard]] std::uint64_t index(const Key& k) const {
-    return (std::uint64_t(k[2] - lo[2]) * size(1) + std::uint64_t(k[1] - lo[1])) * size(0) +
-           std::uint64_t(k[0] - lo[0]);
+};
+
+// The dense index of packed keys in a KeyBox (x fastest), with its strides held in registers.
+class BoxIndex {
+ public:
+  explicit BoxIndex(const KeyBox& box)
+      : stride_y_(box.size(0)),
+        stride_z_(box.size(0) * box.size(1)),
+        first_(std::uint64_t(box.lo[0]) + std::uint64_t(box.lo[1]) * stride_y_ +
+               std::uint64_t(box.lo[2]) * stride_z_) {}
+  [[nodiscard]] std::uint64_t operator()(std::uint64_t packed) const {
+    return (packed & 0xffff) + ((packed >> 16) & 0xffff) * stride_y_ + (packed >> 32) * stride_z_ - first_;
   }
+
+ private:
+  std::uint64_t stride_y_, stride_z_, first_;
 };
 
 // Boxes larger than this fall back to sorting packed keys (a 2^28-bit set is 32 MB).
@@ -145,26 +158,33 @@ struct BrickGrid {
   }
 };
 
-// Walk position in a dense BrickGrid: per axis a pointer into its offset table; the bit index is the sum of
-// the three entries. A step moves one pointer (chosen without a branch: the caller passes 0 for the others).
+// Walk position in a dense BrickGrid: per axis a pointer into its offset table and the entry it points at;
+// the bit index is the sum of the three entries. A walk copies its cursor, so that this state lives in
+// registers.
 class DenseCursor {
  public:
   DenseCursor(const BrickGrid& grid, std::uint64_t* words) : grid_(grid), words_(words), bits_(grid.bits()) {}
-  // Starts at `from`, the walk ending at `to`; false if `from` is outside the grid.
-  bool start(const Key& from, const Key& to) {
-    for (int i = 0; i < 3; ++i) at_[i] = grid_.offset[i].data() + grid_.slot(i, from[i]);
-    index_ = *at_[0] + *at_[1] + *at_[2];
+  // Starts at `from`, the walk ending at `to` and moving by `step` (-1, 0 or +1 per axis); false if `from` is
+  // outside the grid.
+  bool start(const Key& from, const Key& to, const int step[3]) {
+    for (int i = 0; i < 3; ++i) {
+      at_[i] = grid_.offset[i].data() + grid_.slot(i, from[i]);
+      entry_[i] = *at_[i];
+      step_[i] = step[i];
+    }
+    index_ = entry_[0] + entry_[1] + entry_[2];
     end_ = grid_.index(to);
     return index_ < bits_;
   }
-  void step(int dx, int dy, int dz) {
-    at_[0] += dx;
-    at_[1] += dy;
-    at_[2] += dz;
-    index_ = *at_[0] + *at_[1] + *at_[2];
+  template <int kAxis>
+  void step() {
+    at_[kAxis] += step_[kAxis];
+    entry_[kAxis] = *at_[kAxis];
+    index_ = entry_[0] + entry_[1] + entry_[2];
   }
   // At the end voxel, or out of the grid (one test: a guard entry makes the index ≥ bits).
-  [[nodiscard]] bool done() const { return (index_ == end_) | (index_ >= bits_); }
+  [[nodiscard]] bool done() const { return (index_ == end_) | outside(); }
+  [[nodiscard]] bool outside() const { return index_ >= bits_; }
   void mark() { words_[index_ >> 6] |= std::uint64_t{1} << (index_ & 63); }
 
  private:
@@ -172,37 +192,40 @@ class DenseCursor {
   std::uint64_t* words_;
   std::uint32_t bits_;
   const std::uint32_t* at_[3] = {nullptr, nullptr, nullptr};
+  std::uint32_t entry_[3] = {0, 0, 0};
+  int step_[3] = {0, 0, 0};
   std::uint32_t index_ = 0, end_ = 0;
 };
 
 // Walk position that lists packed keys (for boxes too large for a dense bit array).
 class SparseCursor {
  public:
-  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(out) {}
-  bool start(const Key& from, const Key& to) {
+  explicit SparseCursor(std::vector<std::uint64_t>& out) : out_(&out) {}
+  bool start(const Key& from, const Key& to, const int step[3]) {
     for (int i = 0; i < 3; ++i) {
       key_[i] = from[i];
       end_[i] = to[i];
+      step_[i] = step[i];
     }
     return true;
   }
-  void step(int dx, int dy, int dz) {
-    key_[0] += dx;
-    key_[1] += dy;
-    key_[2] += dz;
+  template <int kAxis>
+  void step() {
+    key_[kAxis] += step_[kAxis];
   }
   [[nodiscard]] bool done() const {
-    return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) ||
-           ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0;
+    return (key_[0] == end_[0] && key_[1] == end_[1] && key_[2] == end_[2]) || outside();
   }
+  [[nodiscard]] bool outside() const { return ((key_[0] | key_[1] | key_[2]) & ~0xffff) != 0; }
   void mark() {
-    out_.push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
+    out_->push_back(std::uint64_t(key_[0]) | (std::uint64_t(key_[1]) << 16) | (std::uint64_t(key_[2]) << 32));
   }
 
  private:
-  std::vector<std::uint64_t>& out_;
+  std::vector<std::uint64_t>* out_;
   int key_[3] = {0, 0, 0};
   int end_[3] = {0, 0, 0};
+  int step_[3] = {0, 0, 0};
 };
 
 void set_bit(std::vector<std::uint64_t>& words, std::uint64_t i) {
@@ -264,6 +287,7 @@ struct Origin {
 struct Ray {
   float end[3];
   Key end_key;
+  bool cut;  // ends at max_range, not at a voxel centre
   std::uint32_t origin;
 };
 
@@ -302,48 +326,56 @@ WalkStart walk_start(const Origin& origin, const Ray& ray, const octomap::OcTree
 
 // Amanatides & Woo's voxel walk, in key space. It follows OctoMap's computeRayKeys arithmetic (walk_start,
 // the same tie-breaking between axes and the same stop rule) so that the crossed voxels match OctoMap's, but
-// it hands each voxel to `cursor` instead of storing the ray. The origin voxel is included, the end voxel is
-// not; a ray within one voxel marks nothing. The walk stops where it leaves the cursor's grid (it never comes
-// back on that axis).
-template <class Cursor>
-void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor& cursor) {
-  if (origin.key == ray.end_key || !cursor.start(origin.key, ray.end_key)) return;
-  cursor.mark();
+// it hands each voxel to `cursor` (a copy, kept in registers) instead of storing the ray. The origin voxel is
+// included, the end voxel is not; a ray within one voxel marks nothing. The walk stops where it leaves the
+// cursor's grid (it never comes back on that axis). A ray to a voxel centre (kToCentre) needs no end-voxel
+// test: in its end voxel every next crossing lies at least half a voxel past the centre, so the length test
+// stops it there (rounding errors are below a micrometre).
+template <bool kToCentre, class Cursor>
+void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, Cursor cursor) {
+  if (origin.key == ray.end_key) return;
   const WalkStart w = walk_start(origin, ray, grid);
-  // The loop keeps everything in scalars; the compiler makes the axis choice a branch, which lets the next
-  // step start before the comparison ends. A branch-free choice (min and masks) measured slower: every step
-  // then waits for the comparison.
+  if (!cursor.start(origin.key, ray.end_key, w.step)) return;
+  cursor.mark();
   double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
   const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
-  const int sx = w.step[0], sy = w.step[1], sz = w.step[2];
+  const double length = w.length;
   // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
   int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
                    std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
                    std::abs(int(ray.end_key[2]) - int(origin.key[2]));
-  // OctoMap steps, stops at the end voxel, then stops if the next crossing (the smallest crossing distance)
-  // lies past the end point (rounding at a corner), and else marks the voxel. The next crossing is also what
-  // chooses the next step, so each turn chooses once and tests once.
-  bool x_axis = false, y_axis = false, z_axis = false;
-  double t_next = 0.0;
-  auto choose = [&] {
-    // OctoMap's tie-breaking: the later axis wins ties.
-    const bool x_before_y = tx < ty;
-    const double t_xy = x_before_y ? tx : ty;
-    z_axis = !(t_xy < tz);
-    x_axis = !z_axis && x_before_y;
-    y_axis = !z_axis && !x_before_y;
-    t_next = z_axis ? tz : t_xy;
-  };
-  choose();
-  while (steps_left-- > 0) {
-    cursor.step(x_axis ? sx : 0, y_axis ? sy : 0, z_axis ? sz : 0);
-    tx = x_axis ? tx + dx : tx;
-    ty = y_axis ? ty + dy : ty;
-    tz = z_axis ? tz + dz : tz;
-    if (cursor.done()) return;
-    choose();
-    if (t_next > w.length) return;
+  // OctoMap steps along the axis of the nearest crossing, stops at the end voxel, then stops if the next
+  // crossing lies past the end point (rounding at a corner), and else marks the voxel. Here each turn tests
+  // the next crossing, marks the voxel the previous step entered (the origin voxel, marked already, on the
+  // first turn), then steps: the same rule (if the first crossing lies past the end point, OctoMap takes the
+  // first step, then stops without marking). Each axis has its own code path: the choice is a branch, which
+  // lets the next step start before the comparison ends (a branch-free choice measured slower: every step
+  // then waits for the comparison).
+  auto advance = [&](double& t, double delta, auto axis) {
+    if (t > length) return false;
     cursor.mark();
+    t += delta;
+    cursor.template step<decltype(axis)::value>();
+    return !(kToCentre ? cursor.outside() : cursor.done());
+  };
+  using X = std::integral_constant<int, 0>;
+  using Y = std::integral_constant<int, 1>;
+  using Z = std::integral_constant<int, 2>;
+  while (steps_left-- > 0) {
+    // OctoMap's tie-breaking: the later axis wins ties.
+    const bool more = tx < ty ? (tx < tz ? advance(tx, dx, X{}) : advance(tz, dz, Z{}))
+                              : (ty < tz ? advance(ty, dy, Y{}) : advance(tz, dz, Z{}));
+    if (!more) return;
+  }
+}
+
+// Walks `ray`, with the end-voxel test only where it is needed (a ray cut at max_range).
+template <class Cursor>
+void walk(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, const Cursor& cursor) {
+  if (ray.cut) {
+    walk_ray<false>(origin, ray, grid, cursor);
+  } else {
+    walk_ray<true>(origin, ray, grid, cursor);
   }
 }
 
@@ -362,8 +394,7 @@ constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
 // OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
 // resolution) + the tree's key offset. Branch-free, so that a run of points costs the same whether or not
-// neighbouring points share a voxel (a branch on that is mispredicted at every voxel border); on SSE2 (every
-// x86-64) a point's three coordinates are converted together.
+// neighbouring points share a voxel (a branch on that is mispredicted at every voxel border).
 class KeyConverter {
  public:
   explicit KeyConverter(const octomap::OcTree& grid)
@@ -387,37 +418,66 @@ class KeyConverter {
     return inside ? packed : kNoKey;
   }
 
-  // key(p.x, p.y, p.z), bit for bit.
-  [[nodiscard]] std::uint64_t key(const pcl::PointXYZ& p) const {
+  // out[i] = key(p[i].x, p[i].y, p[i].z) for i < count, bit for bit; `redo` has room for `count` indices.
+  void keys(const pcl::PointXYZ* p, std::size_t count, std::uint64_t* out, std::uint32_t* redo) const {
+    std::size_t i = 0;
 #if defined(__SSE2__)
-    const __m128d factor = _mm_set1_pd(factor_);
-    const __m128d low = _mm_set1_pd(-double(max_val_));
-    const __m128d high = _mm_set1_pd(double(max_val_));
-    const __m128 xyzw = _mm_loadu_ps(p.data);  // the fourth lane is PCL's padding, ignored
-    const __m128d xy = _mm_mul_pd(_mm_cvtps_pd(xyzw), factor);
-    const __m128d zw = _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(xyzw, xyzw)), factor);
-    const __m128d xy_in = _mm_and_pd(_mm_cmpge_pd(xy, low), _mm_cmplt_pd(xy, high));
-    const __m128d zw_in = _mm_and_pd(_mm_cmpge_pd(zw, low), _mm_cmplt_pd(zw, high));
-    const bool inside = (_mm_movemask_pd(xy_in) == 3) & ((_mm_movemask_pd(zw_in) & 1) == 1);
-    const __m128i floored = _mm_unpacklo_epi64(floor(_mm_and_pd(xy, xy_in)), floor(_mm_and_pd(zw, zw_in)));
-    const __m128i keys = _mm_add_epi32(floored, _mm_set1_epi32(max_val_));  // x, y, z, (padding)
-    const auto xy_keys = std::uint64_t(_mm_cvtsi128_si64(keys));
-    const auto z_key = std::uint64_t(std::uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(keys, 8))));
-    const std::uint64_t packed =
-        (xy_keys & 0xffff) | ((xy_keys >> 16) & 0xffff0000) | ((z_key & 0xffff) << 32);
-    return inside ? packed : kNoKey;
+    std::size_t redo_count = 0;
+    for (; i + 4 <= count; i += 4) redo_count = four_keys(p, i, out, redo, redo_count);
+    for (std::size_t r = 0; r < redo_count; ++r) out[redo[r]] = key(p[redo[r]].x, p[redo[r]].y, p[redo[r]].z);
 #else
-    return key(p.x, p.y, p.z);
+    (void)redo;
 #endif
+    for (; i < count; ++i) out[i] = key(p[i].x, p[i].y, p[i].z);
   }
 
  private:
 #if defined(__SSE2__)
-  // floor() of two doubles in int32 lanes 0 and 1 (lanes 2 and 3 are not used).
-  static __m128i floor(__m128d s) {
-    const __m128i truncated = _mm_cvttpd_epi32(s);
-    const __m128i rounded_up = _mm_castpd_si128(_mm_cmpgt_pd(_mm_cvtepi32_pd(truncated), s));
-    return _mm_add_epi32(truncated, _mm_shuffle_epi32(rounded_up, _MM_SHUFFLE(3, 3, 2, 0)));  // -1 there
+  // Points i .. i + 3 at once in single precision (four lanes per instruction instead of two): u = x ×
+  // factor + 32768 differs from OctoMap's double x × factor + 32768 by less than 2^-8 + 2^-9 inside the key
+  // range (rounding of the factor, the product and the sum), so trunc(u), which is floor(u) for u ≥ 0, is
+  // OctoMap's key unless an integer lies within 2^-7 of u. The indices of points with such a coordinate
+  // (about 8 %: depths in whole millimetres often put z × 50 next to an integer) are appended to `redo`
+  // without a branch, to be redone with key(); returns the new count.
+  std::size_t four_keys(const pcl::PointXYZ* p, std::size_t i, std::uint64_t* out, std::uint32_t* redo,
+                        std::size_t redo_count) const {
+    const __m128 p0 = _mm_loadu_ps(p[i].data), p1 = _mm_loadu_ps(p[i + 1].data);
+    const __m128 p2 = _mm_loadu_ps(p[i + 2].data), p3 = _mm_loadu_ps(p[i + 3].data);
+    const __m128 xy01 = _mm_unpacklo_ps(p0, p1), xy23 = _mm_unpacklo_ps(p2, p3);  // x0 x1 y0 y1, x2 x3 y2 y3
+    const __m128 z01 = _mm_unpackhi_ps(p0, p1), z23 = _mm_unpackhi_ps(p2, p3);    // z0 z1 _ _, z2 z3 _ _
+    __m128 near = _mm_setzero_ps();
+    __m128 inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    const __m128i kx = axis_keys(_mm_movelh_ps(xy01, xy23), near, inside);
+    const __m128i ky = axis_keys(_mm_movehl_ps(xy23, xy01), near, inside);
+    const __m128i kz = axis_keys(_mm_movelh_ps(z01, z23), near, inside);
+    const __m128i xy = _mm_or_si128(kx, _mm_slli_epi32(ky, 16));
+    const __m128i outside = _mm_xor_si128(_mm_castps_si128(inside), _mm_set1_epi32(-1));
+    // Packed z:y:x per point; an outside point's key is all ones (kNoKey).
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                     _mm_or_si128(_mm_unpacklo_epi32(xy, kz), _mm_unpacklo_epi32(outside, outside)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i + 2),
+                     _mm_or_si128(_mm_unpackhi_epi32(xy, kz), _mm_unpackhi_epi32(outside, outside)));
+    const int lanes = _mm_movemask_ps(near);
+    for (int lane = 0; lane < 4; ++lane) {
+      redo[redo_count] = std::uint32_t(i) + std::uint32_t(lane);
+      redo_count += std::size_t((lanes >> lane) & 1);
+    }
+    return redo_count;
+  }
+
+  // trunc(v × factor + 32768) of four coordinates (the key where `inside` and not `near`); clears `inside`
+  // where out of the key range (or not finite) and sets `near` where single precision may be off by one.
+  __m128i axis_keys(__m128 v, __m128& near, __m128& inside) const {
+    const __m128 offset = _mm_set1_ps(float(max_val_));
+    const __m128 tolerance = _mm_set1_ps(0x1p-7f);
+    const __m128 u = _mm_add_ps(_mm_mul_ps(v, _mm_set1_ps(float(factor_))), offset);
+    const __m128i truncated = _mm_cvttps_epi32(u);
+    const __m128 fraction = _mm_sub_ps(u, _mm_cvtepi32_ps(truncated));  // exact
+    near = _mm_or_ps(near, _mm_or_ps(_mm_cmple_ps(fraction, tolerance),
+                                     _mm_cmpge_ps(fraction, _mm_sub_ps(_mm_set1_ps(1.0f), tolerance))));
+    inside = _mm_and_ps(
+        inside, _mm_and_ps(_mm_cmpge_ps(u, _mm_setzero_ps()), _mm_cmplt_ps(u, _mm_add_ps(offset, offset))));
+    return truncated;
   }
 #endif
 
@@ -426,22 +486,24 @@ class KeyConverter {
 };
 
 // Appends to `keys` the packed keys of `points` [begin, end), skipping invalid points and repeats of the
-// previous key (neighbouring pixels mostly share a voxel), and extends `box` by them. Compacts block by
-// block through a small buffer, so that no frame-sized memory is written twice.
+// previous point's key (neighbouring pixels mostly share a voxel), and extends `box` by them. Converts and
+// compacts block by block through a small buffer, so that no frame-sized memory is written twice.
 void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator<pcl::PointXYZ>>& points,
                        std::size_t begin, std::size_t end, const KeyConverter& converter,
                        std::vector<std::uint64_t>& keys, KeyBox& box) {
   constexpr std::size_t kBlock = 256;
   std::uint64_t block[kBlock];
+  std::uint32_t redo[kBlock];
   std::uint64_t last = kNoKey;
   for (std::size_t block_begin = begin; block_begin < end; block_begin += kBlock) {
-    const std::size_t block_end = std::min(end, block_begin + kBlock);
+    const std::size_t count = std::min(end - block_begin, kBlock);
+    converter.keys(points.data() + block_begin, count, block, redo);
     std::size_t n = 0;
-    for (std::size_t i = block_begin; i < block_end; ++i) {
-      const std::uint64_t packed = converter.key(points[i]);
-      block[n] = packed;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint64_t packed = block[i];
+      block[n] = packed;  // n <= i: compacts in place
       n += std::size_t((packed != last) & (packed != kNoKey));
-      last = packed == kNoKey ? last : packed;
+      last = packed;
     }
     for (std::size_t i = 0; i < n; ++i) box.extend(unpack(block[i]));
     keys.insert(keys.end(), block, block + n);
@@ -498,15 +560,14 @@ DistinctKeys distinct(const ScanKeys& keys) {
     return out;
   }
   BitSet seen(keys.box.volume());
+  const BoxIndex index(keys.box);
   for (const auto& list : keys.points) {
     for (const std::uint64_t p : list) {
-      const Key k = unpack(p);
-      if (!seen.test_and_set(keys.box.index(k))) out.points.push_back(k);
+      if (!seen.test_and_set(index(p))) out.points.push_back(unpack(p));
     }
   }
   for (const std::uint64_t p : keys.clear) {
-    const Key k = unpack(p);
-    if (!seen.test_and_set(keys.box.index(k))) out.clear.push_back(k);
+    if (!seen.test_and_set(index(p))) out.clear.push_back(unpack(p));
   }
   return out;
 }
@@ -566,6 +627,7 @@ void add_rays(const octomap::OcTree& grid, double max_range, std::uint32_t s, co
     const RayEnd end = ray_to(grid, out.origins[s], k, max_range, ray);
     if (end == RayEnd::kOutside) continue;
     if (hit && end == RayEnd::kVoxel) out.hits.push_back(k);
+    ray.cut = end == RayEnd::kCut;
     ray.origin = s;
     out.box.extend(ray.end_key);
     out.rays.push_back(ray);
@@ -597,7 +659,7 @@ std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& br
     sets[t].assign(bricks.bits() / 64, 0);
     DenseCursor cursor(bricks, sets[t].data());
     for (std::size_t r = begin; r < end; ++r)
-      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
   });
   std::vector<std::uint64_t>& crossed = sets[0];
   for (std::size_t t = 1; t < sets.size(); ++t) {
@@ -612,7 +674,7 @@ std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcT
   run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
     SparseCursor cursor(lists[t]);
     for (std::size_t r = begin; r < end; ++r)
-      walk_ray(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
   });
   std::vector<std::uint64_t> all;
   for (const auto& list : lists) all.insert(all.end(), list.begin(), list.end());

@@ -5,6 +5,11 @@
 #include <time.h>
 
 #include <algorithm>
+#include <condition_variable>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -28,27 +33,119 @@ inline double cpu_seconds_with_helpers() {
   return thread_cpu_seconds() + detail::helper_cpu_seconds;
 }
 
+namespace detail {
+// Helper threads kept for one calling thread's parallel_for calls: starting a thread costs tens of µs (and
+// page faults for its stack), and the occupancy map splits its work twice per scan. Helpers wait on a
+// condition variable between calls (no spinning: they use no CPU while idle) and end with the calling
+// thread.
+class HelperPool {
+ public:
+  HelperPool() = default;
+  HelperPool(const HelperPool&) = delete;
+  HelperPool& operator=(const HelperPool&) = delete;
+  ~HelperPool() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& thread : threads_) thread.join();
+  }
+
+  // Whether a run is under way (a body that calls parallel_for again must not reuse the pool).
+  [[nodiscard]] bool busy() const { return busy_; }
+
+  // Runs share(1..helpers) on helper threads and share(0) on the caller; returns when all are done, with
+  // the CPU seconds the helpers spent on it.
+  double run(int helpers, const std::function<void(int)>& share) {
+    busy_ = true;
+    while (static_cast<int>(threads_.size()) < helpers) {
+      const int index = static_cast<int>(threads_.size()) + 1;
+      threads_.emplace_back([this, index] { serve(index); });
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      share_ = &share;
+      helpers_ = helpers;
+      pending_ = helpers;
+      cpu_ = 0.0;
+      ++generation_;
+    }
+    wake_.notify_all();
+    std::exception_ptr error;  // the helpers still use `share`: wait for them before passing it on
+    try {
+      share(0);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    busy_ = false;
+    if (error) std::rethrow_exception(error);
+    return cpu_;
+  }
+
+ private:
+  void serve(int index) {
+    std::uint64_t seen = 0;
+    for (;;) {
+      const std::function<void(int)>* share = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        if (index > helpers_) continue;  // this run needs fewer helpers
+        share = share_;
+      }
+      const double start = thread_cpu_seconds();
+      (*share)(index);
+      const double cpu = thread_cpu_seconds() - start;
+      const std::lock_guard<std::mutex> lock(mutex_);
+      cpu_ += cpu;
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::vector<std::thread> threads_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  const std::function<void(int)>* share_ = nullptr;
+  std::uint64_t generation_ = 0;
+  int helpers_ = 0, pending_ = 0;
+  double cpu_ = 0.0;
+  bool stop_ = false, busy_ = false;
+};
+
+inline HelperPool& helper_pool() {
+  thread_local HelperPool pool;
+  return pool;
+}
+}  // namespace detail
+
 /// Runs body(0..count-1) on up to `threads` threads (the calling thread is one of them) and returns when all
 /// are done. Items are interleaved, so neighbouring (similarly costly) items go to different threads; with
 /// count == threads, item t runs on thread t (the caller runs item 0). body must be safe to call
-/// concurrently for different items; which thread runs an item must not change its result.
+/// concurrently for different items; which thread runs an item must not change its result. The helper
+/// threads are kept for the calling thread's next call and end with it (a nested call from body starts
+/// threads of its own).
 template <typename Body>
 void parallel_for(int count, int threads, const Body& body) {
   threads = std::clamp(threads, 1, std::max(1, count));
-  const auto share = [&](int t) {
+  const std::function<void(int)> share = [&](int t) {
     for (int i = t; i < count; i += threads) body(i);
   };
-  std::vector<std::thread> pool;
-  std::vector<double> helper_cpu(static_cast<std::size_t>(threads), 0.0);
-  for (int t = 1; t < threads; ++t) {
-    pool.emplace_back([&, t] {
-      share(t);
-      helper_cpu[static_cast<std::size_t>(t)] = thread_cpu_seconds();
-    });
+  if (threads == 1) {
+    share(0);
+    return;
   }
-  share(0);
-  for (std::thread& thread : pool) thread.join();
-  for (const double cpu : helper_cpu) detail::helper_cpu_seconds += cpu;
+  detail::HelperPool& pool = detail::helper_pool();
+  if (!pool.busy()) {
+    detail::helper_cpu_seconds += pool.run(threads - 1, share);
+    return;
+  }
+  detail::HelperPool nested;
+  detail::helper_cpu_seconds += nested.run(threads - 1, share);
 }
 
 }  // namespace cellmap
