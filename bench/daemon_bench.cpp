@@ -245,6 +245,7 @@ class Traces {
     sweep.report = trace.report;
     if (sweep.report) sweep.report->changes = {};
     sweep.persist = trace.persist;
+    sweep.map_state = trace.map_state;
     sweep.publish = trace.publish;
     sweep.version = trace.version;
     sweep.acquisition_cpu = trace.acquisition_cpu;
@@ -256,7 +257,7 @@ class Traces {
     std::int64_t taken_ns = 0;
     std::map<std::string, std::size_t> frames_by_camera;
     std::optional<SweepReport> report;
-    daemon::StepCost persist, publish;
+    daemon::StepCost persist, publish, map_state;
     std::uint64_t version = 0;
     double acquisition_cpu = 0.0;
   };
@@ -327,7 +328,7 @@ double load_average() {
 struct Totals {
   std::map<std::string, std::size_t> fused_by_camera;
   std::size_t fused = 0;
-  double filter = 0, fuse = 0, change = 0, segment = 0, persist = 0, publish = 0;  // CPU seconds
+  double filter = 0, fuse = 0, change = 0, segment = 0, persist = 0, publish = 0, map_state = 0;  // CPU s
   double fuse_wall = 0;
   double gathering_wall = 0;   // seconds the gathering thread spent on frames (self filter, voxels; wall)
   double processing_wall = 0;  // seconds the processing thread spent on sweeps (every stage, wall)
@@ -339,8 +340,8 @@ double gathering_wall(const SweepReport& r) {
   return r.t_gathering;
 }
 
-// Wall seconds the processing thread spent on one sweep once it was gathered, stage by stage: what a
-// confirming frame waits for after its sweep ended.
+// Wall seconds the processing thread spent on one sweep once it was gathered until its version was
+// published, stage by stage: what a confirming frame waits for after its sweep ended.
 double closing_wall(const Traces::Sweep& s) {
   const SweepReport& r = *s.report;
   return r.t_update + r.t_change + r.t_segment + s.persist.wall + s.publish.wall;
@@ -361,9 +362,10 @@ Totals add_up(const std::vector<Traces::Sweep>& sweeps) {
     t.change += s.report->cpu_change;
     t.segment += s.report->cpu_segment;
     t.persist += s.persist.cpu;
+    t.map_state += s.map_state.cpu;
     t.publish += s.publish.cpu;
     t.gathering_wall += gathering_wall(*s.report);
-    t.processing_wall += closing_wall(s);
+    t.processing_wall += closing_wall(s) + s.map_state.wall;
     if (s.version != version) ++t.versions;
     version = s.version;
   }
@@ -406,13 +408,14 @@ std::vector<double> confirm_to_delta_ms(const std::vector<Traces::Sweep>& sweeps
 // The processing of the sweeps that made a version after the first, stage by stage (wall ms, p50 and max):
 // what a confirming sweep costs once it was gathered (its frames were fused as they came).
 void print_close(const std::vector<Traces::Sweep>& sweeps) {
-  std::vector<double> update, change, segment, persist, publish, whole;
+  std::vector<double> update, change, segment, persist, publish, whole, map_state;
   for (const Traces::Sweep* s : confirming_sweeps(sweeps)) {
     if (!s->report) continue;
     update.push_back(1e3 * s->report->t_update);
     change.push_back(1e3 * s->report->t_change);
     segment.push_back(1e3 * s->report->t_segment);
     persist.push_back(1e3 * s->persist.wall);
+    map_state.push_back(1e3 * s->map_state.wall);
     publish.push_back(1e3 * s->publish.wall);
     whole.push_back(1e3 * closing_wall(*s));
   }
@@ -423,9 +426,9 @@ void print_close(const std::vector<Traces::Sweep>& sweeps) {
   };
   std::printf(
       "close of a confirming sweep, wall ms p50/max (%zu versions after the first): map update %s, "
-      "change %s, re-segmentation %s, persist %s, publish %s, whole %s\n",
+      "change %s, re-segmentation %s, persist %s, publish %s, whole %s; then the map state %s\n",
       whole.size(), p50_max(update).c_str(), p50_max(change).c_str(), p50_max(segment).c_str(),
-      p50_max(persist).c_str(), p50_max(publish).c_str(), p50_max(whole).c_str());
+      p50_max(persist).c_str(), p50_max(publish).c_str(), p50_max(whole).c_str(), p50_max(map_state).c_str());
 }
 
 void print_stage(const char* stage, double cpu, std::size_t frames, const char* note) {
@@ -525,7 +528,7 @@ void print_frames(const Options& options, const Recording& recording, const std:
   std::printf("sweeps processed: %zu, versions published: %zu\n", run.sweeps.size(), t.versions);
   std::printf(
       "gathering thread busy %.0f %% of the run (wall time fusing frames as they came), processing thread "
-      "%.0f %% (map update, change, re-segmentation, persist, publish)\n",
+      "%.0f %% (map update, change, re-segmentation, persist, publish, map state)\n",
       100.0 * t.gathering_wall / run.seconds, 100.0 * t.processing_wall / run.seconds);
 }
 
@@ -539,12 +542,15 @@ void print_cpu(const DaemonRun& run, const Totals& t, std::size_t played) {
   print_stage("fusion", t.fuse, t.fused, "(gathering thread as frames come, map update at a sweep's end)");
   print_stage("change", t.change, t.fused, "");
   print_stage("re-segmentation", t.segment, t.fused, "(sweeps with a change, and the first version)");
-  print_stage("persist", t.persist, t.fused, "(processing thread: version and map state to disk)");
+  print_stage("persist", t.persist, t.fused, "(processing thread: the version's boxes to disk)");
   print_stage("publish", t.publish, t.fused, "(processing thread: snapshot and delta)");
+  print_stage("map state", t.map_state, t.fused, "(processing thread: the map to disk, after publishing)");
   print_stage("whole process", run.cpu, t.fused, "(every thread, DDS included)");
-  std::printf("  per version: persist %.1f ms CPU, publish %.2f ms CPU\n",
-              t.versions ? 1e3 * t.persist / static_cast<double>(t.versions) : NAN,
-              t.versions ? 1e3 * t.publish / static_cast<double>(t.versions) : NAN);
+  const auto per_version = [&](double cpu) {
+    return t.versions ? 1e3 * cpu / static_cast<double>(t.versions) : NAN;
+  };
+  std::printf("  per version: persist %.1f ms CPU, publish %.2f ms CPU, map state %.1f ms CPU\n",
+              per_version(t.persist), per_version(t.publish), per_version(t.map_state));
 }
 
 void print_latency(const DaemonRun& run, const SubscriberProcess& subscriber) {

@@ -261,13 +261,16 @@ std::optional<SweepReport> Daemon::run_pipeline(GatheredSweep& sweep, std::uint6
 
 void Daemon::flush(SweepTrace& trace) {
   publish_cost_ = {};
-  const Stopwatch watch;
-  keeper_.flush(pipeline_);
-  watch.add_to(trace.persist);
+  const Stopwatch boxes;
+  keeper_.publish_boxes(pipeline_);
+  boxes.add_to(trace.persist);
   trace.persist.wall -= publish_cost_.wall;
   trace.persist.cpu -= publish_cost_.cpu;
   trace.publish = publish_cost_;
   published_version_ = keeper_.published().version();
+  const Stopwatch map_state;
+  keeper_.save_map_state(pipeline_);
+  map_state.add_to(trace.map_state);
 }
 
 std::uint64_t Daemon::dropped_frames() const {

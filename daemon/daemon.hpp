@@ -40,10 +40,11 @@ struct SweepTrace {
   std::uint64_t number = 0;           ///< sweeps handled so far, this one included
   const FrameSweep* sweep = nullptr;  ///< the sweep's frames (without points); valid during the call only
   std::optional<SweepReport> report;  ///< what the pipeline did; nullopt if the sweep failed
-  StepCost persist;              ///< saving the version the sweep made (boxes and map state), if it made one
-  StepCost publish;              ///< publishing it (snapshot and delta)
-  std::uint64_t version = 0;     ///< the version subscribers have after the sweep
-  double acquisition_cpu = 0.0;  ///< CPU seconds the sweep source's threads used so far
+  StepCost persist;                   ///< saving the version the sweep made (its boxes), if it made one
+  StepCost publish;                   ///< publishing it (snapshot and delta)
+  StepCost map_state;                 ///< saving the map state with it, after publishing
+  std::uint64_t version = 0;          ///< the version subscribers have after the sweep
+  double acquisition_cpu = 0.0;       ///< CPU seconds the sweep source's threads used so far
 };
 
 /// What the command line adds to the config.
@@ -79,7 +80,8 @@ class Daemon final {
   std::optional<SweepReport> run_pipeline(GatheredSweep& sweep, std::uint64_t number);
   // Frames never fused: dropped from the frame queue, in sweeps dropped from the backlog, or by the source.
   [[nodiscard]] std::uint64_t dropped_frames() const;
-  // Saves and publishes what the sweep changed: keeper_.flush(), its cost split into saving and publishing.
+  // Saves and publishes what the sweep changed (VersionKeeper::flush), its cost split into saving the boxes,
+  // publishing and saving the map state.
   void flush(SweepTrace& trace);
   // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the
   // robot layer the model to show.

@@ -69,8 +69,25 @@ void VersionKeeper::resume(const CellPipeline& pipeline) {
 }
 
 void VersionKeeper::flush(const CellPipeline& pipeline) {
+  publish_boxes(pipeline);
+  save_map_state(pipeline);
+}
+
+void VersionKeeper::publish_boxes(const CellPipeline& pipeline) {
   if (save_due(pipeline.boxes())) save(pipeline);
   if (saved_.version() > published_.version()) publish_saved();
+}
+
+void VersionKeeper::save_map_state(const CellPipeline& pipeline) {
+  if (!map_state_owed_ || save_owed_) return;
+  try {
+    store_.attach_blob(saved_.version(), pipeline.map_state());
+  } catch (const Error& e) {
+    failed("map state of version " + std::to_string(saved_.version()) + " not saved: " + e.what());
+    return;
+  }
+  map_state_owed_ = false;
+  if (!fault_.empty() && saved_.version() == published_.version()) recovered();
 }
 
 bool VersionKeeper::save_due(const std::vector<Box>& boxes) {
@@ -87,13 +104,14 @@ bool VersionKeeper::save_due(const std::vector<Box>& boxes) {
 void VersionKeeper::save(const CellPipeline& pipeline) {
   const Environment next(saved_.cell(), store_.next_version(), next_stamp(), pipeline.boxes());
   try {
-    store_.save(next, pipeline.map_state(), pipeline.next_box_id());
+    store_.save(next, std::nullopt, pipeline.next_box_id());
   } catch (const Error& e) {
     save_owed_ = true;
     failed("version " + std::to_string(next.version()) + " not saved: " + e.what());
     return;
   }
   save_owed_ = false;
+  map_state_owed_ = true;
   resumed_ = false;
   saved_ = next;
 }
@@ -113,12 +131,14 @@ void VersionKeeper::publish_saved() {
     spdlog::info("version {}: {} added, {} modified, {} removed, {} boxes", saved_.version(),
                  delta.added.size(), delta.modified.size(), delta.removed.size(), saved_.boxes().size());
   }
-  if (!fault_.empty()) {
-    spdlog::info("version {} is out after {} failed attempts; running again", saved_.version(),
-                 failed_attempts_);
-  }
   published_ = saved_;
   resumed_ = false;
+  if (!fault_.empty()) recovered();
+}
+
+void VersionKeeper::recovered() {
+  spdlog::info("version {} is out after {} failed attempts; running again", saved_.version(),
+               failed_attempts_);
   fault_.clear();
   failed_attempts_ = 0;
 }

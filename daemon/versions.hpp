@@ -24,8 +24,10 @@ using WallClock = std::function<std::int64_t()>;
 
 /// Gets every version of the cell out, in the order that keeps a number seen by subscribers on disk:
 /// numbers it (VersionStore::next_version()), stamps it (the wall clock, but always above the previous stamp:
-/// a clock stepped back does not make stamps go backwards), saves it with the map state and the box-id
-/// counter, and only then publishes it with its delta from what subscribers have.
+/// a clock stepped back does not make stamps go backwards), saves its boxes and the box-id counter, only then
+/// publishes it with its delta from what subscribers have, and then saves the map state with it (a few MB
+/// that subscribers need not wait for). A crash before the map state is on disk restarts with the version's
+/// boxes and an empty map, which settles again.
 ///
 /// Nothing is dropped on a fault: a save or a publication that fails (disk full, state directory removed or
 /// read-only, a DDS write refused) is logged once with the reason, fault() says why, subscribers keep the
@@ -45,14 +47,20 @@ class VersionKeeper final {
   /// At start: announces what the state directory holds, under the number VersionStore::resume() gives
   /// (saved again with `pipeline`'s map state when a newer number may have been lost). Faults as in flush().
   void resume(const CellPipeline& pipeline);
-  /// After each sweep (and now and then while pending()): saves a version of the pipeline's boxes if they
-  /// differ from the newest saved version, if an earlier save failed or if the saved state vanished; then
-  /// publishes the newest saved version if subscribers do not have it yet. Never throws for I/O or DDS
-  /// faults.
+  /// After each sweep (and now and then while pending()): publish_boxes(), then save_map_state().
   void flush(const CellPipeline& pipeline);
+  /// Saves a version of the pipeline's boxes if they differ from the newest saved version, if an earlier
+  /// save failed or if the saved state vanished; then publishes the newest saved version if subscribers do
+  /// not have it yet. Never throws for I/O or DDS faults.
+  void publish_boxes(const CellPipeline& pipeline);
+  /// Saves the pipeline's map state with the newest saved version if it has none yet. Never throws for I/O
+  /// faults (retried by the next call).
+  void save_map_state(const CellPipeline& pipeline);
 
   /// Whether a save or a publication failed and waits for the next flush().
-  [[nodiscard]] bool pending() const { return save_owed_ || saved_.version() > published_.version(); }
+  [[nodiscard]] bool pending() const {
+    return save_owed_ || map_state_owed_ || saved_.version() > published_.version();
+  }
   /// Why the newest content is not out yet (one line); empty when everything went out.
   [[nodiscard]] const std::string& fault() const { return fault_; }
   /// What subscribers have: the last version published (version 0 before the first).
@@ -63,15 +71,18 @@ class VersionKeeper final {
   void save(const CellPipeline& pipeline);
   void publish_saved();
   void failed(const std::string& reason);
+  // Logs that everything went out after faults, and clears them.
+  void recovered();
   [[nodiscard]] std::int64_t next_stamp() const;
 
   VersionStore& store_;
   Publish publish_;
   WallClock clock_;
-  Environment saved_;       // the newest version on disk (the recovered one at start)
-  Environment published_;   // the newest version published
-  bool save_owed_ = false;  // a save failed: one is due whatever the boxes
-  bool resumed_ = false;    // saved_ is what the state directory held, not yet announced
+  Environment saved_;            // the newest version on disk (the recovered one at start)
+  Environment published_;        // the newest version published
+  bool save_owed_ = false;       // a save failed: one is due whatever the boxes
+  bool map_state_owed_ = false;  // the newest saved version has no map state yet
+  bool resumed_ = false;         // saved_ is what the state directory held, not yet announced
   std::string fault_;
   std::uint64_t failed_attempts_ = 0;  // since the last success
 };

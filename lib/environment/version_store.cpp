@@ -271,6 +271,7 @@ void VersionStore::save(const Environment& env, std::optional<std::string_view> 
   }
   // The snapshot is the commit point: a crash before this rename leaves the previous version loadable.
   write_file_atomically(snapshot_path(dir_, env.version()), doc.dump(1) + "\n");
+  last_snapshot_ = blob ? std::string() : doc.dump();
   last_saved_ = env.version();
   highest_used_ = std::max(highest_used_, env.version());
   next_box_id_ = counter;
@@ -280,6 +281,17 @@ void VersionStore::save(const Environment& env, std::optional<std::string_view> 
     remove_quietly(blob_path(dir_, good_.front()));
     good_.erase(good_.begin());
   }
+}
+
+void VersionStore::attach_blob(std::uint64_t version, std::string_view blob) {
+  const std::string what = dir_.string() + ": attach a blob to version " + std::to_string(version);
+  if (version != last_saved_ || last_snapshot_.empty())
+    throw Error(what + ": not the newest version saved without a blob");
+  json doc = json::parse(last_snapshot_);
+  write_file_atomically(blob_path(dir_, version), blob);
+  doc["blob"] = {{"size", blob.size()}, {"fnv1a64", fnv1a64(blob)}};
+  write_file_atomically(snapshot_path(dir_, version), doc.dump(1) + "\n");
+  last_snapshot_.clear();
 }
 
 // The marker goes out before the snapshot that uses the ids, so no crash leaves a published id above it.

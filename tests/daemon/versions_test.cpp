@@ -70,6 +70,7 @@ class KeeperTest : public ::testing::Test {
     return [this](const Environment& env, const EnvironmentDelta& delta) {
       if (refuse) throw Error("dds write: refused");
       EXPECT_TRUE(fs::exists(snapshot(env.version()))) << "version " << env.version() << " published unsaved";
+      ++published_;
       publisher_.publish(env, delta);
     };
   }
@@ -89,6 +90,7 @@ class KeeperTest : public ::testing::Test {
   }
 
   bool refuse = false;
+  int published_ = 0;  // versions the keeper published
   const std::string cell_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   test::TempDir dir_;
   dds::Participant participant_{test::domain::kKeeper};
@@ -124,6 +126,41 @@ TEST_F(KeeperTest, SavesEachVersionBeforePublishingAndRetriesARefusedWrite) {
   EXPECT_EQ(keeper.published().version(), 3u);
   EXPECT_FALSE(keeper.pending());
   EXPECT_EQ(keeper.fault(), "");
+}
+
+// A version goes out once its boxes are on disk; its map state follows: a restart before that finds the
+// boxes without a map, one after finds both. A map state that cannot be saved is retried, the version out.
+TEST_F(KeeperTest, PublishesOnceTheBoxesAreSavedAndSavesTheMapStateAfter) {
+  VersionStore store(state_dir(), cell_);
+  VersionKeeper keeper(store, publish());
+  CellPipeline pipeline = holding({1, 2});
+  (void)pipeline.process(wall_sweep());
+  keeper.publish_boxes(pipeline);
+  EXPECT_EQ(received(1), (std::vector<std::uint64_t>{1, 2}));
+  EXPECT_TRUE(keeper.pending()) << "the map state is still owed";
+  EXPECT_FALSE(VersionStore(state_dir(), cell_).recovered().blob.has_value());
+  keeper.save_map_state(pipeline);
+  EXPECT_FALSE(keeper.pending());
+  const VersionStore reopened(state_dir(), cell_);
+  ASSERT_TRUE(reopened.recovered().blob.has_value());
+  EXPECT_EQ(read_file(*reopened.recovered().blob), pipeline.map_state());
+
+  // Version 2's map state cannot be written (a directory stands where its file goes): it waits.
+  CellPipeline changed = holding({1, 2, 3});
+  keeper.publish_boxes(changed);
+  EXPECT_EQ(received(2), (std::vector<std::uint64_t>{1, 2, 3}));
+  fs::path blob = snapshot(2);
+  blob.replace_extension(".blob");
+  fs::create_directory(blob);
+  keeper.save_map_state(changed);
+  EXPECT_TRUE(keeper.pending());
+  EXPECT_EQ(keeper.fault().rfind("map state of version 2 not saved: ", 0), 0u) << keeper.fault();
+  fs::remove(blob);
+  keeper.flush(changed);
+  EXPECT_FALSE(keeper.pending());
+  EXPECT_EQ(keeper.fault(), "");
+  EXPECT_EQ(published_, 2) << "a map state saved late publishes nothing";
+  EXPECT_TRUE(VersionStore(state_dir(), cell_).recovered().blob.has_value());
 }
 
 TEST_F(KeeperTest, UnusableStateDirectoryIsRetriedUntilItWorksAgain) {

@@ -77,6 +77,39 @@ TEST(VersionStoreTest, RoundTripKeepsEveryFieldAndTheBlob) {
             content(5).boxes().size());
 }
 
+// A version saved with its boxes first and its blob attached after (as cellmapd publishes between the two):
+// before the attach it reads back without a blob, after it with the blob; attaching is for the newest
+// version without one only.
+TEST(VersionStoreTest, ABlobAttachedAfterTheBoxesReadsBackWithThem) {
+  test::TempDir dir;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    store.save(content(1), blob_of(1));
+    store.save(content(2));
+    {
+      const VersionStore crashed_here(dir.path(), "cell-a");
+      EXPECT_EQ(crashed_here.recovered().environment, content(2));
+      EXPECT_FALSE(crashed_here.recovered().blob.has_value()) << "the boxes load, the map is lost";
+      EXPECT_TRUE(crashed_here.recovered().problems.empty());
+    }
+    EXPECT_THROW(store.attach_blob(1, blob_of(1)), Error) << "not the newest version";
+    store.attach_blob(2, blob_of(2));
+    EXPECT_THROW(store.attach_blob(2, blob_of(2)), Error) << "it has one now";
+    store.save(content(3), blob_of(3));
+    EXPECT_THROW(store.attach_blob(3, blob_of(3)), Error) << "saved with one";
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().environment, content(3));
+  ASSERT_TRUE(store.recovered().blob.has_value());
+  EXPECT_EQ(read_file(*store.recovered().blob), blob_of(3));
+  // Version 2, the previous good one, kept the blob attached to it.
+  fs::remove(dir.path() / "environment-00000000000000000003.json");
+  const VersionStore previous(dir.path(), "cell-a");
+  EXPECT_EQ(previous.recovered().environment, content(2));
+  ASSERT_TRUE(previous.recovered().blob.has_value());
+  EXPECT_EQ(read_file(*previous.recovered().blob), blob_of(2));
+}
+
 TEST(VersionStoreTest, RefusesBackwardsAndForeignCells) {
   test::TempDir dir;
   VersionStore store(dir.path(), "cell-a");

@@ -40,7 +40,8 @@ struct RecoveredState final {
 /// ones are deleted.
 ///
 /// Publishing rule for the caller, so that a number seen by subscribers is never given to other content:
-/// save(v) before publishing v. next_version() is above every version any file names (corrupt ones too).
+/// save(v) before publishing v (its blob may follow, attach_blob). next_version() is above every version any
+/// file names (corrupt ones too).
 /// After a restart, announce resume()'s environment first.
 ///
 /// Not thread-safe; one VersionStore per state directory (no inter-process locking).
@@ -77,6 +78,13 @@ class VersionStore final {
   /// again).
   void save(const Environment& env, std::optional<std::string_view> blob = std::nullopt,
             std::uint64_t next_box_id = 0);
+  /// Adds `blob` to the newest saved version, saved without one: the blob is written, then the snapshot
+  /// again with the blob's size and checksum, so a caller can publish a version once its boxes are on disk
+  /// and save the larger blob after. A crash before the snapshot's rename leaves the version as it was
+  /// (boxes, no blob), never one that does not read back.
+  /// @throws Error if `version` is not the newest saved version or already has a blob, or on I/O failure
+  /// (the version is then unchanged and attach_blob can be called again).
+  void attach_blob(std::uint64_t version, std::string_view blob);
 
   /// False once the newest saved version's snapshot is no longer on disk (the state directory was removed or
   /// emptied by hand): a restart would not find it, so the caller should save its environment again. True
@@ -97,6 +105,7 @@ class VersionStore final {
   RecoveredState recovered_;
   std::uint64_t highest_used_ = 0;  // max version saved or named by any file (corrupt included)
   std::uint64_t last_saved_ = 0;    // version of the newest intact snapshot
+  std::string last_snapshot_;       // its JSON as written by save() (for attach_blob); empty = not known
   std::uint64_t next_box_id_ = 1;
   std::uint64_t box_id_marker_ = 0;  // the n of the newest next-box-id-<n> on disk, 0 = none
   std::vector<std::uint64_t> good_;  // intact versions, oldest first; the last two are kept on disk
