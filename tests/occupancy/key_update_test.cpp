@@ -284,7 +284,8 @@ void expect_octomaps_point_keys(const octomap::OcTree& tree, Scan scan) {
   octomap::KeySet expected;
   for (const auto& p : scan.points_C) {
     octomap::OcTreeKey key;
-    if (std::isfinite(p.x) && tree.coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key))
+    const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    if (finite && tree.coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key))
       expected.insert(key);
   }
   Sweep sweep;
