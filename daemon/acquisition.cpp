@@ -287,7 +287,7 @@ class CameraAcquisition final : public Acquisition {
              std::uint64_t max_sweeps) {
     std::lock_guard<std::mutex> lock(mutex_);
     for (SweepFrame& frame : frames) {
-      const FramePlace place = grouper_.place(frame.frame.stamp);
+      const FramePlace place = grouper_.place(frame.frame.sensor, frame.frame.stamp);
       if (place.ends_open_sweep && end_sweep(max_sweeps)) return true;
       // A replay played as fast as processed must lose no frame: wait for the thread that fuses them.
       while (lossless_ && !stop && !output_.frames.wait_for_room(milliseconds(100))) {
