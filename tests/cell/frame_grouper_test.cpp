@@ -47,8 +47,15 @@ TEST(FrameGrouperTest, AFrameAtTheEndOfThePeriodEndsTheOpenSweep) {
   FrameGrouper grouper(grouping(0.5));
   // Two cameras at uneven rates, so neither tells where its next frame falls; the slower camera's 0.45
   // (late) still joins the first sweep.
-  EXPECT_EQ(sweep_sizes(grouper, {{"a", 0.0}, {"a", 0.1}, {"a", 0.15}, {"b", 0.45}, {"a", 0.3}, {"a", 0.5},
-                                  {"b", 0.6}, {"a", 0.99}, {"b", 1.0}}),
+  EXPECT_EQ(sweep_sizes(grouper, {{"a", 0.0},
+                                  {"a", 0.1},
+                                  {"a", 0.15},
+                                  {"b", 0.45},
+                                  {"a", 0.3},
+                                  {"a", 0.5},
+                                  {"b", 0.6},
+                                  {"a", 0.99},
+                                  {"b", 1.0}}),
             (std::vector<std::size_t>{5, 3, 1}));
   EXPECT_EQ(grouper.open_frames(), 1u);
   EXPECT_TRUE(grouper.flush());
@@ -62,7 +69,8 @@ TEST(FrameGrouperTest, TheFrameThatEndsASweepOpensTheNext) {
   EXPECT_FALSE(grouper.place("a", 10.2).ends_open_sweep);
   EXPECT_TRUE(grouper.place("a", 10.5).ends_open_sweep);
   EXPECT_EQ(grouper.open_frames(), 1u);
-  EXPECT_FALSE(grouper.place("a", 10.6).ends_open_sweep) << "the period counts from the new sweep's first frame";
+  EXPECT_FALSE(grouper.place("a", 10.6).ends_open_sweep)
+      << "the period counts from the new sweep's first frame";
   EXPECT_TRUE(grouper.place("a", 11.0).ends_open_sweep);
 }
 
@@ -87,7 +95,8 @@ TEST(FrameGrouperTest, ASweepOfTwoCamerasWaitsForTheSlowerOne) {
   const std::vector<Frame> frames{{"a", 0.0}, {"b", 0.0}, {"a", 0.1}, {"a", 0.2},
                                   {"b", 0.2}, {"a", 0.3}, {"a", 0.4}};
   for (const Frame& frame : frames) {
-    EXPECT_FALSE(grouper.place(frame.sensor, frame.stamp).completes_sweep) << frame.sensor << " " << frame.stamp;
+    EXPECT_FALSE(grouper.place(frame.sensor, frame.stamp).completes_sweep)
+        << frame.sensor << " " << frame.stamp;
   }
   EXPECT_TRUE(grouper.place("b", 0.4).completes_sweep) << "b's next frame, at 0.6, lies past 0.5";
   const FramePlace next = grouper.place("a", 0.5);

@@ -285,8 +285,7 @@ void expect_octomaps_point_keys(const octomap::OcTree& tree, Scan scan) {
   for (const auto& p : scan.points_C) {
     octomap::OcTreeKey key;
     const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-    if (finite && tree.coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key))
-      expected.insert(key);
+    if (finite && tree.coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key)) expected.insert(key);
   }
   Sweep sweep;
   sweep.scans.push_back(std::move(scan));

@@ -9,7 +9,8 @@ FrameGrouper::FrameGrouper(const SweepParams& grouping) : grouping_(grouping) {
 }
 
 FrameGrouper::Sensor& FrameGrouper::sensor(const std::string& name) {
-  const auto it = std::find_if(sensors_.begin(), sensors_.end(), [&](const Sensor& s) { return s.name == name; });
+  const auto it =
+      std::find_if(sensors_.begin(), sensors_.end(), [&](const Sensor& s) { return s.name == name; });
   if (it != sensors_.end()) return *it;
   sensors_.push_back(Sensor{name});
   return sensors_.back();
