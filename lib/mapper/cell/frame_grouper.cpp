@@ -17,7 +17,6 @@ FrameGrouper::Sensor& FrameGrouper::sensor(const std::string& name) {
 }
 
 void FrameGrouper::open(double stamp) {
-  open_frames_ = 0;
   open_first_stamp_ = stamp;
   for (Sensor& s : sensors_) s.in_open = false;
 }
