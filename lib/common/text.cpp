@@ -1,6 +1,8 @@
 #include "cellmap/common/text.hpp"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include "cellmap/common/error.hpp"
@@ -20,6 +22,12 @@ std::vector<std::string> split(const std::string& line, char separator) {
   while (std::getline(stream, item, separator)) items.push_back(trim(item));
   if (!line.empty() && line.back() == separator) items.emplace_back();
   return items;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
 }
 
 std::string single_line(std::string text) {

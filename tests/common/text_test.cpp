@@ -15,6 +15,13 @@ TEST(TextTest, SplitTrimsAndKeepsEmptyItems) {
   EXPECT_EQ(trim(" \t x y\r"), "x y");
 }
 
+TEST(TextTest, LowerExtensionKeepsTheDotOfTheLastExtensionOnly) {
+  EXPECT_EQ(lower_extension("frames/Depth_0001.PNG"), ".png");
+  EXPECT_EQ(lower_extension("cloud.tar.PCD"), ".pcd");
+  EXPECT_EQ(lower_extension("dir.d/poses"), "");
+  EXPECT_EQ(lower_extension(""), "");
+}
+
 TEST(TextTest, ParseFiniteTakesWholeFiniteNumbersOnly) {
   EXPECT_DOUBLE_EQ(parse_finite("-2.5e-3", "x"), -2.5e-3);
   EXPECT_EQ(error_of([] { (void)parse_finite("2.5m", "poses.csv:3: x"); }),

@@ -91,7 +91,7 @@ TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirP
   transport::EnvironmentSubscriber planner(participant, "replay");
   transport::StatusReader reader(participant);
   auto daemon = start_daemon(yaml, test::domain::kReplay, kSweeps);
-  EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version published from the replay";
+  EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "no version published from the replay";
   const auto stopped = test::wait_for_status(
       reader, "replay", [](const transport::CellStatus& s) { return s.state == "stopped"; });
   const int status = daemon->wait();
@@ -189,7 +189,7 @@ TEST_P(DegradedReplayTest, KeepsTheLastVersionPublished) {
 
   // A late joiner gets that version, with the boxes the status counts.
   transport::EnvironmentSubscriber late(participant, "degraded");
-  ASSERT_TRUE(late.wait_for_version(degraded->version, test::kPatience)) << "the last version is gone";
+  ASSERT_TRUE(late.wait_for_version(degraded->version, test::kDaemonPatience)) << "the last version is gone";
   EXPECT_EQ(late.environment()->version(), degraded->version);
   EXPECT_EQ(late.environment()->boxes().size(), degraded->boxes);
   EXPECT_TRUE(daemon->running());
@@ -303,7 +303,7 @@ TEST_F(CameraE2eTest, OneOfTwoCamerasUnpluggedDegradesTheCellAndTheOtherKeepsThe
   EXPECT_EQ(degraded->sensors[0].state, "streaming");
   EXPECT_EQ(degraded->sensors[1].name, "wrist");
   EXPECT_EQ(degraded->sensors[1].state.rfind("disconnected", 0), 0u) << degraded->sensors[1].state;
-  EXPECT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the streaming camera's map was not published";
+  EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the streaming camera's map was not published";
 
   daemon->signal(SIGTERM);
   const int status = daemon->wait();

@@ -23,7 +23,7 @@ namespace {
 
 using namespace std::chrono_literals;
 // Each test has its own domain (support/dds_domains.hpp) so ctest -j runs them side by side.
-using test::kPatience;
+using test::kDaemonPatience;
 using test::settled;
 
 // The parameter: DDS Security on.
@@ -54,7 +54,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber planner(participant, "e2e", std::ref(recorder));
   transport::StatusReader status(participant, "e2e");
-  ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "no first version from the daemon";
+  ASSERT_TRUE(planner.wait_for_version(1, kDaemonPatience)) << "no first version from the daemon";
   const Environment before = settled(planner, status, "e2e", test::kLongQuietSweeps);
   ASSERT_FALSE(before.boxes().empty());
 
@@ -63,7 +63,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   const std::string name =
       inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
-  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, kPatience)) << "the added box never arrived";
+  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, kDaemonPatience)) << "the added box never arrived";
   const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
@@ -79,7 +79,7 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   }
 
   inject(domain, {"remove", "--name", name});
-  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, kPatience)) << "the removal never arrived";
+  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, kDaemonPatience)) << "the removal never arrived";
   const EnvironmentDelta removed = recorder.to(with_box.version() + 1);
   EXPECT_EQ(removed.removed, std::vector<std::uint64_t>{box.id});
   EXPECT_TRUE(removed.added.empty());
@@ -96,7 +96,7 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
     const dds::Participant participant = service_->participant(domain);
     transport::EnvironmentSubscriber planner(participant, "e2e");
     transport::StatusReader status(participant, "e2e");
-    ASSERT_TRUE(planner.wait_for_version(1, kPatience));
+    ASSERT_TRUE(planner.wait_for_version(1, kDaemonPatience));
     before_kill = settled(planner, status, "e2e", test::kLongQuietSweeps);
   }
   const std::uint64_t last = before_kill->version();
@@ -109,7 +109,7 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
   std::atomic<int> callbacks{0};
   transport::EnvironmentSubscriber late(participant, "e2e",
                                         [&](const Environment&, const EnvironmentDelta&) { ++callbacks; });
-  ASSERT_TRUE(late.wait_for_version(last, kPatience));
+  ASSERT_TRUE(late.wait_for_version(last, kDaemonPatience));
   const Environment resumed = *late.environment();
   EXPECT_EQ(callbacks.load(), 1) << "the late joiner did not get the latest version in one callback";
   // The number `last` still means what subscribers saw before the kill (same stamp and boxes); a resumed
@@ -135,7 +135,7 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
     return std::any_of(env.boxes().begin(), env.boxes().end(),
                        [&](const Box& box) { return box.contains(injected); });
   };
-  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + kDaemonPatience;
   while (!holds_injected() && std::chrono::steady_clock::now() < deadline)
     late.wait_for_version(late.environment()->version() + 1, 1s);
   EXPECT_TRUE(holds_injected()) << "the box injected after the restart never arrived";
@@ -189,7 +189,7 @@ TEST(CellmapdStatusE2eTest, SighupReloadsLogLevelAndSweepPeriodAndStatusFollowsT
   const dds::Participant participant = service.participant(test::domain::kReload);
   transport::StatusReader reader(participant);
   const auto status_where = [&](const std::function<bool(const transport::CellStatus&)>& accept,
-                                std::chrono::milliseconds patience = kPatience) {
+                                std::chrono::milliseconds patience = kDaemonPatience) {
     return test::wait_for_status(reader, "reload", log, accept, patience);
   };
 
@@ -319,7 +319,7 @@ TEST(CellmapdStateE2eTest, AChangeWaitingToBeGatheredWhenKilledComesOutOnceAfter
   const dds::Participant participant = service.participant(domain);
   transport::EnvironmentSubscriber planner(participant, "gather");
   transport::StatusReader status(participant, "gather");
-  ASSERT_TRUE(planner.wait_for_version(1, kPatience)) << "the restarted daemon announced nothing";
+  ASSERT_TRUE(planner.wait_for_version(1, kDaemonPatience)) << "the restarted daemon announced nothing";
   const std::uint64_t resumed = planner.environment()->version();
   EXPECT_FALSE(service.inject(domain, add_box).empty());  // the simulated cell starts from its scene again
   ASSERT_TRUE(test::wait_until_boxed(planner, centre)) << "the waiting change never came out";

@@ -105,7 +105,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   EXPECT_FALSE(planner.environment().has_value()) << "a version went out unsaved";
 
   disk_.free();
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the held version never went out";
   EXPECT_FALSE(planner.environment()->boxes().empty());
   ASSERT_TRUE(test::wait_for_status(reader, service.cell(), running).has_value()) << "never running again";
   const Environment before = test::settled(planner, reader, service.cell());
@@ -123,7 +123,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   EXPECT_EQ(planner.environment()->version(), before.version());
 
   disk_.make_read_only(false);
-  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kPatience)) << "nothing went out after rw";
+  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kDaemonPatience)) << "nothing went out after rw";
   EXPECT_TRUE(test::wait_until_boxed(planner, centre)) << "the box injected while read-only never arrived";
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
@@ -135,7 +135,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   transport::StatusReader reader(participant);
   transport::EnvironmentSubscriber planner(participant, service.cell());
   auto daemon = service.start_daemon(test::domain::kLaterVersionFault);
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "no first version";
   const Environment before = test::settled(planner, reader, service.cell());
 
   disk_.fill();
@@ -150,7 +150,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
   {
     // A planner that joins now gets the last version that went out.
     transport::EnvironmentSubscriber late(participant, service.cell());
-    ASSERT_TRUE(late.wait_for_version(before.version(), test::kPatience));
+    ASSERT_TRUE(late.wait_for_version(before.version(), test::kDaemonPatience));
     EXPECT_TRUE(*late.environment() == before);
   }
 
@@ -161,7 +161,7 @@ TEST_F(FaultsE2eTest, FullDiskHoldsALaterVersionAndARemovedDirectoryIsWrittenAga
 
   // The state directory removed under the running daemon: its boxes are saved again as the next version.
   fs::remove_all(disk_.state_dir());
-  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, test::kPatience)) << "not saved again";
+  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, test::kDaemonPatience)) << "not saved again";
   const Environment again = *planner.environment();
   EXPECT_TRUE(diff(with_box, again).empty()) << "the boxes changed";
   daemon->signal(SIGTERM);
@@ -183,7 +183,7 @@ TEST_F(FaultsE2eTest, SecuredFullDiskHoldsTheFirstVersionUntilSpaceComesBack) {
   EXPECT_EQ(full->version, 0u);
   EXPECT_FALSE(planner.environment().has_value()) << "a version went out unsaved";
   disk_.free();
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "the held version never went out";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the held version never went out";
   EXPECT_FALSE(planner.environment()->boxes().empty());
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
@@ -202,7 +202,7 @@ TEST(SecuredVersionKeeperTest, RefusedDdsWriteIsRetriedUntilItGoesOut) {
   const std::vector<std::string> flags = credentials.flags(security::Role::kTool);
   argv.insert(argv.end(), flags.begin(), flags.end());
   test::ChildProcess echo(argv);
-  ASSERT_TRUE(publisher.wait_for_subscribers(1, test::kPatience)) << "the tool's echo never matched";
+  ASSERT_TRUE(publisher.wait_for_subscribers(1, test::kDaemonPatience)) << "the tool's echo never matched";
 
   bool refuse = false;
   const test::TempDir dir;
@@ -234,7 +234,7 @@ TEST(SecuredVersionKeeperTest, RefusedDdsWriteIsRetriedUntilItGoesOut) {
 
   // Version 1 (a delta from 0 and the snapshot), then version 2 (its delta from 1 and the snapshot).
   std::vector<nlohmann::json> got;
-  while (const std::optional<std::string> line = echo.read_line(test::kPatience)) {
+  while (const std::optional<std::string> line = echo.read_line(test::kDaemonPatience)) {
     got.push_back(nlohmann::json::parse(*line));
   }
   EXPECT_EQ(echo.wait(), 0);

@@ -14,13 +14,14 @@
 #include "cellmap/sweep/sweep.hpp"
 #include "support/dds_domains.hpp"
 #include "transport/loopback.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap::daemon {
 namespace {
 
 using namespace std::chrono_literals;
 using transport::Layer;
-constexpr auto kPatience = 30s;
+using test::kPatience;
 
 class LayerPublisherTest : public ::testing::Test {
  protected:

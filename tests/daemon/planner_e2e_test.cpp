@@ -17,7 +17,7 @@ using namespace std::chrono_literals;
 
 // The next JSON line the planner prints, or a failure.
 nlohmann::json next_state(test::ChildProcess& planner) {
-  const std::optional<std::string> line = planner.read_line(test::kPatience);
+  const std::optional<std::string> line = planner.read_line(test::kDaemonPatience);
   if (!line) {
     ADD_FAILURE() << "the planner printed nothing";
     return nlohmann::json::object();
@@ -42,7 +42,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   planner_argv.push_back("--json");
   test::ChildProcess planner(planner_argv);
 
-  ASSERT_TRUE(observer.wait_for_version(1, test::kPatience)) << "no first version from the daemon";
+  ASSERT_TRUE(observer.wait_for_version(1, test::kDaemonPatience)) << "no first version from the daemon";
   const nlohmann::json first = next_state(planner);
   EXPECT_EQ(first.value("state", ""), "free") << first.dump();
   const Environment before = test::settled(observer, status, "planner", test::kLongQuietSweeps);
@@ -50,7 +50,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const std::string name =
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
-  ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kPatience)) << "the box never arrived";
+  ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kDaemonPatience)) << "the box never arrived";
   const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
@@ -72,7 +72,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
 
   const Environment with_box = test::settled(observer, status, "planner");
   service.inject(domain, {"remove", "--name", name});
-  ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kPatience)) << "removal never arrived";
+  ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kDaemonPatience)) << "removal never arrived";
   EXPECT_EQ(recorder.to(with_box.version() + 1).removed, std::vector<std::uint64_t>{box.id});
   const nlohmann::json free = next_state(planner);
   EXPECT_EQ(free.value("state", ""), "free") << free.dump();
@@ -84,7 +84,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
   // The daemon's writers have left this participant (its status writer is seen leaving with them).
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + test::kDaemonPatience;
   bool departed = false;
   while (!departed && std::chrono::steady_clock::now() < deadline) {
     (void)status.take(100ms);
@@ -96,7 +96,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   daemon = service.start_daemon(domain);
   const std::string again =
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
-  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kPatience)) << "nothing after the restart";
+  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kDaemonPatience)) << "nothing after the restart";
   const nlohmann::json blocked_again = next_state(planner);
   EXPECT_EQ(blocked_again.value("state", ""), "blocked") << blocked_again.dump();
   EXPECT_EQ(blocked_again.value("removed", -1), 0) << blocked_again.dump();

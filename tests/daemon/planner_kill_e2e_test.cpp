@@ -151,7 +151,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
                    .inject(test::domain::kKill,
                            {"add-box", "--center", "1.0,1.2,1.2", "--half-extents", "0.08,0.08,0.08"})
                    .empty());
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + test::kDaemonPatience;
   while (seen.latest() <= before && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(100ms);
     collect();
@@ -162,7 +162,7 @@ TEST(PlannerKillE2eTest, RandomSigkillsOfDaemonAndSubscriberKeepVersionsMonotoni
   ASSERT_TRUE(settled) << "the daemon never settled after the last change";
   collect();
   EXPECT_EQ(seen.latest(), settled->version) << "the daemon's log and its status disagree";
-  const auto caught_up = std::chrono::steady_clock::now() + test::kPatience;
+  const auto caught_up = std::chrono::steady_clock::now() + test::kDaemonPatience;
   while (subscriber_last < settled->version && std::chrono::steady_clock::now() < caught_up) {
     std::this_thread::sleep_for(100ms);
     collect();

@@ -29,7 +29,7 @@ using security::Role;
 transport::CellStatus wait_for_status(transport::StatusReader& reader,
                                       const std::function<bool(const transport::CellStatus&)>& done) {
   transport::CellStatus last;
-  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + test::kDaemonPatience;
   while (std::chrono::steady_clock::now() < deadline) {
     for (const transport::CellStatus& status : reader.take(200ms)) {
       last = status;
@@ -62,7 +62,7 @@ bool is_cyclone_log(const std::string& line) {
 }
 
 std::optional<std::string> read_probe_line(test::ChildProcess& process,
-                                           std::chrono::milliseconds timeout = test::kPatience) {
+                                           std::chrono::milliseconds timeout = test::kDaemonPatience) {
   std::optional<std::string> line;
   do {
     line = process.read_line(timeout);
@@ -128,7 +128,7 @@ TEST(SecurityE2eTest, AParticipantWithoutCredentialsReachesNobodyAndReceivesNoth
   // Where robot poses would go (the simulating daemon reads none): a reader with the daemon's credentials.
   auto poses = start(probe(test::domain::kAttack, "secure", {"serve"}, &credentials, Role::kDaemon));
   expect_line(*poses, "ready");
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no first version over DDS Security";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "no first version over DDS Security";
   const Environment before = test::settled(planner, status, "secure");
   const transport::TrackerStats stats_before = planner.stats();
 
@@ -265,7 +265,7 @@ TEST_P(PlantPartitionsTest, APlannerOfOneCellReceivesNothingOfAnother) {
   const dds::Participant participant(static_cast<std::uint32_t>(domain),
                                      a ? std::optional(a->as(Role::kPlanner)) : std::nullopt);
   transport::EnvironmentSubscriber planner(participant, "plant-a");
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "no version of its own cell";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "no version of its own cell";
 
   // plant-b's data is on the domain: a tool of plant-b (its own process) receives its delta and snapshot.
   std::vector<std::string> echo{CELLMAP_TOOL, "echo",  "--domain",  std::to_string(domain),
@@ -305,7 +305,7 @@ TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
   expect_line(*daemon, "ready");
   const dds::Participant participant(test::domain::kOtherCa, ours.as(Role::kPlanner));
   transport::EnvironmentSubscriber planner(participant, "ca");
-  ASSERT_TRUE(planner.wait_for_version(1, test::kPatience)) << "our own peers never matched";
+  ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "our own peers never matched";
 
   const std::string domain = std::to_string(test::domain::kOtherCa);
   const auto as_theirs = [&](std::vector<std::string> argv, Role role) {

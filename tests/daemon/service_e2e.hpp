@@ -25,7 +25,9 @@
 
 namespace cellmap::test {
 
-inline constexpr std::chrono::seconds kPatience{90};
+/// How long a test waits on what a daemon it started does (a version, a status, a line of its log): longer than
+/// kPatience, as the daemon first has to start, sweep and confirm.
+inline constexpr std::chrono::seconds kDaemonPatience{90};
 
 /// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:
 /// these tests are about versions and deltas; noise robustness is tested where the noise is modelled.
@@ -74,7 +76,7 @@ class ServiceFixture {
     append_flags(argv, security::Role::kTool);
     argv.insert(argv.end(), args.begin(), args.end());
     ChildProcess tool(argv);
-    const std::string out = tool.read_line(kPatience).value_or("");
+    const std::string out = tool.read_line(kDaemonPatience).value_or("");
     EXPECT_EQ(tool.wait(), 0) << "cellmap inject failed";
     return out;
   }
@@ -132,7 +134,7 @@ inline std::string security_name(const ::testing::TestParamInfo<bool>& info) {
 inline std::optional<transport::CellStatus> wait_for_status(
     transport::StatusReader& reader, const std::string& cell,
     const std::function<bool(const transport::CellStatus&)>& accept) {
-  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + kDaemonPatience;
   while (std::chrono::steady_clock::now() < deadline) {
     for (const transport::CellStatus& status : reader.take(std::chrono::milliseconds(200))) {
       if (status.cell == cell && accept(status)) return status;
@@ -170,7 +172,7 @@ inline Environment settled(const transport::EnvironmentSubscriber& planner, tran
   const std::optional<transport::CellStatus> quiet = wait_until_settled(status, cell, quiet_sweeps, held);
   if (!quiet) {
     ADD_FAILURE() << "the environment never settled";
-  } else if (!planner.wait_for_version(quiet->version, kPatience)) {
+  } else if (!planner.wait_for_version(quiet->version, kDaemonPatience)) {
     ADD_FAILURE() << "the subscriber never got the settled version " << quiet->version;
   }
   return *planner.environment();
@@ -184,7 +186,7 @@ inline bool wait_until_boxed(const transport::EnvironmentSubscriber& planner, co
     return env && std::any_of(env->boxes().begin(), env->boxes().end(),
                               [&](const Box& box) { return box.contains(p_C); });
   };
-  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  const auto deadline = std::chrono::steady_clock::now() + kDaemonPatience;
   while (!boxed() && std::chrono::steady_clock::now() < deadline) {
     const std::uint64_t version = planner.environment() ? planner.environment()->version() : 0;
     planner.wait_for_version(version + 1, std::chrono::seconds(1));
@@ -206,7 +208,7 @@ class DaemonLog {
   /// Reads until a line holding `text` comes (returned) or `patience` runs out or the daemon ended. Lines
   /// an earlier wait_for() went past are not searched again.
   std::optional<std::string> wait_for(const std::string& text,
-                                      std::chrono::milliseconds patience = kPatience) {
+                                      std::chrono::milliseconds patience = kDaemonPatience) {
     const auto deadline = std::chrono::steady_clock::now() + patience;
     for (;;) {
       while (searched_ < lines_.size()) {
@@ -242,7 +244,7 @@ class DaemonLog {
 inline std::optional<transport::CellStatus> wait_for_status(
     transport::StatusReader& reader, const std::string& cell, DaemonLog& log,
     const std::function<bool(const transport::CellStatus&)>& accept,
-    std::chrono::milliseconds patience = kPatience) {
+    std::chrono::milliseconds patience = kDaemonPatience) {
   const auto deadline = std::chrono::steady_clock::now() + patience;
   while (std::chrono::steady_clock::now() < deadline) {
     log.drain();
@@ -255,7 +257,7 @@ inline std::optional<transport::CellStatus> wait_for_status(
 
 /// planner.wait_for_version() that reads the daemon's log meanwhile.
 inline bool wait_for_version(const transport::EnvironmentSubscriber& planner, std::uint64_t version,
-                             DaemonLog& log, std::chrono::milliseconds patience = kPatience) {
+                             DaemonLog& log, std::chrono::milliseconds patience = kDaemonPatience) {
   const auto deadline = std::chrono::steady_clock::now() + patience;
   while (std::chrono::steady_clock::now() < deadline) {
     log.drain();

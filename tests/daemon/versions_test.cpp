@@ -20,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-constexpr auto kPatience = 30s;
+using test::kPatience;
 
 Box box_with_id(std::uint64_t id) {
   Box box;

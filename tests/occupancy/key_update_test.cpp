@@ -11,6 +11,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "occupancy/box_scene.hpp"
+#include "occupancy/octomap_cloud.hpp"
 
 namespace cellmap {
 namespace {
@@ -25,11 +26,7 @@ Keys sorted(const octomap::KeySet& set) {
   return keys;
 }
 
-octomap::Pointcloud to_octomap(const Scan& scan) {
-  octomap::Pointcloud cloud;
-  for (const auto& p : scan.points_C.points) cloud.push_back(p.x, p.y, p.z);
-  return cloud;
-}
+using testing::to_octomap;
 
 octomap::point3d origin_of(const Scan& scan) {
   return octomap::point3d(float(scan.origin_C.x()), float(scan.origin_C.y()), float(scan.origin_C.z()));

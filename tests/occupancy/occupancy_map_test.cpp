@@ -7,6 +7,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "occupancy/box_scene.hpp"
+#include "occupancy/octomap_cloud.hpp"
 #include "tree_agreement.hpp"
 
 namespace cellmap {
@@ -14,11 +15,7 @@ namespace {
 
 using testing::AlignedBox;
 
-octomap::Pointcloud to_octomap(const Scan& scan) {
-  octomap::Pointcloud cloud;
-  for (const auto& p : scan.points_C.points) cloud.push_back(p.x, p.y, p.z);
-  return cloud;
-}
+using testing::to_octomap;
 
 Eigen::Isometry3d camera_at(const Eigen::Vector3d& p_C, double pitch) {
   Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -13,6 +14,10 @@
 #include "cellmap/common/error.hpp"
 
 namespace cellmap::test {
+
+/// How long a test waits for what it can observe (a reader matched, a sample, an ack): generous, as the
+/// machine is shared; passing runs take milliseconds.
+inline constexpr std::chrono::seconds kPatience{30};
 
 /// A fresh directory under the system temp folder, removed with everything in it when the object goes.
 class TempDir {

@@ -16,7 +16,7 @@ namespace cellmap::transport {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr auto kPatience = 30s;
+using test::kPatience;
 constexpr std::uint32_t kDomain = test::domain::kLayers;
 
 TEST(VoxelRunsTest, NeighboursAlongXJoinOneRun) {

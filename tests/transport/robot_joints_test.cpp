@@ -19,7 +19,7 @@ namespace cellmap::transport {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr auto kPatience = 30s;  // generous: the machine is shared; passing runs take milliseconds
+using test::kPatience;
 const std::vector<std::string> kJoints{"j1", "j2", "j3"};
 
 RobotJoints joints_at(const std::string& cell, std::int64_t stamp_ns, std::vector<std::string> names,

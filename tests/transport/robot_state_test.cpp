@@ -19,7 +19,7 @@ namespace cellmap::transport {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr auto kPatience = 30s;  // generous: the machine is shared; passing runs take milliseconds
+using test::kPatience;
 
 RobotState state_at(const std::string& cell, std::int64_t stamp_ns, double x, double yaw) {
   RobotState state;

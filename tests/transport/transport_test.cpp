@@ -19,12 +19,13 @@
 #include "scene_steps.hpp"
 #include "support/dds_domains.hpp"
 #include "support/test_credentials.hpp"
+#include "support/test_support.hpp"
 
 namespace cellmap::transport {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr auto kPatience = 30s;  // generous: the machine is shared; passing runs take milliseconds
+using test::kPatience;
 
 class TransportTest : public ::testing::Test {
  protected:

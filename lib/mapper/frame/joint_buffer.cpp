@@ -20,7 +20,7 @@ void check_payload(const Payload& payload, const std::string& what) {
   }
 }
 
-bool earlier(const JointState& sample, double stamp) {
+bool joints_before(const JointState& sample, double stamp) {
   return sample.stamp < stamp;
 }
 
@@ -41,7 +41,7 @@ void JointBuffer::push(const JointState& sample) {
   }
   if (sample.payload) check_payload(*sample.payload, what);
   std::lock_guard<std::mutex> lock(mutex_);
-  auto where = std::lower_bound(samples_.begin(), samples_.end(), sample.stamp, earlier);
+  auto where = std::lower_bound(samples_.begin(), samples_.end(), sample.stamp, joints_before);
   if (where != samples_.end() && where->stamp == sample.stamp) {
     *where = sample;
   } else {
@@ -59,7 +59,7 @@ JointBuffer::Result JointBuffer::at(double stamp) const {
       result.status = PoseLookup::kPending;
       return result;
     }
-    auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp, earlier);  // first >= stamp
+    auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp, joints_before);  // first >= stamp
     if (after->stamp == stamp) {
       result.state = *after;
     } else {

@@ -17,7 +17,7 @@ void check_rigid(const Eigen::Isometry3d& X, const std::string& what) {
   }
 }
 
-bool earlier(const StampedPose& sample, double stamp) {
+bool pose_before(const StampedPose& sample, double stamp) {
   return sample.stamp < stamp;
 }
 
@@ -42,7 +42,7 @@ void PoseBuffer::push(double stamp, const Eigen::Isometry3d& X_CE) {
   if (!std::isfinite(stamp)) throw Error("pose buffer: stamp is not finite");
   check_rigid(X_CE, "pose buffer: sample at " + std::to_string(stamp));
   std::lock_guard<std::mutex> lock(mutex_);
-  auto where = std::lower_bound(samples_.begin(), samples_.end(), stamp, earlier);
+  auto where = std::lower_bound(samples_.begin(), samples_.end(), stamp, pose_before);
   if (where != samples_.end() && where->stamp == stamp) {
     where->X_CE = X_CE;
   } else {
@@ -59,7 +59,7 @@ PoseBuffer::Result PoseBuffer::at(double stamp) const {
     result.status = PoseLookup::kPending;
     return result;
   }
-  auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp, earlier);  // first >= stamp
+  auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp, pose_before);  // first >= stamp
   if (after->stamp == stamp) {
     result.status = PoseLookup::kFound;
     result.X_CE = after->X_CE;

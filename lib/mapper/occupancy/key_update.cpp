@@ -25,15 +25,6 @@ namespace {
 
 using Key = octomap::OcTreeKey;
 
-// Packs a key as z:y:x so that numeric order is the (z, y, x) order of the dense index.
-std::uint64_t pack(const Key& k) {
-  return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
-}
-Key unpack(std::uint64_t p) {
-  return Key(static_cast<std::uint16_t>(p & 0xffff), static_cast<std::uint16_t>((p >> 16) & 0xffff),
-             static_cast<std::uint16_t>(p >> 32));
-}
-
 // An axis-aligned box of keys (inclusive bounds) with a dense index, x fastest.
 struct KeyBox {
   int lo[3] = {std::numeric_limits<int>::max(), std::numeric_limits<int>::max(),
@@ -273,7 +264,7 @@ std::vector<Key> keys_of(const std::vector<KeyBrick>& bricks, bool occupied) {
   std::sort(packed.begin(), packed.end());  // z:y:x packing sorts by (z, y, x)
   std::vector<Key> out;
   out.reserve(packed.size());
-  for (const std::uint64_t p : packed) out.push_back(unpack(p));
+  for (const std::uint64_t p : packed) out.push_back(unpack_key(p));
   return out;
 }
 
@@ -505,7 +496,7 @@ void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator
       n += std::size_t((packed != last) & (packed != kNoKey));
       last = packed;
     }
-    for (std::size_t i = 0; i < n; ++i) box.extend(unpack(block[i]));
+    for (std::size_t i = 0; i < n; ++i) box.extend(unpack_key(block[i]));
     keys.insert(keys.end(), block, block + n);
   }
 }
@@ -531,7 +522,7 @@ ScanKeys scan_keys(const Scan& scan, const octomap::OcTree& grid, int threads) {
     const std::uint64_t packed = converter.key(p.x, p.y, p.z);
     if (packed == kNoKey) continue;
     out.clear.push_back(packed);
-    out.box.extend(unpack(packed));
+    out.box.extend(unpack_key(packed));
   }
   for (const KeyBox& b : boxes) {
     if (!b.empty()) out.box.extend(b);
@@ -553,9 +544,9 @@ DistinctKeys distinct(const ScanKeys& keys) {
     std::vector<std::uint64_t> all;
     for (const auto& list : keys.points) all.insert(all.end(), list.begin(), list.end());
     const std::vector<std::uint64_t> points = sorted_unique(std::move(all));
-    for (const std::uint64_t p : points) out.points.push_back(unpack(p));
+    for (const std::uint64_t p : points) out.points.push_back(unpack_key(p));
     for (const std::uint64_t p : sorted_unique(keys.clear)) {
-      if (!std::binary_search(points.begin(), points.end(), p)) out.clear.push_back(unpack(p));
+      if (!std::binary_search(points.begin(), points.end(), p)) out.clear.push_back(unpack_key(p));
     }
     return out;
   }
@@ -563,11 +554,11 @@ DistinctKeys distinct(const ScanKeys& keys) {
   const BoxIndex index(keys.box);
   for (const auto& list : keys.points) {
     for (const std::uint64_t p : list) {
-      if (!seen.test_and_set(index(p))) out.points.push_back(unpack(p));
+      if (!seen.test_and_set(index(p))) out.points.push_back(unpack_key(p));
     }
   }
   for (const std::uint64_t p : keys.clear) {
-    if (!seen.test_and_set(index(p))) out.clear.push_back(unpack(p));
+    if (!seen.test_and_set(index(p))) out.clear.push_back(unpack_key(p));
   }
   return out;
 }
@@ -714,12 +705,12 @@ void dense_bricks(const BrickGrid& bricks, const std::vector<Key>& hits,
 void sparse_bricks(const std::vector<Key>& hits, const std::vector<std::uint64_t>& crossed,
                    KeyUpdate& update) {
   std::vector<std::uint64_t> packed_hits;
-  for (const Key& k : hits) packed_hits.push_back(pack(k));
+  for (const Key& k : hits) packed_hits.push_back(pack_key(k));
   const std::vector<std::uint64_t> occupied = sorted_unique(std::move(packed_hits));
   std::map<std::uint64_t, KeyBrick> bricks;  // by packed brick base
   auto mark = [&](std::uint64_t p, bool hit) {
-    const Key k = unpack(p);
-    KeyBrick& brick = bricks[pack(brick_base(k))];
+    const Key k = unpack_key(p);
+    KeyBrick& brick = bricks[pack_key(brick_base(k))];
     brick.base = brick_base(k);
     const int i = KeyBrick::local_index(k);
     (hit ? brick.occupied : brick.free)[std::size_t(i >> 6)] |= std::uint64_t{1} << (i & 63);
@@ -788,7 +779,7 @@ void KeyUpdateUnion::merge(KeyUpdateUnion& other) {
 
 void KeyUpdateUnion::add(const std::vector<KeyBrick>& bricks) {
   for (const KeyBrick& brick : bricks) {
-    const auto [at, inserted] = index_.try_emplace(pack(brick.base), bricks_.size());
+    const auto [at, inserted] = index_.try_emplace(pack_key(brick.base), bricks_.size());
     if (inserted) {
       bricks_.push_back(brick);
       continue;

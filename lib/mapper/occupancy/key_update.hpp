@@ -14,6 +14,15 @@
 
 namespace cellmap {
 
+/// A key as one number z:y:x (16 bits each), so that numeric order is the (z, y, x) order of a dense index.
+[[nodiscard]] inline std::uint64_t pack_key(const octomap::OcTreeKey& k) {
+  return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
+}
+[[nodiscard]] inline octomap::OcTreeKey unpack_key(std::uint64_t p) {
+  return octomap::OcTreeKey(static_cast<std::uint16_t>(p & 0xffff), static_cast<std::uint16_t>((p >> 16) & 0xffff),
+                            static_cast<std::uint16_t>(p >> 32));
+}
+
 /// 16 × 16 × 16 leaf voxels whose keys share all but their 4 lowest bits: exactly one OcTree subtree 4 levels
 /// above the leaves. Bit i of a mask is the voxel whose local key offsets (x, y, z) interleave to i with x in
 /// the lowest bit of each triple and z in the highest — OctoMap's child order, so each child subtree is a

@@ -5,20 +5,17 @@
 #include <vector>
 
 #include "cellmap/common/error.hpp"
+#include "key_update.hpp"
 
 namespace cellmap {
 namespace {
-
-std::uint64_t pack(const octomap::OcTreeKey& k) {
-  return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
-}
 
 // Appends the packed leaf keys of every known voxel of `tree`, expanding pruned leaves.
 void append_known(const octomap::OcTree& tree, std::vector<std::uint64_t>& out) {
   const unsigned depth = tree.getTreeDepth();
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     if (it.getDepth() == depth) {
-      out.push_back(pack(it.getKey()));
+      out.push_back(pack_key(it.getKey()));
       continue;
     }
     const int span = 1 << (depth - it.getDepth());
@@ -26,7 +23,7 @@ void append_known(const octomap::OcTree& tree, std::vector<std::uint64_t>& out) 
     for (int z = 0; z < span; ++z)
       for (int y = 0; y < span; ++y)
         for (int x = 0; x < span; ++x)
-          out.push_back(pack(octomap::OcTreeKey(first[0] + x, first[1] + y, first[2] + z)));
+          out.push_back(pack_key(octomap::OcTreeKey(first[0] + x, first[1] + y, first[2] + z)));
   }
 }
 

@@ -19,12 +19,6 @@
 namespace cellmap {
 namespace {
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
-
 // libtiff reports through handlers; these keep the first message for our Error instead of printing it.
 int keep_tiff_message(TIFF*, void* user_data, const char*, const char* format, va_list args) {
   auto* message = static_cast<std::string*>(user_data);

@@ -17,11 +17,6 @@ namespace {
 
 constexpr const char* kPosesHeader = "file,stamp,x,y,z,qw,qx,qy,qz";
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 }  // namespace
 

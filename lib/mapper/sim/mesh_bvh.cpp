@@ -8,7 +8,6 @@ namespace cellmap::sim {
 namespace {
 
 constexpr int kLeafSize = 4;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Entry and exit distance of the ray through the box, with 1/d precomputed; false if it misses [0, t_max].
 bool slabs(const Eigen::Vector3d& min, const Eigen::Vector3d& max, const Eigen::Vector3d& o,
@@ -57,8 +56,8 @@ int MeshBvh::build(std::vector<int>& order, int begin, int end,
   const int index = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
   Node node;
-  node.min = Eigen::Vector3d::Constant(kInf);
-  node.max = Eigen::Vector3d::Constant(-kInf);
+  node.min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  node.max = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   Eigen::Vector3d c_min = node.min, c_max = node.max;
   for (int i = begin; i < end; ++i) {
     const Triangle& t = triangles_[static_cast<std::size_t>(order[i])];

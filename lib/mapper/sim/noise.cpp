@@ -8,7 +8,6 @@
 namespace cellmap::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // SplitMix64's finalizer: a fast bijective hash with good avalanche, so hash(key, pixel) acts as a random
 // number generator that can be evaluated for any pixel in any order (what makes the noise order-free).
@@ -38,7 +37,7 @@ class Random {
     for (std::uint64_t attempt = 0; attempt < 4; ++attempt) {
       const double u1 = 1.0 - uniform(index, kGauss + 2 * attempt);  // (0, 1]
       const double u2 = uniform(index, kGauss + 2 * attempt + 1);
-      z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * kPi * u2);
+      z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * M_PI * u2);
       if (std::abs(z) <= limit) return z;
     }
     return std::clamp(z, -limit, limit);
@@ -110,10 +109,10 @@ class Waviness {
     const double scale = width / 640.0;
     for (int k = 0; k < 3; ++k) {
       const auto index = static_cast<std::uint64_t>(k);
-      const double theta = 2 * kPi * random.uniform(index, kWave);
+      const double theta = 2 * M_PI * random.uniform(index, kWave);
       const double length = wave_length_px * scale * (0.6 + 0.8 * random.uniform(index, kWave + 1));
-      const double ku = 2 * kPi * std::cos(theta) / length, kv = 2 * kPi * std::sin(theta) / length;
-      const double phase = 2 * kPi * random.uniform(index, kWave + 2);
+      const double ku = 2 * M_PI * std::cos(theta) / length, kv = 2 * M_PI * std::sin(theta) / length;
+      const double phase = 2 * M_PI * random.uniform(index, kWave + 2);
       for (int u = 0; u < width; ++u) {
         column_sin_[k].push_back(std::sin(ku * u));
         column_cos_[k].push_back(std::cos(ku * u));

@@ -15,7 +15,6 @@
 namespace cellmap::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::string format_vector(const Eigen::VectorXd& v) {
   std::ostringstream out;
@@ -70,7 +69,7 @@ Obstacle read_obstacle(YamlMap map) {
   obstacle.X_CO.translation() = map.vector3("center");
   if (map.has("yaw") && map.has("rotation")) map.fail("yaw", "give either yaw or rotation, not both");
   if (map.has("yaw")) {
-    const double yaw = map.number("yaw", 0.0, -2 * kPi, 2 * kPi);
+    const double yaw = map.number("yaw", 0.0, -2 * M_PI, 2 * M_PI);
     obstacle.X_CO.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   } else if (map.has("rotation")) {
     obstacle.X_CO.linear() = map.unit_quaternion("rotation").toRotationMatrix();
@@ -187,7 +186,7 @@ PinholeIntrinsics read_intrinsics(YamlMap map, SensorModel model) {
 
 LineScanner read_scanner(YamlMap map) {
   LineScanner s;
-  s.fov = map.number("fov", s.fov, 1e-3, 2 * kPi);
+  s.fov = map.number("fov", s.fov, 1e-3, 2 * M_PI);
   s.beams = static_cast<int>(map.integer("beams", s.beams, 2, 100000));
   s.min_range = map.number("min_range", s.min_range, 0.0, 1000.0);
   s.max_range = map.number("max_range", s.max_range, 0.0, 1000.0);
@@ -343,10 +342,10 @@ Robot read_robot(YamlMap map, const std::string& base_dir) {
 double Obstacle::volume() const {
   if (const auto* box = std::get_if<BoxShape>(&shape)) return 8.0 * box->half_extents.prod();
   if (const auto* cyl = std::get_if<CylinderShape>(&shape)) {
-    return kPi * cyl->radius * cyl->radius * 2.0 * cyl->half_length;
+    return M_PI * cyl->radius * cyl->radius * 2.0 * cyl->half_length;
   }
   const double r = std::get<SphereShape>(shape).radius;
-  return 4.0 / 3.0 * kPi * r * r * r;
+  return 4.0 / 3.0 * M_PI * r * r * r;
 }
 
 double Obstacle::surface_area() const {
@@ -355,10 +354,10 @@ double Obstacle::surface_area() const {
     return 8.0 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z());
   }
   if (const auto* cyl = std::get_if<CylinderShape>(&shape)) {
-    return 2.0 * kPi * cyl->radius * (cyl->radius + 2.0 * cyl->half_length);
+    return 2.0 * M_PI * cyl->radius * (cyl->radius + 2.0 * cyl->half_length);
   }
   const double r = std::get<SphereShape>(shape).radius;
-  return 4.0 * kPi * r * r;
+  return 4.0 * M_PI * r * r;
 }
 
 double Obstacle::signed_distance(const Eigen::Vector3d& p_C) const {
@@ -403,9 +402,9 @@ std::vector<Eigen::Vector3d> Obstacle::sample_surface(double spacing) const {
     }
   } else if (const auto* cyl = std::get_if<CylinderShape>(&shape)) {
     const double r = cyl->radius, hl = cyl->half_length;
-    const int around = cells(2 * kPi * r), along = cells(2 * hl);
+    const int around = cells(2 * M_PI * r), along = cells(2 * hl);
     for (int i = 0; i < around; ++i) {
-      const double phi = 2 * kPi * (i + 0.5) / around;
+      const double phi = 2 * M_PI * (i + 0.5) / around;
       for (int j = 0; j < along; ++j) {
         p_O.emplace_back(r * std::cos(phi), r * std::sin(phi), -hl + (j + 0.5) * 2 * hl / along);
       }
@@ -414,9 +413,9 @@ std::vector<Eigen::Vector3d> Obstacle::sample_surface(double spacing) const {
     for (int side = -1; side <= 1; side += 2) {
       for (int ring = 0; ring < rings; ++ring) {
         const double rho = (ring + 0.5) * r / rings;
-        const int n = cells(2 * kPi * rho);
+        const int n = cells(2 * M_PI * rho);
         for (int i = 0; i < n; ++i) {
-          const double phi = 2 * kPi * (i + 0.5) / n;
+          const double phi = 2 * M_PI * (i + 0.5) / n;
           p_O.emplace_back(rho * std::cos(phi), rho * std::sin(phi), side * hl);
         }
       }
@@ -424,8 +423,8 @@ std::vector<Eigen::Vector3d> Obstacle::sample_surface(double spacing) const {
   } else {
     // Fibonacci lattice: near-uniform points, one per spacing² of area.
     const double r = std::get<SphereShape>(shape).radius;
-    const int n = std::max(4, static_cast<int>(std::ceil(4 * kPi * r * r / (spacing * spacing))));
-    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    const int n = std::max(4, static_cast<int>(std::ceil(4 * M_PI * r * r / (spacing * spacing))));
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
     for (int i = 0; i < n; ++i) {
       const double z = 1.0 - (i + 0.5) * 2.0 / n;
       const double rho = std::sqrt(1.0 - z * z);
@@ -458,7 +457,7 @@ SensorModel sensor_model_from_string(const std::string& name) {
 }
 
 void LineScanner::validate() const {
-  if (!(fov > 0 && fov <= 2 * kPi)) throw Error("scanner: fov must be in (0, 2π]");
+  if (!(fov > 0 && fov <= 2 * M_PI)) throw Error("scanner: fov must be in (0, 2π]");
   if (beams < 2) throw Error("scanner: beams must be >= 2");
   if (!(min_range >= 0 && max_range > min_range)) throw Error("scanner: need 0 <= min_range < max_range");
   if (!(range_resolution > 0)) throw Error("scanner: range_resolution must be positive");
@@ -470,7 +469,7 @@ Scene without_depth_filter(Scene scene) {
 }
 
 FieldOfView LineScanner::field_of_view() const {
-  constexpr double kMaxStep = kPi / 6;
+  constexpr double kMaxStep = M_PI / 6;
   const int steps = std::max(1, static_cast<int>(std::ceil(fov / kMaxStep)));
   FieldOfView out{{}, false, max_range};
   for (int i = 0; i <= steps; ++i) {

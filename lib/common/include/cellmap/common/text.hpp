@@ -13,6 +13,10 @@ namespace cellmap {
 /// Splits at `separator`; every item is trimmed; a trailing separator gives a last empty item.
 [[nodiscard]] std::vector<std::string> split(const std::string& line, char separator);
 
+/// The extension of the file name in `path`, dot included, in lower case ("a/B.PNG" → ".png"); empty if it
+/// has none.
+[[nodiscard]] std::string lower_extension(const std::string& path);
+
 /// `text` with every control character (newline included) replaced by '?': for messages that quote input,
 /// which must stay one line.
 [[nodiscard]] std::string single_line(std::string text);
