@@ -25,9 +25,11 @@
 
 namespace cellmap::test {
 
-/// How long a test waits on what a daemon it started does (a version, a status, a line of its log): longer than
-/// kPatience, as the daemon first has to start, sweep and confirm.
-inline constexpr std::chrono::seconds kDaemonPatience{90};
+/// How long a test waits on what a daemon it started does (a version, a status, a line of its log): longer
+/// than kPatience, as the daemon first has to start, sweep and confirm; four times that in a sanitizer build,
+/// whose daemon sweeps the simulated cell 20-60 times slower (4 s a sweep under ASan, its first version after
+/// about 100 s).
+inline constexpr std::chrono::seconds kDaemonPatience{90 * kSanitizerSlowdown};
 
 /// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:
 /// these tests are about versions and deltas; noise robustness is tested where the noise is modelled.

@@ -15,6 +15,21 @@
 
 namespace cellmap::test {
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define CELLMAP_TEST_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define CELLMAP_TEST_SANITIZED 1
+#endif
+/// How many times longer a test waits in a sanitizer build (ASan, TSan) than in a plain one.
+#ifdef CELLMAP_TEST_SANITIZED
+inline constexpr int kSanitizerSlowdown = 4;
+#else
+inline constexpr int kSanitizerSlowdown = 1;
+#endif
+
 /// How long a test waits for what it can observe (a reader matched, a sample, an ack): generous, as the
 /// machine is shared; passing runs take milliseconds.
 inline constexpr std::chrono::seconds kPatience{30};
