@@ -303,7 +303,8 @@ TEST_F(CameraE2eTest, OneOfTwoCamerasUnpluggedDegradesTheCellAndTheOtherKeepsThe
   EXPECT_EQ(degraded->sensors[0].state, "streaming");
   EXPECT_EQ(degraded->sensors[1].name, "wrist");
   EXPECT_EQ(degraded->sensors[1].state.rfind("disconnected", 0), 0u) << degraded->sensors[1].state;
-  EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the streaming camera's map was not published";
+  EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience))
+      << "the streaming camera's map was not published";
 
   daemon->signal(SIGTERM);
   const int status = daemon->wait();

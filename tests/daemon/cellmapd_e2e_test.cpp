@@ -63,7 +63,8 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   const std::string name =
       inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
-  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, kDaemonPatience)) << "the added box never arrived";
+  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, kDaemonPatience))
+      << "the added box never arrived";
   const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
@@ -79,7 +80,8 @@ TEST_P(CellmapdE2eTest, InjectedBoxArrivesAsOneAddedBoxAndLeavesAsOneRemoved) {
   }
 
   inject(domain, {"remove", "--name", name});
-  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, kDaemonPatience)) << "the removal never arrived";
+  ASSERT_TRUE(planner.wait_for_version(with_box.version() + 1, kDaemonPatience))
+      << "the removal never arrived";
   const EnvironmentDelta removed = recorder.to(with_box.version() + 1);
   EXPECT_EQ(removed.removed, std::vector<std::uint64_t>{box.id});
   EXPECT_TRUE(removed.added.empty());

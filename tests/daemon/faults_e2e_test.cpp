@@ -16,8 +16,8 @@
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "daemon/service_e2e.hpp"
-#include "versions.hpp"
 #include "support/dds_domains.hpp"
+#include "versions.hpp"
 
 namespace cellmap {
 namespace {
@@ -123,7 +123,8 @@ TEST_F(FaultsE2eTest, FullDiskHoldsTheFirstVersionUntilSpaceComesBackThenReadOnl
   EXPECT_EQ(planner.environment()->version(), before.version());
 
   disk_.make_read_only(false);
-  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kDaemonPatience)) << "nothing went out after rw";
+  ASSERT_TRUE(planner.wait_for_version(before.version() + 1, test::kDaemonPatience))
+      << "nothing went out after rw";
   EXPECT_TRUE(test::wait_until_boxed(planner, centre)) << "the box injected while read-only never arrived";
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
@@ -197,8 +198,8 @@ TEST(SecuredVersionKeeperTest, RefusedDdsWriteIsRetriedUntilItGoesOut) {
   const dds::Participant participant(static_cast<std::uint32_t>(domain),
                                      credentials.as(security::Role::kDaemon));
   transport::EnvironmentPublisher publisher(participant, cell);
-  std::vector<std::string> argv{CELLMAP_TOOL, "echo", "--domain", std::to_string(domain), "--count", "4",
-                                "--timeout", "90"};
+  std::vector<std::string> argv{CELLMAP_TOOL, "echo", "--domain",  std::to_string(domain),
+                                "--count",    "4",    "--timeout", "90"};
   const std::vector<std::string> flags = credentials.flags(security::Role::kTool);
   argv.insert(argv.end(), flags.begin(), flags.end());
   test::ChildProcess echo(argv);

@@ -1,5 +1,6 @@
 // The daemon's layers: written after a sweep only while read, only when they changed or a reader joined
-// (real participants on loopback, one domain per test); sensor views from real frames through the sweep stage.
+// (real participants on loopback, one domain per test); sensor views from real frames through the sweep
+// stage.
 #include "layer_publisher.hpp"
 
 #include <gtest/gtest.h>
@@ -13,15 +14,15 @@
 
 #include "cellmap/sweep/sweep.hpp"
 #include "support/dds_domains.hpp"
-#include "transport/loopback.hpp"
 #include "support/test_support.hpp"
+#include "transport/loopback.hpp"
 
 namespace cellmap::daemon {
 namespace {
 
 using namespace std::chrono_literals;
-using transport::Layer;
 using test::kPatience;
+using transport::Layer;
 
 class LayerPublisherTest : public ::testing::Test {
  protected:

@@ -36,7 +36,8 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const dds::Participant participant = service.participant(domain);
   test::DeltaRecorder recorder;
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
-  transport::StatusReader status(participant, service.cell());  // tells when the stopped daemon's writers are gone
+  transport::StatusReader status(participant,
+                                 service.cell());  // tells when the stopped daemon's writers are gone
   // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");
@@ -50,7 +51,8 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const std::string name =
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
-  ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kDaemonPatience)) << "the box never arrived";
+  ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kDaemonPatience))
+      << "the box never arrived";
   const EnvironmentDelta added = recorder.to(before.version() + 1);
   ASSERT_EQ(added.added.size(), 1u);
   EXPECT_TRUE(added.modified.empty());
@@ -72,7 +74,8 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
 
   const Environment with_box = test::settled(observer, status, "planner");
   service.inject(domain, {"remove", "--name", name});
-  ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kDaemonPatience)) << "removal never arrived";
+  ASSERT_TRUE(observer.wait_for_version(with_box.version() + 1, test::kDaemonPatience))
+      << "removal never arrived";
   EXPECT_EQ(recorder.to(with_box.version() + 1).removed, std::vector<std::uint64_t>{box.id});
   const nlohmann::json free = next_state(planner);
   EXPECT_EQ(free.value("state", ""), "free") << free.dump();
@@ -96,7 +99,8 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   daemon = service.start_daemon(domain);
   const std::string again =
       service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
-  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kDaemonPatience)) << "nothing after the restart";
+  ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kDaemonPatience))
+      << "nothing after the restart";
   const nlohmann::json blocked_again = next_state(planner);
   EXPECT_EQ(blocked_again.value("state", ""), "blocked") << blocked_again.dump();
   EXPECT_EQ(blocked_again.value("removed", -1), 0) << blocked_again.dump();

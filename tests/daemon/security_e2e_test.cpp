@@ -237,9 +237,9 @@ TEST(SecurityE2eTest, EachRoleCreatesOnlyTheWritersAndReadersItsPermissionsGrant
   }
 }
 
-// A plant: cells plant-a and plant-b on one domain, each a daemon publishing its cell; secured, with credentials
-// of one plant's CAs (plant-b's issued with plant-a's), so that every participant authenticates every other
-// and only the partitions keep the cells apart.
+// A plant: cells plant-a and plant-b on one domain, each a daemon publishing its cell; secured, with
+// credentials of one plant's CAs (plant-b's issued with plant-a's), so that every participant authenticates
+// every other and only the partitions keep the cells apart.
 class PlantPartitionsTest : public ::testing::TestWithParam<bool> {};
 
 TEST_P(PlantPartitionsTest, APlannerOfOneCellReceivesNothingOfAnother) {
@@ -268,8 +268,9 @@ TEST_P(PlantPartitionsTest, APlannerOfOneCellReceivesNothingOfAnother) {
   ASSERT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "no version of its own cell";
 
   // plant-b's data is on the domain: a tool of plant-b (its own process) receives its delta and snapshot.
-  std::vector<std::string> echo{CELLMAP_TOOL, "echo",  "--domain",  std::to_string(domain),
-                                "--cell",     "plant-b", "--count", "2", "--timeout", "60"};
+  std::vector<std::string> echo{CELLMAP_TOOL, "echo",    "--domain", std::to_string(domain),
+                                "--cell",     "plant-b", "--count",  "2",
+                                "--timeout",  "60"};
   if (b) {
     const std::vector<std::string> flags = b->flags(Role::kTool);
     echo.insert(echo.end(), flags.begin(), flags.end());
@@ -282,12 +283,15 @@ TEST_P(PlantPartitionsTest, APlannerOfOneCellReceivesNothingOfAnother) {
 
   EXPECT_EQ(planner.stats().other_cells, 0u) << "plant-b's samples reached plant-a's planner";
   if (secured) {
-    // plant-a's planner credentials grant plant-a's partition only: no reader of plant-b's, nor of every cell.
-    EXPECT_NE(test::error_of([&] { transport::EnvironmentSubscriber x(participant, "plant-b"); })
-                  .find("Not Allowed By Security"),
+    // plant-a's planner credentials grant plant-a's partition only: no reader of plant-b's, nor of every
+    // cell.
+    EXPECT_NE(test::error_of([&] {
+                transport::EnvironmentSubscriber x(participant, "plant-b");
+              }).find("Not Allowed By Security"),
               std::string::npos);
-    EXPECT_NE(test::error_of([&] { transport::StatusReader x(participant, transport::kEveryCell); })
-                  .find("Not Allowed By Security"),
+    EXPECT_NE(test::error_of([&] {
+                transport::StatusReader x(participant, transport::kEveryCell);
+              }).find("Not Allowed By Security"),
               std::string::npos);
   }
   // plant-b's writers never matched plant-a's planner: their only reader was the echo's.
@@ -331,7 +335,8 @@ TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
             std::string::npos);
   EXPECT_EQ(code, 1) << "a robot of another CA reached the daemon's robot-state reader";
   const nlohmann::json served = stop(*daemon);
-  EXPECT_EQ(served, (nlohmann::json{{"edits", 0}, {"poses", 0}, {"subscribers", 1}, {"subscribers_joined", 1}}))
+  EXPECT_EQ(served,
+            (nlohmann::json{{"edits", 0}, {"poses", 0}, {"subscribers", 1}, {"subscribers_joined", 1}}))
       << "only our own planner may have matched";
 }
 
@@ -354,8 +359,8 @@ TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
 
   // Valid credentials of another cell ("refusal"; the daemon's cell is cell-1 by default).
   ASSERT_EQ(::chmod(daemon.private_key.c_str(), 0600), 0);
-  lines = run({CELLMAPD, "--domain", std::to_string(test::domain::kRefusal), "--state-dir", state.path().string(),
-               "--security", credentials.directory().string()},
+  lines = run({CELLMAPD, "--domain", std::to_string(test::domain::kRefusal), "--state-dir",
+               state.path().string(), "--security", credentials.directory().string()},
               &code);
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_NE(lines[0].find(" critical " + daemon.certificate.string() +

@@ -19,7 +19,8 @@ namespace cellmap {
   return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
 }
 [[nodiscard]] inline octomap::OcTreeKey unpack_key(std::uint64_t p) {
-  return octomap::OcTreeKey(static_cast<std::uint16_t>(p & 0xffff), static_cast<std::uint16_t>((p >> 16) & 0xffff),
+  return octomap::OcTreeKey(static_cast<std::uint16_t>(p & 0xffff),
+                            static_cast<std::uint16_t>((p >> 16) & 0xffff),
                             static_cast<std::uint16_t>(p >> 32));
 }
 

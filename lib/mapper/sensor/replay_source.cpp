@@ -17,7 +17,6 @@ namespace {
 
 constexpr const char* kPosesHeader = "file,stamp,x,y,z,qw,qx,qy,qz";
 
-
 }  // namespace
 
 std::vector<ReplayEntry> read_replay_poses(const std::string& path) {

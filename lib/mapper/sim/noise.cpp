@@ -8,7 +8,6 @@
 namespace cellmap::sim {
 namespace {
 
-
 // SplitMix64's finalizer: a fast bijective hash with good avalanche, so hash(key, pixel) acts as a random
 // number generator that can be evaluated for any pixel in any order (what makes the noise order-free).
 std::uint64_t mix(std::uint64_t x) {

@@ -15,7 +15,6 @@
 namespace cellmap::sim {
 namespace {
 
-
 std::string format_vector(const Eigen::VectorXd& v) {
   std::ostringstream out;
   out << "[";
