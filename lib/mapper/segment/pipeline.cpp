@@ -12,8 +12,6 @@
 namespace cellmap {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 class Stopwatch {
  public:
   double lap() {
@@ -145,7 +143,7 @@ void read_region_growing(YamlMap m, SegmentConfig& c) {
   RegionGrowingParams& r = c.region_growing;
   r.gap = m.number("gap", r.gap, 1e-4, 1.0);
   r.max_curvature = m.number("max_curvature", r.max_curvature, 0.0, 1.0 / 3.0);
-  r.max_angle = m.number("max_angle", r.max_angle, 0.0, kPi);
+  r.max_angle = m.number("max_angle", r.max_angle, 0.0, M_PI);
   r.min_cluster_size = static_cast<int>(m.integer("min_cluster_size", r.min_cluster_size, 1, 100000000));
   c.gap_floor_factor = m.number("gap_floor_factor", c.gap_floor_factor, 0.0, 100.0);
   m.expect_all_read();
@@ -160,7 +158,7 @@ void read_merge(YamlMap m, SegmentConfig& c) {
   ConvexMergeParams& p = c.merge_params;
   c.merge = m.get<bool>("enabled", c.merge);
   p.patch_radius = m.number("patch_radius", p.patch_radius, 1e-4, 1.0);
-  p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, kPi);
+  p.concavity_tolerance = m.number("concavity_tolerance", p.concavity_tolerance, 0.0, M_PI);
   p.min_boundary_points =
       static_cast<int>(m.integer("min_boundary_points", p.min_boundary_points, 1, 1000000));
   p.samples_per_boundary =

@@ -9,7 +9,6 @@
 namespace cellmap::self_filter {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Segments of a tessellated circle; with the circumscribing factor the polygon contains the circle.
 constexpr int kSegments = 24;
 constexpr int kRings = 12;  // latitude bands of a sphere
@@ -48,10 +47,10 @@ PaddedShape cylinder(double radius, double half_length) {
   PaddedShape shape;
   shape.kind = PaddedShape::Kind::kCylinder;
   shape.half = Eigen::Vector3d(radius, radius, half_length);
-  const double r = radius / std::cos(kPi / kSegments);  // polygon's edges touch the circle from outside
+  const double r = radius / std::cos(M_PI / kSegments);  // polygon's edges touch the circle from outside
   for (const double z : {-half_length, half_length}) {
     for (int i = 0; i < kSegments; ++i) {
-      const double a = 2.0 * kPi * i / kSegments;
+      const double a = 2.0 * M_PI * i / kSegments;
       shape.vertices_G.emplace_back(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z).cast<float>());
     }
   }
@@ -76,11 +75,11 @@ PaddedShape sphere(double radius) {
   // A latitude-longitude polyhedron whose faces stay outside the sphere: every face is within one band and
   // one segment, so its distance from the centre is at least r·cos(half the segment)·cos(half the band);
   // using full angles leaves a margin for the non-planar quads split into triangles.
-  const double r = radius / (std::cos(kPi / kSegments) * std::cos(kPi / kRings));
+  const double r = radius / (std::cos(M_PI / kSegments) * std::cos(M_PI / kRings));
   for (int ring = 0; ring <= kRings; ++ring) {
-    const double polar = kPi * ring / kRings;
+    const double polar = M_PI * ring / kRings;
     for (int i = 0; i < kSegments; ++i) {
-      const double a = 2.0 * kPi * i / kSegments;
+      const double a = 2.0 * M_PI * i / kSegments;
       shape.vertices_G.emplace_back(Eigen::Vector3d(r * std::sin(polar) * std::cos(a),
                                                     r * std::sin(polar) * std::sin(a), r * std::cos(polar))
                                         .cast<float>());

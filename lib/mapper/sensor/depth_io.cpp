@@ -5,8 +5,6 @@
 
 #include <pcl/io/lzf_image_io.h>
 
-#include <algorithm>
-#include <cctype>
 #include <csetjmp>
 #include <cstring>
 #include <filesystem>
