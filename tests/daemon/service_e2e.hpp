@@ -27,8 +27,9 @@ namespace cellmap::test {
 
 /// How long a test waits on what a daemon it started does (a version, a status, a line of its log): longer
 /// than kPatience, as the daemon first has to start, sweep and confirm; four times that in a sanitizer build,
-/// whose daemon sweeps the simulated cell 20-60 times slower (4 s a sweep under ASan, its first version after
-/// about 100 s).
+/// whose daemon sweeps the simulated cell several times slower (under ASan, quiet: 0.3 s a sweep against the
+/// release build's 0.2 s period, the first segmentation 2 s against 0.3 s, its first version after ≈ 8 s;
+/// ThreadSanitizer and a loaded machine slow it further).
 inline constexpr std::chrono::seconds kDaemonPatience{90 * kSanitizerSlowdown};
 
 /// A state directory and a config for cellmapd running the simulated cell under `cell` with exact depths:

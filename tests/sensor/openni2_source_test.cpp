@@ -240,10 +240,3 @@ TEST(SensorsCommandTest, ListsAndExitsZero) {
 
 }  // namespace
 }  // namespace cellmap
-
-// LeakSanitizer (the unit tests also run under ASan): OpenNI2's driver libraries keep a few small allocations
-// for the life of the process (PS1080, PSLink, DummyDevice; ~400 bytes, allocated inside the drivers when
-// OpenNI2 loads them). They are not ours to free; everything allocated by cellmap is still checked.
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libPS1080.so\nleak:libPSLink.so\nleak:libDummyDevice.so\nleak:libOniFile.so\n";
-}

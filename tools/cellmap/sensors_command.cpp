@@ -60,10 +60,3 @@ void add_sensors_command(CLI::App& app) {
 }
 
 }  // namespace cellmap::cli
-
-// LeakSanitizer (sanitizer builds only call this): OpenNI2's driver libraries keep a few small allocations
-// for the life of the process (PS1080, PSLink; allocated inside the drivers when OpenNI2 loads them). Not
-// ours to free; everything allocated by cellmap is still checked.
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libPS1080.so\nleak:libPSLink.so\nleak:libDummyDevice.so\nleak:libOniFile.so\n";
-}
