@@ -4,6 +4,7 @@
 #include <map>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 
 namespace cellmap {
 namespace {
@@ -12,8 +13,9 @@ bool by_id(const Box& a, const Box& b) {
   return a.id < b.id;
 }
 
+// Cell names come from the network too: quoted on one line.
 std::string version_text(const std::string& cell, std::uint64_t version) {
-  return "environment '" + cell + "' version " + std::to_string(version);
+  return "environment '" + single_line(cell) + "' version " + std::to_string(version);
 }
 
 }  // namespace
@@ -81,8 +83,9 @@ EnvironmentDelta diff(const Environment& before, const Environment& after) {
 
 Environment apply(const Environment& env, const EnvironmentDelta& delta) {
   const std::string what = "delta " + std::to_string(delta.from_version) + " -> " +
-                           std::to_string(delta.to_version) + " for '" + delta.cell + "'";
-  if (delta.cell != env.cell()) throw Error(what + ": cell: does not match '" + env.cell() + "'");
+                           std::to_string(delta.to_version) + " for '" + single_line(delta.cell) + "'";
+  if (delta.cell != env.cell())
+    throw Error(what + ": cell: does not match '" + single_line(env.cell()) + "'");
   if (delta.from_version != env.version()) {
     throw Error(what + ": from_version: does not match " + version_text(env.cell(), env.version()));
   }

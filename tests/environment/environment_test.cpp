@@ -100,6 +100,28 @@ TEST(EnvironmentTest, ApplyRefusesMismatchedDeltas) {
   }
 }
 
+// Found by fuzz_dds_samples: a delta from the network whose cell name holds a line break made a refusal of
+// two lines (a forged log line). The cell is quoted with '?' for each control character.
+TEST(EnvironmentTest, RefusalQuotesACellNameWithALineBreakOnOneLine) {
+  const Environment env("c\nforged", 3, 0, {});
+  EnvironmentDelta delta;
+  delta.cell = env.cell();
+  delta.from_version = 3;
+  delta.to_version = 4;
+  delta.modified = {box(2, 5.0)};
+  for (const std::string& cell : {env.cell(), std::string("d\rforged")}) {
+    delta.cell = cell;
+    try {
+      (void)apply(env, delta);
+      FAIL() << "a delta of an absent box or another cell must throw";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find_first_of("\n\r"), std::string::npos) << what;
+      EXPECT_NE(what.find("forged"), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(EnvironmentTest, ChainOfDeltasReproducesEveryVersion) {
   // Versions built by random edits: applying the diffs in order must rebuild each version exactly.
   std::srand(7);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/common/wall_clock.hpp"
 #include "cellmap/transport/topics.hpp"
 #include "wire.hpp"
@@ -12,8 +13,8 @@
 namespace cellmap::transport {
 
 RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& joint_names) {
-  const std::string where =
-      std::string(kRobotJointsTopic) + " '" + joints.cell + "' at " + std::to_string(joints.stamp_ns);
+  const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "' at " +
+                            std::to_string(joints.stamp_ns);
   if (joints.positions.size() != joint_names.size()) {
     throw Error(where + ": " + std::to_string(joints.positions.size()) + " positions, the robot has " +
                 std::to_string(joint_names.size()) + " joints");
@@ -49,8 +50,8 @@ bool RobotJointsWriter::wait_for_reader(std::chrono::nanoseconds timeout) const 
 void RobotJointsWriter::write(const RobotJoints& joints) const {
   wire::validate(joints);
   if (joints.cell != cell_) {
-    throw Error(std::string(kRobotJointsTopic) + " '" + joints.cell + "': this writer is for cell '" + cell_ +
-                "'");
+    throw Error(std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) +
+                "': this writer is for cell '" + cell_ + "'");
   }
   const wire::RobotJointsSample sample(joints);
   writer_.write(sample.get());

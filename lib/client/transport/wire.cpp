@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport::wire {
@@ -234,7 +235,7 @@ RobotState from_wire(const cellmap_msg_RobotState& msg) {
   RobotState state;
   state.cell = cell_of(msg.cell, kRobotStateTopic);
   const std::string where =
-      std::string(kRobotStateTopic) + " '" + state.cell + "' at " + std::to_string(msg.stamp_ns);
+      std::string(kRobotStateTopic) + " '" + single_line(state.cell) + "' at " + std::to_string(msg.stamp_ns);
   require_finite(msg.position, 3, where + ": position");
   require_finite(msg.orientation, 4, where + ": orientation");
   const Eigen::Quaterniond q(msg.orientation[0], msg.orientation[1], msg.orientation[2], msg.orientation[3]);
@@ -272,7 +273,7 @@ RobotJointsSample::RobotJointsSample(const RobotJoints& joints) : joints_(joints
 
 void validate(const RobotJoints& joints) {
   if (joints.cell.empty()) throw Error(std::string(kRobotJointsTopic) + ": cell: must not be empty");
-  const std::string where = std::string(kRobotJointsTopic) + " '" + joints.cell + "'";
+  const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "'";
   if (!joints.names.empty() && joints.names.size() != joints.positions.size()) {
     throw Error(where + ": " + std::to_string(joints.names.size()) + " names for " +
                 std::to_string(joints.positions.size()) + " positions");
@@ -303,7 +304,7 @@ RobotJoints from_wire(const cellmap_msg_RobotJoints& msg) {
   joints.positions.assign(msg.positions._buffer, msg.positions._buffer + msg.positions._length);
   if (msg.payload._length == 1) {
     const cellmap_msg_ToolPayload& p = msg.payload._buffer[0];
-    const std::string where = std::string(kRobotJointsTopic) + " '" + joints.cell + "': payload";
+    const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "': payload";
     require_finite(p.rotation, 4, where + ".rotation");
     const Eigen::Quaterniond q(p.rotation[0], p.rotation[1], p.rotation[2], p.rotation[3]);
     if (std::abs(q.norm() - 1.0) > 1e-3)
