@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/common/text.hpp"
 #include "cellmap/transport/topics.hpp"
+#include "wire.hpp"
 
 namespace cellmap::transport {
 namespace {
@@ -53,15 +53,13 @@ void check_limits(const SceneEdit& edit, const InputLimits& limits) {
 }
 
 void check_limits(const RobotState& state, const InputLimits& limits, std::int64_t now_ns) {
-  const std::string where = std::string(kRobotStateTopic) + " '" + single_line(state.cell) + "' at " +
-                            std::to_string(state.stamp_ns);
+  const std::string where = wire::sample_name(kRobotStateTopic, state.cell, state.stamp_ns);
   require_inside(state.X_CE.translation(), limits, where + ": position");
   require_stamp_near(state.stamp_ns, limits, now_ns, where);
 }
 
 void check_limits(const RobotJoints& joints, const InputLimits& limits, std::int64_t now_ns) {
-  const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "' at " +
-                            std::to_string(joints.stamp_ns);
+  const std::string where = wire::sample_name(kRobotJointsTopic, joints.cell, joints.stamp_ns);
   require_stamp_near(joints.stamp_ns, limits, now_ns, where);
   if (!joints.payload) return;
   const double largest = limits.cell.sizes().maxCoeff();

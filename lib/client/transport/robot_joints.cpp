@@ -13,8 +13,7 @@
 namespace cellmap::transport {
 
 RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& joint_names) {
-  const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "' at " +
-                            std::to_string(joints.stamp_ns);
+  const std::string where = wire::sample_name(kRobotJointsTopic, joints.cell, joints.stamp_ns);
   if (joints.positions.size() != joint_names.size()) {
     throw Error(where + ": " + std::to_string(joints.positions.size()) + " positions, the robot has " +
                 std::to_string(joint_names.size()) + " joints");

@@ -94,6 +94,10 @@ std::string cell_of(const char* cell, const char* topic) {
   return cell;
 }
 
+std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns) {
+  return std::string(topic) + " '" + single_line(cell) + "' at " + std::to_string(stamp_ns);
+}
+
 EnvironmentSample::EnvironmentSample(const Environment& env)
     : cell_(env.cell()), boxes_(to_msgs(env.boxes())) {
   msg_.cell = text(cell_);
@@ -234,8 +238,7 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
 RobotState from_wire(const cellmap_msg_RobotState& msg) {
   RobotState state;
   state.cell = cell_of(msg.cell, kRobotStateTopic);
-  const std::string where =
-      std::string(kRobotStateTopic) + " '" + single_line(state.cell) + "' at " + std::to_string(msg.stamp_ns);
+  const std::string where = sample_name(kRobotStateTopic, state.cell, msg.stamp_ns);
   require_finite(msg.position, 3, where + ": position");
   require_finite(msg.orientation, 4, where + ": orientation");
   const Eigen::Quaterniond q(msg.orientation[0], msg.orientation[1], msg.orientation[2], msg.orientation[3]);

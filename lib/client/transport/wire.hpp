@@ -3,6 +3,7 @@
 // Outgoing: a *Sample object builds the C struct pointing into its own storage (nothing is dds_alloc'ed), so
 // it must outlive the write. Incoming: from_wire() copies out of Cyclone's loaned sample and validates it.
 
+#include <cstdint>
 #include <vector>
 
 #include "cellmap.h"
@@ -84,6 +85,8 @@ void validate(const RobotJoints& joints);
 
 /// The cell of an incoming sample. @throws Error naming the topic if it is empty.
 [[nodiscard]] std::string cell_of(const char* cell, const char* topic);
+/// How refusals name a sample: "<topic> '<cell>' at <stamp_ns>", the cell (from the network) on one line.
+[[nodiscard]] std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns);
 /// The bytes of `sample` (of the generated `type`) in an RTPS DATA submessage: the 4-byte encapsulation
 /// header plus the XCDR1 body, measured with Cyclone's own serializer.
 [[nodiscard]] std::size_t serialized_size(const void* sample, const dds_topic_descriptor_t& type);
