@@ -1,7 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <string>
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
@@ -21,6 +26,35 @@ Sweep patch_sweep() {
   Sweep sweep;
   sweep.scans.push_back(scan);
   return sweep;
+}
+
+// A saved map written by hand: write()'s header, then `nodes` (OctoMap's node data).
+std::string saved_map(const std::string& nodes) {
+  std::ostringstream header;
+  OccupancyMap().write(header);  // an empty map: the header and no node
+  return header.str() + nodes;
+}
+
+// One node of OctoMap's node data: its log-odds, then which children follow.
+std::string node(float log_odds, std::uint8_t children) {
+  std::string bytes(sizeof log_odds, '\0');
+  std::memcpy(bytes.data(), &log_odds, sizeof log_odds);
+  return bytes + static_cast<char>(children);
+}
+
+// A path of single children from the root down to level `depth` (exclusive), whose last node has the
+// children `last_children`.
+std::string path_to(unsigned depth, std::uint8_t last_children) {
+  std::string nodes;
+  for (unsigned level = 0; level + 1 < depth; ++level) nodes += node(2.0f, 0x01);
+  return nodes + node(2.0f, last_children);
+}
+
+OccupancyMap read_map(const std::string& saved) {
+  std::istringstream in(saved);
+  OccupancyMap map;
+  map.read(in);
+  return map;
 }
 
 TEST(OccupancyMapStateTest, OccupiedCentresInsideRegionsOnly) {
@@ -74,6 +108,45 @@ TEST(OccupancyMapStateTest, ReadRejectsOtherResolutionAndGarbage) {
   std::stringstream truncated(saved.str().substr(0, saved.str().size() / 2));
   OccupancyMap again;
   EXPECT_THROW(again.read(truncated), Error);
+}
+
+TEST(OccupancyMapStateTest, ReadRefusesAMapThatUnpacksToMoreOccupiedVoxelsThanTheLimit) {
+  // Pruned occupied leaves at level 9 of 16 stand for 8⁷ = 2²¹ voxels each: two are the limit, three beyond.
+  static_assert(OccupancyMap::kMaxSavedOccupiedVoxels == 2 * (std::uint64_t{1} << 21));
+  const OccupancyMap two = read_map(saved_map(path_to(9, 0x03) + node(2.0f, 0) + node(2.0f, 0)));
+  EXPECT_EQ(two.tree().getNumLeafNodes(), 2u);
+  std::size_t occupied_leaves = 0;
+  for (auto it = two.tree().begin_leafs(); it != two.tree().end_leafs(); ++it)
+    occupied_leaves += two.tree().isNodeOccupied(*it) ? 1 : 0;
+  EXPECT_EQ(occupied_leaves, 2u);
+  // A free third leaf counts nothing; an occupied one is refused, as is one node for 8¹⁵ voxels.
+  EXPECT_NO_THROW(read_map(saved_map(path_to(9, 0x07) + node(2.0f, 0) + node(2.0f, 0) + node(-2.0f, 0))));
+  try {
+    read_map(saved_map(path_to(9, 0x07) + node(2.0f, 0) + node(2.0f, 0) + node(2.0f, 0)));
+    ADD_FAILURE() << "a map of 3 · 2²¹ occupied voxels was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than 4194304 occupied voxels"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(read_map(saved_map(node(2.0f, 0x01) + node(2.0f, 0))), Error);
+}
+
+TEST(OccupancyMapStateTest, ReadRefusesNodeDataOctoMapWouldMisread) {
+  const std::string leaf_at_16 = path_to(16, 0x01) + node(2.0f, 0);
+  EXPECT_NO_THROW(read_map(saved_map(leaf_at_16)));
+  // One level deeper than the tree, a log-odds that is not a number, a node cut short, a child missing.
+  EXPECT_THROW(read_map(saved_map(path_to(17, 0x01) + node(2.0f, 0))), Error);
+  std::string not_a_number = leaf_at_16;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(not_a_number.data() + not_a_number.size() - 5, &nan, sizeof nan);
+  EXPECT_THROW(read_map(saved_map(not_a_number)), Error);
+  EXPECT_THROW(read_map(saved_map(leaf_at_16.substr(0, leaf_at_16.size() - 1))), Error);
+  EXPECT_THROW(read_map(saved_map(path_to(16, 0x03) + node(2.0f, 0))), Error);
+}
+
+TEST(OccupancyMapStateTest, AnEmptyMapReadsBackEmpty) {
+  const OccupancyMap map = read_map(saved_map(""));
+  EXPECT_EQ(map.tree().size(), 0u);
+  EXPECT_TRUE(map.occupied_keys().empty());
 }
 
 }  // namespace

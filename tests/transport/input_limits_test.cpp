@@ -96,6 +96,19 @@ TEST_F(SceneEditRulesTest, UnknownKindsAndBadNamesAreRefused) {
             "cellmap/sim/scene_edits '" + std::string(128, 'x') + "': name: longer than 128 bytes");
 }
 
+// A name with a line break would split the log line that quotes it (found by fuzz_dds_samples:
+// fuzz/regressions/dds_samples/scene_edit_name_with_line_break).
+TEST_F(SceneEditRulesTest, ANameWithAControlCharacterIsRefusedOnOneLine) {
+  name_ = "c\n2026-12-02T06:00:00.000 info forged";
+  msg_.name = name_.data();
+  EXPECT_EQ(
+      refusal(),
+      "cellmap/sim/scene_edits 'c?2026-12-02T06:00:00.000 info forged': name: holds a control character");
+  name_ = "tab\there";
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'tab?here': name: holds a control character");
+}
+
 class RobotStateRulesTest : public ::testing::Test {
  protected:
   RobotStateRulesTest() {
@@ -156,8 +169,7 @@ TEST_F(RobotStateRulesTest, ACellNameWithLineBreaksIsQuotedOnOneLine) {
   cell_ = "cell-1\n2026-12-02T06:00:00.000 info forged\r";
   msg_.cell = cell_.data();
   msg_.position[2] = std::nan("");
-  EXPECT_EQ(refusal().substr(0, 69),
-            "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?' at ")
+  EXPECT_EQ(refusal().substr(0, 69), "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?' at ")
       << refusal();
   msg_.position[2] = 1.5;
   msg_.stamp_ns = kNow - 6'000'000'000;

@@ -37,7 +37,7 @@ void require_stamp_near(std::int64_t stamp_ns, const InputLimits& limits, std::i
 }  // namespace
 
 void check_limits(const SceneEdit& edit, const InputLimits& limits) {
-  const std::string where = std::string(kSceneEditTopic) + " '" + edit.name.substr(0, kMaxNameLength) + "'";
+  const std::string where = wire::edit_name(edit.name);
   if (edit.name.size() > kMaxNameLength)
     throw Error(where + ": name: longer than " + std::to_string(kMaxNameLength) + " bytes");
   if (edit.kind == SceneEdit::Kind::kRemove) return;

@@ -6,6 +6,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/text.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/topics.hpp"
 
 namespace cellmap::transport::wire {
@@ -96,6 +97,10 @@ std::string cell_of(const char* cell, const char* topic) {
 
 std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns) {
   return std::string(topic) + " '" + single_line(cell) + "' at " + std::to_string(stamp_ns);
+}
+
+std::string edit_name(const std::string& name) {
+  return std::string(kSceneEditTopic) + " '" + single_line(name.substr(0, kMaxNameLength)) + "'";
 }
 
 EnvironmentSample::EnvironmentSample(const Environment& env)
@@ -207,7 +212,7 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
 }
 
 SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
-  const std::string where = std::string(kSceneEditTopic) + " '" + (msg.name ? msg.name : "") + "'";
+  const std::string where = edit_name(msg.name ? msg.name : "");
   SceneEdit edit;
   edit.cell = msg.cell ? msg.cell : "";
   switch (kind_on_the_wire(msg)) {
@@ -225,6 +230,8 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   }
   edit.name = msg.name ? msg.name : "";
   if (edit.name.empty()) throw Error(where + ": name: must not be empty");
+  // Names go to logs and scene files one per line.
+  if (single_line(edit.name) != edit.name) throw Error(where + ": name: holds a control character");
   require_finite(msg.center, 3, where + ": center");
   require_finite(msg.half_extents, 3, where + ": half_extents");
   require_finite(&msg.yaw, 1, where + ": yaw");

@@ -87,6 +87,9 @@ void validate(const RobotJoints& joints);
 [[nodiscard]] std::string cell_of(const char* cell, const char* topic);
 /// How refusals name a sample: "<topic> '<cell>' at <stamp_ns>", the cell (from the network) on one line.
 [[nodiscard]] std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns);
+/// How refusals name a scene edit: "<topic> '<name>'", the name (from the network) on one line and cut at
+/// kMaxNameLength bytes.
+[[nodiscard]] std::string edit_name(const std::string& name);
 /// The bytes of `sample` (of the generated `type`) in an RTPS DATA submessage: the 4-byte encapsulation
 /// header plus the XCDR1 body, measured with Cyclone's own serializer.
 [[nodiscard]] std::size_t serialized_size(const void* sample, const dds_topic_descriptor_t& type);

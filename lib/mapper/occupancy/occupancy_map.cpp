@@ -1,10 +1,13 @@
 #include "cellmap/occupancy/occupancy_map.hpp"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <istream>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -28,6 +31,44 @@ void sort_zyx(std::vector<octomap::OcTreeKey>& keys) {
                               static_cast<octomap::key_type>((p >> 16) & 0xffff),
                               static_cast<octomap::key_type>(p >> 32));
   });
+}
+
+// OctoMap's node data as OcTree::writeData writes it (each node its log-odds as a float, then a byte that
+// says which of its eight children follow, depth first), read from `in` and checked before OcTree::readData
+// sees it: readData recurses once per level, reads on past the end of a truncated stream, and takes one
+// coarse occupied node for every voxel below it. @throws Error unless the data ends within `in`, no node lies
+// deeper than `depth`, every log-odds is finite, and the occupied leaves (log-odds at least
+// `occupied_log_odds`) stand for at most `max_occupied` voxels of the finest level.
+std::string checked_node_data(std::istream& in, unsigned depth, float occupied_log_odds,
+                              std::uint64_t max_occupied) {
+  constexpr std::size_t kNodeBytes = sizeof(float) + 1;
+  std::string data;
+  std::uint64_t occupied = 0;
+  std::vector<int> children_left{1};  // per level on the path from the root: nodes still to read
+  while (!children_left.empty()) {
+    if (children_left.back() == 0) {
+      children_left.pop_back();
+      continue;
+    }
+    --children_left.back();
+    const unsigned level = static_cast<unsigned>(children_left.size()) - 1;
+    char node[kNodeBytes];
+    if (!in.read(node, kNodeBytes)) throw Error("occupancy map: the saved map is truncated");
+    data.append(node, kNodeBytes);
+    float log_odds = 0;
+    std::memcpy(&log_odds, node, sizeof log_odds);
+    if (!std::isfinite(log_odds))
+      throw Error("occupancy map: the saved map holds a log-odds that is not finite");
+    const int children = std::bitset<8>(static_cast<unsigned char>(node[sizeof(float)])).count();
+    if (children > 0 && level == depth) throw Error("occupancy map: the saved map is deeper than the tree");
+    if (children == 0 && log_odds >= occupied_log_odds) occupied += std::uint64_t{1} << (3 * (depth - level));
+    if (occupied > max_occupied) {
+      throw Error("occupancy map: the saved map holds more than " + std::to_string(max_occupied) +
+                  " occupied voxels (OccupancyMap::kMaxSavedOccupiedVoxels)");
+    }
+    if (children > 0) children_left.push_back(children);
+  }
+  return data;
 }
 
 }  // namespace
@@ -260,8 +301,12 @@ void OccupancyMap::read(std::istream& in) {
   }
   auto tree = std::make_unique<octomap::OcTree>(config_.resolution);
   apply_sensor_model(config_, *tree);
-  tree->readData(in);
-  if (!in) throw Error("occupancy map: the saved map is truncated");
+  // An empty map is written as no node at all.
+  if (in.peek() != std::char_traits<char>::eof()) {
+    std::istringstream nodes(
+        checked_node_data(in, tree->getTreeDepth(), tree->getOccupancyThresLog(), kMaxSavedOccupiedVoxels));
+    tree->readData(nodes);
+  }
   tree_ = std::move(tree);
 }
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <memory>
@@ -123,15 +124,22 @@ class OccupancyMap final {
   /// up to that voxel (all of them when none does).
   [[nodiscard]] bool any_occupied_in(
       const Region& region,
-      const std::function<bool(const octomap::OcTreeKey& key, const Eigen::Vector3d& centre_C)>& accept) const;
+      const std::function<bool(const octomap::OcTreeKey& key, const Eigen::Vector3d& centre_C)>& accept)
+      const;
 
   /// Writes the whole map, log-odds included, to `out` (a resolution line, then OctoMap's node data), so a
   /// restarted daemon continues with the same evidence. Silent (OctoMap's .bt writer prints to stderr).
   /// @throws Error if the stream fails.
   void write(std::ostream& out) const;
   /// Replaces the map with one written by write() at the same resolution.
-  /// @throws Error if the stream is not such a map or its resolution differs from the config's.
+  /// @throws Error if the stream is not such a map, its resolution differs from the config's, or it holds
+  /// more than kMaxSavedOccupiedVoxels occupied voxels (the map is then left as it was).
   void read(std::istream& in);
+  /// The most occupied voxels a saved map may hold: 2²² ≈ 4.2 million, at 5 cm 10 000 m² of surface one
+  /// voxel thick, far beyond what a cell's sensors see. Whoever reads a map lists its occupied voxels one by
+  /// one (occupied_keys), and one coarse node of a few bytes in a file can stand for 8¹⁵ of them: a state
+  /// that unpacks to more is refused rather than allowed to exhaust memory.
+  static constexpr std::uint64_t kMaxSavedOccupiedVoxels = std::uint64_t{1} << 22;
 
   /// The OcTree itself (for queries, writing .bt files, or comparison); its parameters are the config's.
   [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
