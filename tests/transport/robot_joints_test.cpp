@@ -120,6 +120,17 @@ TEST(RobotJointsTest, SamplesThatDoNotFitTheRobotAreRefusedAndCounted) {
   EXPECT_THROW(RobotJointsReader(daemon, "cell-a", {"j1", "j1"}), Error);
 }
 
+// A joint name from the network stays on one line in the refusal (found by fuzz_dds_samples:
+// fuzz/regressions/dds_samples/joint_name_with_line_break).
+TEST(RobotJointsTest, AJointNameWithALineBreakIsQuotedOnOneLine) {
+  const RobotJoints unknown = joints_at("cell-a", 7, {"j1", "sh\nou\rlder", "j3"}, {0, 0, 0});
+  EXPECT_EQ(test::error_of([&] { (void)in_robot_order(unknown, kJoints); }),
+            "cellmap/robot_joints 'cell-a' at 7: unknown joint 'sh?ou?lder'");
+  const RobotJoints twice = joints_at("cell-a", 7, {"j1", "j1", "j3"}, {0, 0, 0});
+  EXPECT_EQ(test::error_of([&] { (void)in_robot_order(twice, kJoints); }),
+            "cellmap/robot_joints 'cell-a' at 7: joint 'j1' given twice");
+}
+
 TEST(RobotJointsTest, RobotPoseCommandPublishesNamedJointsWithAPayload) {
   test::use_loopback();
   dds::Participant daemon(test::domain::kJointsCommand);

@@ -26,9 +26,9 @@ RobotJoints in_robot_order(RobotJoints joints, const std::vector<std::string>& j
   std::vector<bool> seen(joint_names.size(), false);
   for (std::size_t i = 0; i < joints.names.size(); ++i) {
     const auto it = std::find(joint_names.begin(), joint_names.end(), joints.names[i]);
-    if (it == joint_names.end()) throw Error(where + ": unknown joint '" + joints.names[i] + "'");
+    if (it == joint_names.end()) throw Error(where + ": unknown joint " + wire::quote_input(joints.names[i]));
     const auto k = static_cast<std::size_t>(it - joint_names.begin());
-    if (seen[k]) throw Error(where + ": joint '" + joints.names[i] + "' given twice");
+    if (seen[k]) throw Error(where + ": joint " + wire::quote_input(joints.names[i]) + " given twice");
     seen[k] = true;
     ordered[k] = joints.positions[i];
   }
@@ -49,8 +49,8 @@ bool RobotJointsWriter::wait_for_reader(std::chrono::nanoseconds timeout) const 
 void RobotJointsWriter::write(const RobotJoints& joints) const {
   wire::validate(joints);
   if (joints.cell != cell_) {
-    throw Error(std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) +
-                "': this writer is for cell '" + cell_ + "'");
+    throw Error(std::string(kRobotJointsTopic) + " " + wire::quote_input(joints.cell) +
+                ": this writer is for cell '" + cell_ + "'");
   }
   const wire::RobotJointsSample sample(joints);
   writer_.write(sample.get());

@@ -95,12 +95,16 @@ std::string cell_of(const char* cell, const char* topic) {
   return cell;
 }
 
+std::string quote_input(const std::string& text) {
+  return "'" + single_line(text.substr(0, kMaxNameLength)) + "'";
+}
+
 std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns) {
-  return std::string(topic) + " '" + single_line(cell) + "' at " + std::to_string(stamp_ns);
+  return std::string(topic) + " " + quote_input(cell) + " at " + std::to_string(stamp_ns);
 }
 
 std::string edit_name(const std::string& name) {
-  return std::string(kSceneEditTopic) + " '" + single_line(name.substr(0, kMaxNameLength)) + "'";
+  return std::string(kSceneEditTopic) + " " + quote_input(name);
 }
 
 EnvironmentSample::EnvironmentSample(const Environment& env)
@@ -283,7 +287,7 @@ RobotJointsSample::RobotJointsSample(const RobotJoints& joints) : joints_(joints
 
 void validate(const RobotJoints& joints) {
   if (joints.cell.empty()) throw Error(std::string(kRobotJointsTopic) + ": cell: must not be empty");
-  const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "'";
+  const std::string where = std::string(kRobotJointsTopic) + " " + quote_input(joints.cell);
   if (!joints.names.empty() && joints.names.size() != joints.positions.size()) {
     throw Error(where + ": " + std::to_string(joints.names.size()) + " names for " +
                 std::to_string(joints.positions.size()) + " positions");
@@ -314,7 +318,7 @@ RobotJoints from_wire(const cellmap_msg_RobotJoints& msg) {
   joints.positions.assign(msg.positions._buffer, msg.positions._buffer + msg.positions._length);
   if (msg.payload._length == 1) {
     const cellmap_msg_ToolPayload& p = msg.payload._buffer[0];
-    const std::string where = std::string(kRobotJointsTopic) + " '" + single_line(joints.cell) + "': payload";
+    const std::string where = std::string(kRobotJointsTopic) + " " + quote_input(joints.cell) + ": payload";
     require_finite(p.rotation, 4, where + ".rotation");
     const Eigen::Quaterniond q(p.rotation[0], p.rotation[1], p.rotation[2], p.rotation[3]);
     if (std::abs(q.norm() - 1.0) > 1e-3)

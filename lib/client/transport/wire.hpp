@@ -85,10 +85,12 @@ void validate(const RobotJoints& joints);
 
 /// The cell of an incoming sample. @throws Error naming the topic if it is empty.
 [[nodiscard]] std::string cell_of(const char* cell, const char* topic);
-/// How refusals name a sample: "<topic> '<cell>' at <stamp_ns>", the cell (from the network) on one line.
-[[nodiscard]] std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns);
-/// How refusals name a scene edit: "<topic> '<name>'", the name (from the network) on one line and cut at
+/// Text from the network as a refusal quotes it: in single quotes, on one line (single_line), cut at
 /// kMaxNameLength bytes.
+[[nodiscard]] std::string quote_input(const std::string& text);
+/// How refusals name a sample: "<topic> '<cell>' at <stamp_ns>", the cell as quote_input() gives it.
+[[nodiscard]] std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns);
+/// How refusals name a scene edit: "<topic> '<name>'", the name as quote_input() gives it.
 [[nodiscard]] std::string edit_name(const std::string& name);
 /// The bytes of `sample` (of the generated `type`) in an RTPS DATA submessage: the 4-byte encapsulation
 /// header plus the XCDR1 body, measured with Cyclone's own serializer.
