@@ -1,6 +1,7 @@
 #include "key_update.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -448,13 +449,27 @@ class KeyConverter {
                      _mm_or_si128(_mm_unpacklo_epi32(xy, kz), _mm_unpacklo_epi32(outside, outside)));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i + 2),
                      _mm_or_si128(_mm_unpackhi_epi32(xy, kz), _mm_unpackhi_epi32(outside, outside)));
+    // The near lanes' indices, in order, with one store (its lanes past the near ones are overwritten later
+    // or ignored: redo_count + 3 < count, as redo_count <= i).
     const int lanes = _mm_movemask_ps(near);
-    for (int lane = 0; lane < 4; ++lane) {
-      redo[redo_count] = std::uint32_t(i) + std::uint32_t(lane);
-      redo_count += std::size_t((lanes >> lane) & 1);
-    }
-    return redo_count;
+    const __m128i order = _mm_loadu_si128(reinterpret_cast<const __m128i*>(kSetLanes[lanes].data()));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(redo + redo_count),
+                     _mm_add_epi32(order, _mm_set1_epi32(static_cast<int>(i))));
+    return redo_count + std::size_t(kSetLanes[lanes][4]);
   }
+
+  // For each 4-bit lane mask: the set lanes in increasing order, then (entry 4) how many there are.
+  static constexpr std::array<std::array<std::uint32_t, 5>, 16> kSetLanes = [] {
+    std::array<std::array<std::uint32_t, 5>, 16> table{};
+    for (std::uint32_t mask = 0; mask < 16; ++mask) {
+      std::uint32_t count = 0;
+      for (std::uint32_t lane = 0; lane < 4; ++lane) {
+        if ((mask >> lane) & 1) table[mask][count++] = lane;
+      }
+      table[mask][4] = count;
+    }
+    return table;
+  }();
 
   // trunc(v × factor + 32768) of four coordinates (the key where `inside` and not `near`); clears `inside`
   // where out of the key range (or not finite) and sets `near` where single precision may be off by one.
@@ -476,6 +491,40 @@ class KeyConverter {
   int max_val_;
 };
 
+// Extends `box` by the packed keys keys[0 .. n): per component their least and greatest value, two keys per
+// instruction where SSE2 is there (16-bit lanes; SSE2 compares them signed, hence the flip of the top bit).
+void extend_by_packed(KeyBox& box, const std::uint64_t* keys, std::size_t n) {
+#if defined(__SSE2__)
+  if (n == 0) return;
+  const __m128i flip = _mm_set1_epi16(static_cast<short>(0x8000));
+  __m128i least = _mm_set1_epi16(0x7fff);
+  __m128i greatest = _mm_set1_epi16(static_cast<short>(0x8000));
+  const auto take = [&](__m128i two_keys) {
+    two_keys = _mm_xor_si128(two_keys, flip);
+    least = _mm_min_epi16(least, two_keys);
+    greatest = _mm_max_epi16(greatest, two_keys);
+  };
+  std::size_t i = 0;
+  for (; i + 2 <= n; i += 2) take(_mm_loadu_si128(reinterpret_cast<const __m128i*>(keys + i)));
+  if (i < n) {
+    const __m128i last = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(keys + i));
+    take(_mm_unpacklo_epi64(last, last));
+  }
+  least = _mm_min_epi16(least, _mm_shuffle_epi32(least, _MM_SHUFFLE(1, 0, 3, 2)));
+  greatest = _mm_max_epi16(greatest, _mm_shuffle_epi32(greatest, _MM_SHUFFLE(1, 0, 3, 2)));
+  least = _mm_xor_si128(least, flip);
+  greatest = _mm_xor_si128(greatest, flip);
+  box.extend(Key(static_cast<std::uint16_t>(_mm_extract_epi16(least, 0)),
+                 static_cast<std::uint16_t>(_mm_extract_epi16(least, 1)),
+                 static_cast<std::uint16_t>(_mm_extract_epi16(least, 2))));
+  box.extend(Key(static_cast<std::uint16_t>(_mm_extract_epi16(greatest, 0)),
+                 static_cast<std::uint16_t>(_mm_extract_epi16(greatest, 1)),
+                 static_cast<std::uint16_t>(_mm_extract_epi16(greatest, 2))));
+#else
+  for (std::size_t i = 0; i < n; ++i) box.extend(unpack_key(keys[i]));
+#endif
+}
+
 // Appends to `keys` the packed keys of `points` [begin, end), skipping invalid points and repeats of the
 // previous point's key (neighbouring pixels mostly share a voxel), and extends `box` by them. Converts and
 // compacts block by block through a small buffer, so that no frame-sized memory is written twice.
@@ -496,7 +545,7 @@ void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator
       n += std::size_t((packed != last) & (packed != kNoKey));
       last = packed;
     }
-    for (std::size_t i = 0; i < n; ++i) box.extend(unpack_key(block[i]));
+    extend_by_packed(box, block, n);
     keys.insert(keys.end(), block, block + n);
   }
 }
