@@ -332,17 +332,15 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
   const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
   const double length = w.length;
-  // A walk needs at most the Manhattan key distance in steps; the bound guards against rounding loops.
-  int steps_left = 3 + std::abs(int(ray.end_key[0]) - int(origin.key[0])) +
-                   std::abs(int(ray.end_key[1]) - int(origin.key[1])) +
-                   std::abs(int(ray.end_key[2]) - int(origin.key[2]));
   // OctoMap steps along the axis of the nearest crossing, stops at the end voxel, then stops if the next
   // crossing lies past the end point (rounding at a corner), and else marks the voxel. Here each turn tests
   // the next crossing, marks the voxel the previous step entered (the origin voxel, marked already, on the
   // first turn), then steps: the same rule (if the first crossing lies past the end point, OctoMap takes the
   // first step, then stops without marking). Each axis has its own code path: the choice is a branch, which
   // lets the next step start before the comparison ends (a branch-free choice measured slower: every step
-  // then waits for the comparison).
+  // then waits for the comparison). The walk ends: every step moves one voxel, and the cursor's grid is
+  // finite (it stops where the walk leaves it), as is the length (every crossing distance grows by its
+  // positive delta at its step).
   auto advance = [&](double& t, double delta, auto axis) {
     if (t > length) return false;
     cursor.mark();
@@ -353,11 +351,20 @@ void walk_ray(const Origin& origin, const Ray& ray, const octomap::OcTree& grid,
   using X = std::integral_constant<int, 0>;
   using Y = std::integral_constant<int, 1>;
   using Z = std::integral_constant<int, 2>;
-  while (steps_left-- > 0) {
-    // OctoMap's tie-breaking: the later axis wins ties.
-    const bool more = tx < ty ? (tx < tz ? advance(tx, dx, X{}) : advance(tz, dz, Z{}))
-                              : (ty < tz ? advance(ty, dy, Y{}) : advance(tz, dz, Z{}));
-    if (!more) return;
+  // OctoMap's tie-breaking: the later axis wins ties. Each branch leaves on its own test, so that the test
+  // is one compare and jump.
+  for (;;) {
+    if (tx < ty) {
+      if (tx < tz) {
+        if (!advance(tx, dx, X{})) return;
+      } else if (!advance(tz, dz, Z{})) {
+        return;
+      }
+    } else if (ty < tz) {
+      if (!advance(ty, dy, Y{})) return;
+    } else if (!advance(tz, dz, Z{})) {
+      return;
+    }
   }
 }
 
