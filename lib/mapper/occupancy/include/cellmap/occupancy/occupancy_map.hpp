@@ -132,8 +132,9 @@ class OccupancyMap final {
   /// @throws Error if the stream fails.
   void write(std::ostream& out) const;
   /// Replaces the map with one written by write() at the same resolution.
-  /// @throws Error if the stream is not such a map, its resolution differs from the config's, or it holds
-  /// more than kMaxSavedOccupiedVoxels occupied voxels (the map is then left as it was).
+  /// @throws Error if the stream is not such a map (also: cut short, a node deeper than the tree, a log-odds
+  /// that is not finite), its resolution differs from the config's, or it holds more than
+  /// kMaxSavedOccupiedVoxels occupied voxels; the map is then left as it was.
   void read(std::istream& in);
   /// The most occupied voxels a saved map may hold: 2²² ≈ 4.2 million, at 5 cm 10 000 m² of surface one
   /// voxel thick, far beyond what a cell's sensors see. Whoever reads a map lists its occupied voxels one by
