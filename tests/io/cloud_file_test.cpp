@@ -250,6 +250,10 @@ TEST_F(CloudFileTest, RefusesPlyLayoutsPclMisreads) {
       {head + "obj_info num_cols 100000\nobj_info num_rows 100000\nelement vertex 1\n" + xyz +
            "end_header\n1 2 3\n",
        "obj_info num_cols x num_rows (100000 x 100000) is not the vertex count 1"},
+      // ... also by a num_rows of 0 after the vertex element (fuzz_ply: PCL's reader then asserts):
+      // fuzz/regressions/ply/num_rows_0_after_the_vertices.ply.
+      {head + "element vertex 1\n" + xyz + "obj_info num_cols 1\nobj_info num_rows 0\nend_header\n1 2 3\n",
+       "obj_info num_cols x num_rows (1 x 0) is not the vertex count 1"},
       {head + "element vertex 1\n" + xyz + "element nothing 100000000\nend_header\n1 2 3\n",
        "element 'nothing' has instances but no properties"},
       {head + "element vertex 1\n" + xyz + "bogus line\nend_header\n1 2 3\n", "unexpected header line"},

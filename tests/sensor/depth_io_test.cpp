@@ -86,5 +86,29 @@ TEST(DepthIoTest, ATiffFuzzFindingIsRefusedWithOneLine) {
   EXPECT_NE(message.find("ink.tiff: cannot read TIFF"), std::string::npos) << message;
 }
 
+// A header of a few bytes claiming a huge image made the reader allocate it before reading a row (1.5 GB:
+// fuzz_depth_image). Found for a TIFF; PNG's reader had the same gap.
+TEST(DepthIoTest, ImagesLargerThanTheLimitAreRefusedBeforeTheyAreAllocated) {
+  TempDir dir("huge");
+  std::ifstream in(test::fuzz_regression("depth_image", "tiff_claiming_a_huge_image"), std::ios::binary);
+  const std::string input((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(input.size(), 1u);
+  write_file_atomically(dir / "huge.tiff", input.substr(1));
+  const std::string tiff = test::one_line_error_of([&] { (void)read_depth_image(dir / "huge.tiff"); });
+  EXPECT_NE(tiff.find("pixels is more than a depth image may have (16777216)"), std::string::npos) << tiff;
+
+  RawDepth image;
+  image.width = 4097;  // 4097 x 4096: one row more than the limit allows
+  image.height = 4096;
+  image.depth.assign(std::size_t{4097} * 4096, 1000);
+  write_depth_png(dir / "huge.png", image);
+  EXPECT_EQ(test::one_line_error_of([&] { (void)read_depth_image(dir / "huge.png"); }),
+            dir / "huge.png" + ": 4097 x 4096 pixels is more than a depth image may have (16777216)");
+  image.width = 4096;  // at the limit
+  image.depth.resize(std::size_t{4096} * 4096);
+  write_depth_png(dir / "limit.png", image);
+  EXPECT_EQ(read_depth_image(dir / "limit.png").depth.size(), std::size_t{4096} * 4096);
+}
+
 }  // namespace
 }  // namespace cellmap

@@ -366,7 +366,10 @@ struct PlyElement {
 struct PlyHeader {
   bool ascii = false;
   std::vector<PlyElement> elements;
-  std::uint64_t columns = 0;  // obj_info num_cols / num_rows (0: not given)
+  // The cloud's width and height as PCL's reader has them at the end of the header (it sizes the cloud by
+  // them): obj_info num_cols / num_rows set them wherever they stand, an "element vertex" line sets them to
+  // its count x 1 unless both are set (not 0) already.
+  std::uint64_t columns = 0;
   std::uint64_t rows = 0;
   std::size_t data_start = 0;
 };
@@ -428,6 +431,10 @@ void read_element(const Words& w, PlyHeader& header) {
   }
   if (header.elements.size() == kMaxFields) refuse("more than " + std::to_string(kMaxFields) + " elements");
   header.elements.push_back(PlyElement{w[1], integer(w[2], kMaxCloudPoints, "element " + shown(w[1])), {}});
+  if (w[1] == "vertex" && (header.columns == 0 || header.rows == 0)) {
+    header.columns = header.elements.back().count;
+    header.rows = 1;
+  }
 }
 
 // PCL reads obj_info num_cols/num_rows (the organized size) and echo_rgb_offset_x/y/z (the viewpoint).
@@ -510,13 +517,9 @@ const PlyElement& vertex_element(const PlyHeader& header) {
 
 void check_ply_claims(const PlyHeader& header, std::uint64_t file_size) {
   const PlyElement& vertex = vertex_element(header);
-  if (header.columns != 0 || header.rows != 0) {
-    const std::uint64_t columns = header.columns != 0 ? header.columns : vertex.count;
-    const std::uint64_t rows = header.rows != 0 ? header.rows : 1;
-    if (columns * rows != vertex.count) {
-      refuse("obj_info num_cols x num_rows (" + std::to_string(columns) + " x " + std::to_string(rows) +
-             ") is not the vertex count " + std::to_string(vertex.count));
-    }
+  if (header.columns * header.rows != vertex.count) {
+    refuse("obj_info num_cols x num_rows (" + std::to_string(header.columns) + " x " +
+           std::to_string(header.rows) + ") is not the vertex count " + std::to_string(vertex.count));
   }
   std::uint64_t vertex_bytes = 0;
   for (const PlyProperty& property : vertex.properties) vertex_bytes += property.min_bytes;

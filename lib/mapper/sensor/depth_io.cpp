@@ -31,6 +31,13 @@ int ignore_tiff_message(TIFF*, void*, const char*, const char*, va_list) {
   return 1;
 }
 
+// Why an image of `width` × `height` cannot be read ("" if it can): more than kMaxDepthPixels.
+std::string size_problem(const std::string& path, std::uint64_t width, std::uint64_t height) {
+  if (width * height <= kMaxDepthPixels) return "";
+  return path + ": " + std::to_string(width) + " x " + std::to_string(height) +
+         " pixels is more than a depth image may have (" + std::to_string(kMaxDepthPixels) + ")";
+}
+
 RawDepth read_tiff(const std::string& path) {
   std::string message;
   TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
@@ -50,6 +57,10 @@ RawDepth read_tiff(const std::string& path) {
     TIFFClose(tiff);
     throw Error(path + ": not a single-channel 16-bit unsigned TIFF (" + std::to_string(samples) + " x " +
                 std::to_string(bits) + " bits)");
+  }
+  if (const std::string problem = size_problem(path, width, height); !problem.empty()) {
+    TIFFClose(tiff);
+    throw Error(problem);
   }
   RawDepth image;
   image.width = static_cast<int>(width);
@@ -120,6 +131,10 @@ RawDepth read_png(const std::string& path) {
     png_destroy_read_struct(&png, &info, nullptr);
     throw Error(path + ": not a single-channel 16-bit grayscale PNG (bit depth " + std::to_string(bits) +
                 ", color type " + std::to_string(color) + ")");
+  }
+  if (const std::string problem = size_problem(path, width, height); !problem.empty()) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    throw Error(problem);
   }
   png_set_swap(png);  // PNG stores 16-bit samples big-endian
   png_read_update_info(png, info);
