@@ -22,9 +22,9 @@ struct RawDepth final {
 /// @throws Error naming the file if it cannot be read, is not one channel of 16 bits, claims more than
 /// kMaxDepthPixels pixels, or the extension is unknown.
 [[nodiscard]] RawDepth read_depth_image(const std::string& path);
-/// The most pixels a depth image read from disk may have: 2²⁴ (4096 × 4096, 32 MB), three times the largest
-/// depth camera mode cellmap knows of. A header of a few bytes can claim any size, and the image is
-/// allocated before its rows are read.
+/// The most pixels a depth image read from disk may have: 2²⁴ (4096 × 4096, 32 MB), 18 times the largest
+/// depth camera mode cellmap knows of (RealSense 1280 × 720). A header of a few bytes can claim any size,
+/// and the image is allocated before its rows are read.
 inline constexpr std::uint64_t kMaxDepthPixels = std::uint64_t{1} << 24;
 
 /// Writes a single-channel 16-bit grayscale PNG (the replay directory's depth format), crash-safely (through
