@@ -86,6 +86,7 @@ std::string ReplaySource::resolve(const std::string& file) const {
 SourceStatus ReplaySource::open() {
   ++status_.attempts;
   next_index_ = 0;
+  read_ahead_.reset();
   entries_.clear();
   try {
     if (!std::filesystem::is_directory(config_.directory)) {
@@ -142,7 +143,7 @@ PinholeIntrinsics ReplaySource::intrinsics_for(const std::string& image_path, in
   return intrinsics;
 }
 
-Frame ReplaySource::load(std::size_t index) const {
+Frame ReplaySource::read_recorded(std::size_t index) const {
   if (index >= entries_.size()) throw Error("replay: frame " + std::to_string(index) + " out of range");
   const ReplayEntry& entry = entries_[index];
   const std::string path = resolve(entry.file);
@@ -159,8 +160,17 @@ Frame ReplaySource::load(std::size_t index) const {
   DepthImage image;
   image.intrinsics = intrinsics_for(path, raw.width, raw.height);
   image.depth = std::move(raw.depth);
-  frame.points_S = depth_to_points(image);
   frame.depth = std::move(image);
+  return frame;
+}
+
+void ReplaySource::to_points(Frame& frame) {
+  if (frame.depth) frame.points_S = depth_to_points(*frame.depth);
+}
+
+Frame ReplaySource::load(std::size_t index) const {
+  Frame frame = read_recorded(index);
+  to_points(frame);
   return frame;
 }
 
@@ -169,6 +179,12 @@ std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
   if (next_index_ >= entries_.size()) {
     status_.state = SourceState::kEnded;
     status_.reason = config_.directory + ": end of recording";
+    return std::nullopt;
+  }
+  try {
+    if (!read_ahead_) read_ahead_ = read_recorded(next_index_);
+  } catch (const Error& e) {
+    fail(e.what());
     return std::nullopt;
   }
   using Clock = std::chrono::steady_clock;
@@ -185,19 +201,26 @@ std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
     return std::nullopt;
   }
   std::this_thread::sleep_until(due);
+  Frame frame = std::move(*read_ahead_);
+  read_ahead_.reset();
   try {
-    Frame frame = load(next_index_);
-    ++next_index_;
-    ++status_.frames;
-    return frame;
+    to_points(frame);
   } catch (const Error& e) {
-    status_.state = SourceState::kError;
-    status_.reason = e.what();
+    fail(e.what());
     return std::nullopt;
   }
+  ++next_index_;
+  ++status_.frames;
+  return frame;
+}
+
+void ReplaySource::fail(const std::string& reason) {
+  status_.state = SourceState::kError;
+  status_.reason = reason;
 }
 
 void ReplaySource::close() {
+  read_ahead_.reset();
   entries_.clear();
   next_index_ = 0;
   status_.state = SourceState::kClosed;

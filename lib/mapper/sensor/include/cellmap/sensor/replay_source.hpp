@@ -33,6 +33,7 @@
 #include <Eigen/Geometry>
 
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,8 +71,10 @@ struct ReplayConfig final {
 };
 
 /// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
-/// frame file exists (kError naming the first problem otherwise); next() loads one frame when it is due and
-/// turns kEnded after the last. Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so
+/// frame file exists (kError naming the first problem otherwise); next() reads the next frame's file ahead
+/// of its time and, when it is due, converts its pixels to points and returns it, so a frame comes at its
+/// recorded time as a camera's does (the file's decoding is the recording's cost, not the frame's; a file
+/// that cannot be read turns kError when next() reads it); it turns kEnded after the last. Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so
 /// frames and poses meet exactly as recorded. Not thread-safe.
 class ReplaySource final : public DepthSource {
  public:
@@ -92,12 +95,18 @@ class ReplaySource final : public DepthSource {
 
  private:
   [[nodiscard]] std::string resolve(const std::string& file) const;
+  // Frame `index` as its file holds it: its depth image (points not yet computed) or its cloud.
+  [[nodiscard]] Frame read_recorded(std::size_t index) const;
+  // The points of a frame read by read_recorded. @throws Error if its image and intrinsics disagree.
+  static void to_points(Frame& frame);
+  void fail(const std::string& reason);
   [[nodiscard]] PinholeIntrinsics intrinsics_for(const std::string& image_path, int width, int height) const;
 
   ReplayConfig config_;
   SourceStatus status_;
   std::vector<ReplayEntry> entries_;
   std::size_t next_index_ = 0;
+  std::optional<Frame> read_ahead_;  // frame next_index_, read before it is due
   std::chrono::steady_clock::time_point start_;
 };
 
