@@ -118,6 +118,26 @@ TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
   EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(50));
 }
 
+// The next frame's file is read while the source waits for its time, so a frame is not late by its
+// decoding: once a wait has read it, the file may go and the frame still comes, with its points.
+TEST(ReplaySourceTest, ReadsTheNextFrameAheadOfItsTime) {
+  Recording recording;
+  ReplayConfig config;
+  config.directory = recording.dir.path().string();
+  config.playback = ReplayConfig::Playback::kFixed;
+  config.rate_hz = 1.0;
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected);
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());  // frame 1 is due in a second
+  fs::remove(recording.dir.path() / "f1.png");
+  const std::optional<Frame> f1 = source.next(std::chrono::milliseconds(5000));
+  ASSERT_TRUE(f1.has_value()) << source.status().reason;
+  EXPECT_DOUBLE_EQ(f1->stamp, 100.05);
+  EXPECT_EQ(f1->points_S.size(), 6u * 4u - 4u);
+  EXPECT_EQ(source.status().state, SourceState::kConnected);
+}
+
 TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {
   Recording recording;
   ReplayConfig config;

@@ -1,6 +1,7 @@
 #include "cellmap/frame/frame.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -19,45 +20,45 @@ void PinholeIntrinsics::validate() const {
 
 namespace {
 
-// Depth in metres of each pixel with a return in [min_range, max_range], else 0, written to `z`.
-void valid_depths(const DepthImage& image, std::vector<double>& z) {
+// Raw depth of each pixel with a return in [min_range, max_range], else 0, written to `raw`.
+void valid_depths(const DepthImage& image, std::vector<std::uint16_t>& raw) {
   const PinholeIntrinsics& k = image.intrinsics;
-  z.resize(image.depth.size());
-  for (std::size_t p = 0; p < z.size(); ++p) {
+  raw.resize(image.depth.size());
+  for (std::size_t p = 0; p < raw.size(); ++p) {
     const double d = image.depth[p] * k.depth_scale;
-    z[p] = image.depth[p] != 0 && d >= k.min_range && d <= k.max_range ? d : 0.0;
+    raw[p] = d >= k.min_range && d <= k.max_range ? image.depth[p] : 0;
   }
 }
 
-// Per pixel, the nearest valid depth (> 0) of `z` among the pixel and its 8 neighbours inside the image,
-// +infinity where there is none, written to `nearest`: two passes of a 3-wide minimum (rows, then columns)
-// that the compiler vectorizes. A pixel lies behind a depth edge exactly when its depth minus this minimum
-// exceeds the limit: the difference is largest for the nearest neighbour (subtraction rounds monotonically),
-// and the pixel itself (difference 0) never exceeds a limit ≥ 0.
-// Written here rather than taken from PCL: its ShadowPoints filter needs normals of an organized cloud
-// first, and the test on raw neighbours is a few comparisons per pixel.
-void nearest_around(const std::vector<double>& z, int width, int height, std::vector<double>& rows,
-                    std::vector<double>& nearest) {
-  constexpr double kNone = std::numeric_limits<double>::infinity();
+// Stands for "no valid depth" in a minimum: a valid pixel is never nearer, and a pixel's own depth is part
+// of its minimum, so a neighbour without a return never lowers it.
+constexpr std::uint16_t kNoReturn = std::numeric_limits<std::uint16_t>::max();
+
+// Per pixel, the nearest valid raw depth of the pixel and its left and right neighbours inside the row
+// (kNoReturn where there is none), written to `rows`: the first pass of a 3 × 3 minimum, whose second pass
+// (above, this, below) runs as the points are made. Kept in raw units: metres are raw × depth_scale, which
+// keeps the order, so the minimum in metres is the minimum in raw units times the scale, exactly.
+// A pixel lies behind a depth edge exactly when its depth minus this minimum exceeds the limit: the
+// difference is largest for the nearest neighbour (subtraction rounds monotonically), and the pixel itself
+// (difference 0) never exceeds a limit ≥ 0. Written here rather than taken from PCL: its ShadowPoints
+// filter needs normals of an organized cloud first, and the test on raw neighbours is a few comparisons
+// per pixel.
+void nearest_in_rows(const std::vector<std::uint16_t>& raw, int width, int height,
+                     std::vector<std::uint16_t>& rows) {
   const std::size_t w = static_cast<std::size_t>(width);
-  rows.resize(z.size());
-  nearest.resize(z.size());
+  rows.resize(raw.size());
+  const auto valid = [](std::uint16_t d) { return d != 0 ? d : kNoReturn; };
   for (int v = 0; v < height; ++v) {
-    const double* in = &z[static_cast<std::size_t>(v) * w];
-    double* out = &rows[static_cast<std::size_t>(v) * w];
-    const auto valid = [](double d) { return d > 0 ? d : kNone; };
-    for (std::size_t u = 0; u < w; ++u) {
-      const double left = u > 0 ? valid(in[u - 1]) : kNone;
-      const double right = u + 1 < w ? valid(in[u + 1]) : kNone;
-      out[u] = std::min(std::min(left, valid(in[u])), right);
+    const std::uint16_t* in = &raw[static_cast<std::size_t>(v) * w];
+    std::uint16_t* out = &rows[static_cast<std::size_t>(v) * w];
+    if (w == 1) {
+      out[0] = valid(in[0]);
+      continue;
     }
-  }
-  for (int v = 0; v < height; ++v) {
-    const double* row = &rows[static_cast<std::size_t>(v) * w];
-    const double* above = v > 0 ? row - w : row;
-    const double* below = v + 1 < height ? row + w : row;
-    double* out = &nearest[static_cast<std::size_t>(v) * w];
-    for (std::size_t u = 0; u < w; ++u) out[u] = std::min(std::min(above[u], row[u]), below[u]);
+    out[0] = std::min(valid(in[0]), valid(in[1]));
+    for (std::size_t u = 1; u + 1 < w; ++u)  // vectorized: no border test inside
+      out[u] = std::min(std::min(valid(in[u - 1]), valid(in[u])), valid(in[u + 1]));
+    out[w - 1] = std::min(valid(in[w - 2]), valid(in[w - 1]));
   }
 }
 
@@ -77,19 +78,26 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const double inv_fx = 1.0 / k.fx;
   const double inv_fy = 1.0 / k.fy;
-  // Kept per thread: frames' worth of doubles, fresh memory (zeroed and page-faulted) on every frame else.
-  thread_local std::vector<double> depths, rows, nearest;
-  valid_depths(image, depths);
-  if (k.max_depth_jump > 0) nearest_around(depths, k.width, k.height, rows, nearest);
+  const bool edges = k.max_depth_jump > 0;
+  const std::size_t w = static_cast<std::size_t>(k.width);
+  // Kept per thread: a frame's worth of pixels, fresh memory (zeroed and page-faulted) on every frame else.
+  thread_local std::vector<std::uint16_t> raw, rows;
+  valid_depths(image, raw);
+  if (edges) nearest_in_rows(raw, k.width, k.height, rows);
   for (int v = 0; v < k.height; ++v) {
-    for (int u = 0; u < k.width; ++u) {
-      const std::size_t p = static_cast<std::size_t>(v) * k.width + u;
-      const double z = depths[p];
-      if (z == 0 || (k.max_depth_jump > 0 && z - nearest[p] > k.max_depth_jump * z)) {
+    const std::size_t row = static_cast<std::size_t>(v) * w;
+    const std::uint16_t* near = edges ? &rows[row] : nullptr;
+    const std::uint16_t* above = edges && v > 0 ? near - w : near;
+    const std::uint16_t* below = edges && v + 1 < k.height ? near + w : near;
+    for (std::size_t u = 0; u < w; ++u) {
+      const std::uint16_t d = raw[row + u];
+      const double z = d * k.depth_scale;
+      if (d == 0 || (edges && z - std::min(std::min(above[u], near[u]), below[u]) * k.depth_scale >
+                                  k.max_depth_jump * z)) {
         if (organized) points.emplace_back(nan, nan, nan);
         continue;
       }
-      points.emplace_back(static_cast<float>((u - k.cx) * z * inv_fx),
+      points.emplace_back(static_cast<float>((double(u) - k.cx) * z * inv_fx),
                           static_cast<float>((v - k.cy) * z * inv_fy), static_cast<float>(z));
     }
   }

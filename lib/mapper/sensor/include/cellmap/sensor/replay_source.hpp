@@ -74,8 +74,9 @@ struct ReplayConfig final {
 /// frame file exists (kError naming the first problem otherwise); next() reads the next frame's file ahead
 /// of its time and, when it is due, converts its pixels to points and returns it, so a frame comes at its
 /// recorded time as a camera's does (the file's decoding is the recording's cost, not the frame's; a file
-/// that cannot be read turns kError when next() reads it); it turns kEnded after the last. Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so
-/// frames and poses meet exactly as recorded. Not thread-safe.
+/// that cannot be read turns kError when next() reads it); it turns kEnded after the last. Stamps are the
+/// recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly as recorded. Not
+/// thread-safe.
 class ReplaySource final : public DepthSource {
  public:
   /// @throws Error if speed or rate_hz is not positive.
