@@ -138,6 +138,23 @@ TEST(ReplaySourceTest, ReadsTheNextFrameAheadOfItsTime) {
   EXPECT_EQ(source.status().state, SourceState::kConnected);
 }
 
+// Replays given one start play on that clock, not from when each opened: the first frame is due at the
+// start, the second at its recorded interval after it.
+TEST(ReplaySourceTest, AGivenStartIsWhenTheFirstFrameIsDue) {
+  Recording recording;
+  ReplayConfig config;
+  config.directory = recording.dir.path().string();
+  const auto start = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  config.start = start;
+  ReplaySource source(config);
+  ASSERT_EQ(source.open().state, SourceState::kConnected);
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());  // not yet due
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(5000)).has_value());
+  EXPECT_GE(std::chrono::steady_clock::now(), start);
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(5000)).has_value());
+  EXPECT_GE(std::chrono::steady_clock::now(), start + std::chrono::milliseconds(50));
+}
+
 TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {
   Recording recording;
   ReplayConfig config;

@@ -105,7 +105,7 @@ SourceStatus ReplaySource::open() {
   }
   status_.state = entries_.empty() ? SourceState::kEnded : SourceState::kConnected;
   status_.reason = entries_.empty() ? config_.directory + ": poses.csv lists no frames" : "";
-  start_ = std::chrono::steady_clock::now();
+  start_ = config_.start.value_or(std::chrono::steady_clock::now());
   return status_;
 }
 

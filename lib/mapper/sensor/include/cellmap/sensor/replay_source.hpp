@@ -68,6 +68,10 @@ struct ReplayConfig final {
   Playback playback = Playback::kRecorded;
   double speed = 1.0;     ///< kRecorded: 2 plays twice as fast
   double rate_hz = 10.0;  ///< kFixed
+  /// When the first frame is due (kRecorded, kFixed); none: when open() succeeds. Replays given the same
+  /// start play on one clock, as their cameras did, whatever the order they open in (not in the
+  /// configuration files: for programs that play recordings against a clock of their own).
+  std::optional<std::chrono::steady_clock::time_point> start;
 };
 
 /// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
