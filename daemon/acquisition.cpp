@@ -174,8 +174,9 @@ class CameraLoop final {
     return streaming_;
   }
   [[nodiscard]] bool streaming() const { return streaming_; }
-  // The camera thread's CPU seconds, as it last noted them (note_cpu(), on the camera thread).
-  void note_cpu() { cpu_ = thread_cpu_seconds(); }
+  // The camera thread's CPU seconds with its source's helpers (a replay's reader), as it last noted them
+  // (note_cpu(), on the camera thread).
+  void note_cpu() { cpu_ = cpu_seconds_with_helpers(); }
   [[nodiscard]] double cpu_seconds() const { return cpu_; }
 
   // Frames dropped for want of a pose, logged at most once a second.

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
@@ -119,7 +120,7 @@ TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
 }
 
 // The next frame's file is read while the source waits for its time, so a frame is not late by its
-// decoding: once a wait has read it, the file may go and the frame still comes, with its points.
+// decoding: once it was read, the file may go and the frame still comes, with its points.
 TEST(ReplaySourceTest, ReadsTheNextFrameAheadOfItsTime) {
   Recording recording;
   ReplayConfig config;
@@ -130,6 +131,10 @@ TEST(ReplaySourceTest, ReadsTheNextFrameAheadOfItsTime) {
   ASSERT_EQ(source.open().state, SourceState::kConnected);
   ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
   EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());  // frame 1 is due in a second
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(900);
+  while (!source.next_frame_read() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(source.next_frame_read()) << "frame 1 was not read within 0.9 s of frame 0";
   fs::remove(recording.dir.path() / "f1.png");
   const std::optional<Frame> f1 = source.next(std::chrono::milliseconds(5000));
   ASSERT_TRUE(f1.has_value()) << source.status().reason;

@@ -1,13 +1,21 @@
 #include "cellmap/sensor/replay_source.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <condition_variable>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 #include "cellmap/common/text.hpp"
 #include "cellmap/io/cloud_file.hpp"
 #include "cellmap/sensor/depth_io.hpp"
@@ -73,9 +81,102 @@ void write_replay_poses(const std::string& path, const std::vector<ReplayEntry>&
   write_file_atomically(path, out.str());
 }
 
+// Reads one asked-for frame at a time on a thread of its own, at the lowest CPU priority.
+class ReplaySource::Reader final {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit Reader(const ReplaySource& source) : source_(source), thread_([this] { run(); }) {}
+  ~Reader() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  // Starts reading frame `index` unless it is already asked for.
+  void ask(std::size_t index) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (asked_ == index) return;
+      asked_ = index;
+      started_ = false;
+      outcome_.reset();
+    }
+    changed_.notify_all();
+  }
+  // Frame `index` (asked for) once read, waiting for the read until `deadline`; nullopt if it is not read by
+  // then. Credits the calling thread with the read's CPU time. @throws Error as the read did.
+  std::optional<Frame> take(std::size_t index, Clock::time_point deadline) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!changed_.wait_until(lock, deadline, [&] { return asked_ == index && outcome_; }))
+      return std::nullopt;
+    Outcome outcome = std::move(*outcome_);
+    outcome_.reset();
+    asked_ = kNone;
+    add_helper_cpu_seconds(outcome.cpu_seconds);
+    if (!outcome.frame) throw Error(outcome.error);
+    return std::move(outcome.frame);
+  }
+  [[nodiscard]] bool read(std::size_t index) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return asked_ == index && outcome_.has_value();
+  }
+
+ private:
+  static constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  struct Outcome {
+    std::optional<Frame> frame;
+    std::string error;         // why there is no frame
+    double cpu_seconds = 0.0;  // the read's, credited to the thread that takes the frame
+  };
+
+  void run() {
+    // Per thread on Linux; a failure leaves the thread at the process's priority, which only costs latency.
+    (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      changed_.wait(lock, [&] { return stop_ || (asked_ != kNone && !started_); });
+      if (stop_) return;
+      started_ = true;
+      const std::size_t index = asked_;
+      lock.unlock();
+      Outcome outcome;
+      const double cpu_start = thread_cpu_seconds();
+      try {
+        outcome.frame = source_.read_recorded(index);
+      } catch (const Error& e) {
+        outcome.error = e.what();
+      }
+      outcome.cpu_seconds = thread_cpu_seconds() - cpu_start;
+      lock.lock();
+      if (asked_ == index && !outcome_) outcome_ = std::move(outcome);
+      changed_.notify_all();
+    }
+  }
+
+  const ReplaySource& source_;  // read_recorded only; entries_ do not change while a reader lives
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::size_t asked_ = kNone;
+  bool started_ = false;
+  std::optional<Outcome> outcome_;
+  bool stop_ = false;
+  std::thread thread_;  // last: started once the rest is set up
+};
+
 ReplaySource::ReplaySource(ReplayConfig config) : config_(std::move(config)) {
   if (!(config_.speed > 0) || !std::isfinite(config_.speed)) throw Error("replay: speed must be > 0");
   if (!(config_.rate_hz > 0) || !std::isfinite(config_.rate_hz)) throw Error("replay: rate_hz must be > 0");
+}
+
+ReplaySource::~ReplaySource() = default;
+
+bool ReplaySource::next_frame_read() const {
+  return reader_ && reader_->read(next_index_);
 }
 
 std::string ReplaySource::resolve(const std::string& file) const {
@@ -86,7 +187,7 @@ std::string ReplaySource::resolve(const std::string& file) const {
 SourceStatus ReplaySource::open() {
   ++status_.attempts;
   next_index_ = 0;
-  read_ahead_.reset();
+  reader_.reset();
   entries_.clear();
   try {
     if (!std::filesystem::is_directory(config_.directory)) {
@@ -106,6 +207,10 @@ SourceStatus ReplaySource::open() {
   status_.state = entries_.empty() ? SourceState::kEnded : SourceState::kConnected;
   status_.reason = entries_.empty() ? config_.directory + ": poses.csv lists no frames" : "";
   start_ = config_.start.value_or(std::chrono::steady_clock::now());
+  if (!entries_.empty()) {
+    reader_ = std::make_unique<Reader>(*this);
+    reader_->ask(0);
+  }
   return status_;
 }
 
@@ -181,12 +286,7 @@ std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
     status_.reason = config_.directory + ": end of recording";
     return std::nullopt;
   }
-  try {
-    if (!read_ahead_) read_ahead_ = read_recorded(next_index_);
-  } catch (const Error& e) {
-    fail(e.what());
-    return std::nullopt;
-  }
+  reader_->ask(next_index_);
   using Clock = std::chrono::steady_clock;
   Clock::time_point due = Clock::now();
   if (config_.playback == ReplayConfig::Playback::kRecorded) {
@@ -201,10 +301,12 @@ std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
     return std::nullopt;
   }
   std::this_thread::sleep_until(due);
-  Frame frame = std::move(*read_ahead_);
-  read_ahead_.reset();
+  std::optional<Frame> frame;
   try {
-    to_points(frame);
+    frame = reader_->take(next_index_, std::max(due, Clock::now()) + timeout);
+    if (!frame) return std::nullopt;  // still being read: late
+    if (next_index_ + 1 < entries_.size()) reader_->ask(next_index_ + 1);
+    to_points(*frame);
   } catch (const Error& e) {
     fail(e.what());
     return std::nullopt;
@@ -220,7 +322,7 @@ void ReplaySource::fail(const std::string& reason) {
 }
 
 void ReplaySource::close() {
-  read_ahead_.reset();
+  reader_.reset();
   entries_.clear();
   next_index_ = 0;
   status_.state = SourceState::kClosed;

@@ -27,10 +27,17 @@ namespace detail {
 inline thread_local double helper_cpu_seconds = 0.0;
 }  // namespace detail
 
-/// CPU seconds the calling thread used so far, with those of the helper threads its parallel_for calls ran:
-/// what a step costs on a thread that splits its work, whatever else the process runs meanwhile.
+/// CPU seconds the calling thread used so far, with those of the helper threads its parallel_for calls ran
+/// (and those credited by add_helper_cpu_seconds): what a step costs on a thread that splits its work,
+/// whatever else the process runs meanwhile.
 inline double cpu_seconds_with_helpers() {
   return thread_cpu_seconds() + detail::helper_cpu_seconds;
+}
+
+/// Credits the calling thread with `seconds` of CPU a thread of another kind spent on its behalf (a
+/// replay's file reader for the camera thread that takes its frames).
+inline void add_helper_cpu_seconds(double seconds) {
+  detail::helper_cpu_seconds += seconds;
 }
 
 namespace detail {

@@ -33,6 +33,7 @@
 #include <Eigen/Geometry>
 
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,16 +76,21 @@ struct ReplayConfig final {
 };
 
 /// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
-/// frame file exists (kError naming the first problem otherwise); next() reads the next frame's file ahead
-/// of its time and, when it is due, converts its pixels to points and returns it, so a frame comes at its
-/// recorded time as a camera's does (the file's decoding is the recording's cost, not the frame's; a file
-/// that cannot be read turns kError when next() reads it); it turns kEnded after the last. Stamps are the
-/// recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly as recorded. Not
-/// thread-safe.
+/// frame file exists (kError naming the first problem otherwise); next() returns each frame when it is
+/// due, its pixels converted to points then, and turns kEnded after the last. The files are read ahead on a
+/// thread of the source's own at the lowest CPU priority (nice 19), so a frame comes at its recorded time
+/// as a camera's does and decoding a recording takes only CPU time the frames' processing leaves (it is
+/// the recording's cost, not the frame's; a camera delivers pixels); a frame whose file is still being
+/// read when it is due comes late, and a file that cannot be read turns kError when its frame is due.
+/// Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly
+/// as recorded. Not thread-safe (one thread calls it; the reader thread is internal).
 class ReplaySource final : public DepthSource {
  public:
   /// @throws Error if speed or rate_hz is not positive.
   explicit ReplaySource(ReplayConfig config);
+  ~ReplaySource() override;
+  ReplaySource(const ReplaySource&) = delete;
+  ReplaySource& operator=(const ReplaySource&) = delete;
 
   [[nodiscard]] const std::string& name() const override { return config_.name; }
   SourceStatus open() override;
@@ -97,6 +103,8 @@ class ReplaySource final : public DepthSource {
   /// Loads frame `index` of the recording, independent of playback timing. @throws Error naming the file.
   [[nodiscard]] Frame load(std::size_t index) const;
   [[nodiscard]] std::size_t size() const { return entries_.size(); }
+  /// Whether the next frame's file was read and the frame waits for its time (or the read failed).
+  [[nodiscard]] bool next_frame_read() const;
 
  private:
   [[nodiscard]] std::string resolve(const std::string& file) const;
@@ -105,13 +113,14 @@ class ReplaySource final : public DepthSource {
   // The points of a frame read by read_recorded. @throws Error if its image and intrinsics disagree.
   static void to_points(Frame& frame);
   void fail(const std::string& reason);
+  class Reader;
   [[nodiscard]] PinholeIntrinsics intrinsics_for(const std::string& image_path, int width, int height) const;
 
   ReplayConfig config_;
   SourceStatus status_;
   std::vector<ReplayEntry> entries_;
   std::size_t next_index_ = 0;
-  std::optional<Frame> read_ahead_;  // frame next_index_, read before it is due
+  std::unique_ptr<Reader> reader_;  // while open; reads frame next_index_ before it is due
   std::chrono::steady_clock::time_point start_;
 };
 
