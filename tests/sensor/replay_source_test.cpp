@@ -110,8 +110,9 @@ TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
   config.playback = ReplayConfig::Playback::kFixed;
   config.rate_hz = 20.0;  // 50 ms apart
   ReplaySource source(config);
-  ASSERT_EQ(source.open().state, SourceState::kConnected);
+  // The replay's clock starts when it opens, so the elapsed time counts from before that.
   const auto start = std::chrono::steady_clock::now();
+  ASSERT_EQ(source.open().state, SourceState::kConnected);
   ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
   // The second frame is due 50 ms after the start: a 1 ms wait returns nothing.
   EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());
