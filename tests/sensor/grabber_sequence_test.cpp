@@ -136,7 +136,7 @@ TEST(GrabberSequenceTest, ReplayGivesEachFrameItsRecordedPose) {
   SensorPoser poser(X_ES);
 
   std::vector<Frame> frames;
-  while (auto frame = source.next(std::chrono::milliseconds(100))) {
+  while (auto frame = source.next(std::chrono::milliseconds(5000))) {
     ASSERT_EQ(poser.attach(*frame, poses), PoseLookup::kFound);
     frames.push_back(std::move(*frame));
   }

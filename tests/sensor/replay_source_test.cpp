@@ -84,7 +84,7 @@ TEST(ReplaySourceTest, PlaysDepthImagesAndCloudsInOrder) {
   ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
   EXPECT_EQ(source.poses().size(), 3u);
 
-  auto f0 = source.next(std::chrono::milliseconds(10));
+  auto f0 = source.next(std::chrono::milliseconds(5000));
   ASSERT_TRUE(f0.has_value());
   EXPECT_EQ(f0->sensor, "desk");
   EXPECT_DOUBLE_EQ(f0->stamp, 100.0);
@@ -93,8 +93,8 @@ TEST(ReplaySourceTest, PlaysDepthImagesAndCloudsInOrder) {
   // Pixel (1, 0): z = 1.001 m, x = (1 - 2.5) z / 3.
   EXPECT_FLOAT_EQ(f0->points_S[0].z, 1.001f);
   EXPECT_FLOAT_EQ(f0->points_S[0].x, static_cast<float>(-1.5 * 1.001 / 3));
-  ASSERT_TRUE(source.next(std::chrono::milliseconds(10)).has_value());
-  auto f2 = source.next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(5000)).has_value());
+  auto f2 = source.next(std::chrono::milliseconds(5000));
   ASSERT_TRUE(f2.has_value());
   EXPECT_FALSE(f2->depth.has_value());
   EXPECT_EQ(f2->points_S.size(), 2u);  // the NaN point is skipped
@@ -182,7 +182,8 @@ TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {
   ReplaySource no_intrinsics(config);
   ASSERT_EQ(no_intrinsics.open().state, SourceState::kConnected);
   EXPECT_THROW((void)no_intrinsics.load(0), Error);
-  EXPECT_FALSE(no_intrinsics.next(std::chrono::milliseconds(1)).has_value());
+  // The frame is read on the reader thread: wait for its outcome.
+  EXPECT_FALSE(no_intrinsics.next(std::chrono::milliseconds(5000)).has_value());
   EXPECT_EQ(no_intrinsics.status().state, SourceState::kError);
   EXPECT_NE(no_intrinsics.status().reason.find("no intrinsics"), std::string::npos);
 }
@@ -204,11 +205,11 @@ TEST(ReplaySourceTest, PcdFramesGoThroughTheHardenedLoader) {
   write_replay_poses(recording.dir / "poses.csv", recording.entries);
   ReplaySource source(config);
   ASSERT_EQ(source.open().state, SourceState::kConnected);
-  ASSERT_TRUE(source.next(std::chrono::milliseconds(100)).has_value());
-  const std::optional<Frame> empty = source.next(std::chrono::milliseconds(100));
+  ASSERT_TRUE(source.next(std::chrono::milliseconds(5000)).has_value());
+  const std::optional<Frame> empty = source.next(std::chrono::milliseconds(5000));
   ASSERT_TRUE(empty.has_value());
   EXPECT_TRUE(empty->points_S.empty());
-  EXPECT_FALSE(source.next(std::chrono::milliseconds(100)).has_value());
+  EXPECT_FALSE(source.next(std::chrono::milliseconds(5000)).has_value());
   EXPECT_EQ(source.status().state, SourceState::kError);
   EXPECT_EQ(source.status().reason,
             recording.dir / "f2.pcd" + ": COUNT: '4294967297' is not an integer in [0, 65536]");
