@@ -182,7 +182,8 @@ struct SeparatedLanes final {
     using namespace projection_lanes_detail;
     distance = T{};
     for (int l = 0; l < LaneCount<T>::value; ++l) set_lane(&distance, l, std::sqrt(get_lane(gap2, l)));
-    const T inverse = 1.0 / distance;
+    // 1 / distance as distance / gap2: the division runs beside the square root instead of after it.
+    const T inverse = distance * (1.0 / gap2);
     const T* Ra = a.rotation;
     for (int i = 0; i < 3; ++i) {
       const T gap_C = Ra[i] * gap[0] + Ra[i + 3] * gap[1] + Ra[i + 6] * gap[2];
