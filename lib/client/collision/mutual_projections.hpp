@@ -55,11 +55,13 @@ inline constexpr int kFaceNormal[8] = {-1, -1, -1, 2, -1, 1, 0, -1};
 // left to the separating axes.
 inline constexpr double kParallel = 1e-9;
 
-// x_k on an edge of its box (free coordinate k, half extent h) facing the other box's face, whose outward
-// normal has component `slope` along the edge: the edge's end nearest the face plane, unless parallel.
-inline bool step_to_edge_end(double slope, double h, double* x_k) {
+// x on an edge of its box (free coordinate k, half extent h) facing the other box's face, whose outward
+// normal has component `slope` along the edge: x_k moves to the edge's end nearest the face plane, unless
+// parallel.
+inline bool step_to_edge_end(double slope, double h, int k, double* x) {
   if (!(std::abs(slope) > kParallel)) return false;
-  *x_k = slope > 0.0 ? -h : h;
+  const double end = slope > 0.0 ? -h : h;
+  for (int m = 0; m < 3; ++m) x[m] = m == k ? end : x[m];
   return true;
 }
 
@@ -72,16 +74,20 @@ inline bool move_to_crossing_edges(const double* ha, const double* hb, const dou
   const double c = d[i];
   const double sin2 = 1.0 - c * c;
   if (!(sin2 > kParallel)) return false;
-  // Lines a0 + s e_i (a0 = p with p_i = 0) and b0 + u d (b0 = B's edge centre); r = a0 - b0.
-  double y0[3] = {y[0], y[1], y[2]};
-  y0[j] = 0.0;
+  const double inverse_sin2 = 1.0 / sin2;  // divided while the numerator is computed, not after it
+  // Lines a0 + s e_i (a0 = p with p_i = 0) and b0 + u d (b0 = B's edge centre); r = a0 - b0. Selects rather
+  // than stores at index i or j keep the numbers in registers.
+  double y0[3];
+  for (int k = 0; k < 3; ++k) y0[k] = k == j ? 0.0 : y[k];
   double r[3];
   b_to_a(R, t, y0, r);
   for (int k = 0; k < 3; ++k) r[k] = (k == i ? 0.0 : p[k]) - r[k];
   const double dr = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
-  const double u_lines = clamp((dr - c * r[i]) / sin2, hb[j]);
-  p[i] = clamp(u_lines * c - r[i], ha[i]);
-  y[j] = clamp(dr + p[i] * c, hb[j]);
+  const double u_lines = clamp((dr - c * r[i]) * inverse_sin2, hb[j]);
+  const double s = clamp(u_lines * c - r[i], ha[i]);
+  const double u = clamp(dr + s * c, hb[j]);
+  for (int k = 0; k < 3; ++k) p[k] = k == i ? s : p[k];
+  for (int k = 0; k < 3; ++k) y[k] = k == j ? u : y[k];
   return true;
 }
 
@@ -109,12 +115,12 @@ projection_round(const double* ha, const double* hb, const double* R, const doub
     closest_in_b(R, t, hb, p, y);
   } else if (i >= 0 && kFaceNormal[y_free] >= 0) {
     const int face = kFaceNormal[y_free];  // B's face normal in A's frame: sign(y_face) R.col(face)
-    if (y[face] != 0.0 && step_to_edge_end(y[face] > 0.0 ? R[i + 3 * face] : -R[i + 3 * face], ha[i], &p[i]))
+    if (y[face] != 0.0 && step_to_edge_end(y[face] > 0.0 ? R[i + 3 * face] : -R[i + 3 * face], ha[i], i, p))
       closest_in_b(R, t, hb, p, y);
   } else if (j >= 0 && kFaceNormal[p_free] >= 0) {
     const int face = kFaceNormal[p_free];  // A's face normal: sign(p_face) e_face
     y_fits = !(p[face] != 0.0 &&
-               step_to_edge_end(p[face] > 0.0 ? R[face + 3 * j] : -R[face + 3 * j], hb[j], &y[j]));
+               step_to_edge_end(p[face] > 0.0 ? R[face + 3 * j] : -R[face + 3 * j], hb[j], j, y));
   }
   b_to_a(R, t, y, q);
   double p_next[3];
