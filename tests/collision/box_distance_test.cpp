@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "epa.hpp"
+#include "signed_distance.hpp"
 
 namespace cellmap::collision {
 namespace {
@@ -245,6 +246,34 @@ TEST(BoxDistanceTest, SeparatingAxesAgreeWithSignedDistanceSign) {
       EXPECT_GE(d.distance, 0.1 - 1e-12);
     }
   }
+}
+
+// signed_distance runs the AVX build where the CPU has it (as here); the baseline build that other CPUs run
+// must give the very same numbers, on separated, touching and overlapping pairs alike.
+TEST(BoxDistanceTest, BaselineBuildGivesTheSameBits) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<double> h(0.0, 1.0);
+  const auto box = [&](double spread) {
+    return Obb(Vector3d(u(rng), u(rng), u(rng)) * spread, Vector3d(h(rng), h(rng), h(rng)),
+               Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix());
+  };
+  int overlapping = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Obb a = box(1.0);
+    const Obb b = box(i % 2 == 0 ? 1.0 : 3.0);
+    const SignedDistance ours = signed_distance(a, b);
+    const SignedDistance baseline = signed_distance_baseline(a, b);
+    overlapping += ours.distance < 0.0;
+    ASSERT_EQ(ours.distance, baseline.distance) << "pair " << i;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(ours.point_a[k], baseline.point_a[k]) << "pair " << i;
+      ASSERT_EQ(ours.point_b[k], baseline.point_b[k]) << "pair " << i;
+      ASSERT_EQ(ours.normal[k], baseline.normal[k]) << "pair " << i;
+    }
+  }
+  EXPECT_GT(overlapping, 2000);  // both branches of the query ran
+  EXPECT_LT(overlapping, 18000);
 }
 
 }  // namespace

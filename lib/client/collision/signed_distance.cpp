@@ -125,10 +125,10 @@ SignedDistance signed_distance_by_axes(const Obb& a, const Obb& b, const Relativ
 // The pairs project_twice leaves open: the rounds of projections from where it left them (mostly one round:
 // crossing edges in closed form), then the separating axes and GJK.
 #if defined(__GNUC__)
-__attribute__((noinline))
+__attribute__((always_inline))
 #endif
-SignedDistance
-signed_distance_open(const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
+inline SignedDistance
+open_pairs(const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
   double p[3] = {projection.p[0], projection.p[1], projection.p[2]};
   double y[3] = {projection.y[0], projection.y[1], projection.y[2]};
   double q[3];
@@ -147,13 +147,63 @@ signed_distance_open(const Obb& a, const Obb& b, const ProjectionLanes<double>& 
   return signed_distance_by_axes(a, b, rel);
 }
 
-}  // namespace
+using OpenPairs = SignedDistance (*)(const Obb&, const Obb&, const ProjectionLanes<double>&);
 
-SignedDistance signed_distance(const Obb& a, const Obb& b) {
+// project_twice, then `open` for the pairs it leaves open (out of line: the certified pairs' path stays
+// short).
+template <OpenPairs open>
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline SignedDistance
+project_then(const Obb& a, const Obb& b) {
   ProjectionLanes<double> projection;
   project_twice(view_of(a), view_of(b), &projection);
   if (projection.certified[0]) return separated_in_cell(a, projection.p, projection.gap, projection.gap2);
-  return signed_distance_open(a, b, projection);
+  return open(a, b, projection);
+}
+
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+SignedDistance
+open_pairs_baseline(const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
+  return open_pairs(a, b, projection);
+}
+
+// The same code compiled for AVX as well, chosen at run time: its three-operand instructions spare most of
+// the register copies that SSE2's two-operand ones need (≈ 5 % per query on random pairs). Without FMA the
+// arithmetic is the same, so both give the same bits.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define CELLMAP_AVX_VARIANT 1
+__attribute__((noinline, target("avx"))) SignedDistance open_pairs_avx(
+    const Obb& a, const Obb& b, const ProjectionLanes<double>& projection) {
+  return open_pairs(a, b, projection);
+}
+
+__attribute__((target("avx"))) SignedDistance signed_distance_avx(const Obb& a, const Obb& b) {
+  return project_then<open_pairs_avx>(a, b);
+}
+
+bool cpu_has_avx() {
+  __builtin_cpu_init();  // also valid before the constructors that would run it
+  return __builtin_cpu_supports("avx");
+}
+// Zero (the baseline) for a caller in another file's static initialisers that runs before this one.
+const bool kCpuHasAvx = cpu_has_avx();
+#endif
+
+}  // namespace
+
+SignedDistance signed_distance_baseline(const Obb& a, const Obb& b) {
+  return project_then<open_pairs_baseline>(a, b);
+}
+
+SignedDistance signed_distance(const Obb& a, const Obb& b) {
+#if defined(CELLMAP_AVX_VARIANT)
+  if (kCpuHasAvx) return signed_distance_avx(a, b);
+#endif
+  return signed_distance_baseline(a, b);
 }
 
 }  // namespace cellmap::collision

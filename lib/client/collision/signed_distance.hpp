@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the two halves of signed_distance, shared with EPA.
+// Internal: the two halves of signed_distance, shared with EPA, and its baseline build.
 
 #include <Eigen/Core>
 
@@ -25,5 +25,9 @@ namespace cellmap::collision {
 /// original B.
 [[nodiscard]] SignedDistance penetration_witnesses(const Obb& a, const Obb& b, const RelativePose& rel,
                                                    double depth, const Eigen::Vector3d& axis_a);
+
+/// signed_distance as compiled for the x86-64 baseline (SSE2), which signed_distance runs where the CPU has
+/// no AVX: the same numbers, bit for bit (for the test that says so).
+[[nodiscard]] SignedDistance signed_distance_baseline(const Obb& a, const Obb& b);
 
 }  // namespace cellmap::collision
