@@ -67,9 +67,10 @@ inline bool step_to_edge_end(double slope, double h, int k, double* x) {
 
 // p on A's edge along e_i, y on B's edge along R.col(j): both move to the closest points of the two edges
 // (segments), in closed form: B's parameter on the lines, clamped; A's for it, clamped; B's again for that,
-// clamped (exact for segments). Returns false, moving nothing, for (nearly) parallel edges.
+// clamped (exact for segments). Writes B's new point in A's frame to q. Returns false, moving nothing, for
+// (nearly) parallel edges.
 inline bool move_to_crossing_edges(const double* ha, const double* hb, const double* R, const double* t,
-                                   int i, int j, double* p, double* y) {
+                                   int i, int j, double* p, double* y, double* q) {
   const double* d = R + 3 * j;  // B's edge direction in A's frame
   const double c = d[i];
   const double sin2 = 1.0 - c * c;
@@ -79,15 +80,16 @@ inline bool move_to_crossing_edges(const double* ha, const double* hb, const dou
   // than stores at index i or j keep the numbers in registers.
   double y0[3];
   for (int k = 0; k < 3; ++k) y0[k] = k == j ? 0.0 : y[k];
-  double r[3];
-  b_to_a(R, t, y0, r);
-  for (int k = 0; k < 3; ++k) r[k] = (k == i ? 0.0 : p[k]) - r[k];
+  double b0[3], r[3];
+  b_to_a(R, t, y0, b0);
+  for (int k = 0; k < 3; ++k) r[k] = (k == i ? 0.0 : p[k]) - b0[k];
   const double dr = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
   const double u_lines = clamp((dr - c * r[i]) * inverse_sin2, hb[j]);
   const double s = clamp(u_lines * c - r[i], ha[i]);
   const double u = clamp(dr + s * c, hb[j]);
   for (int k = 0; k < 3; ++k) p[k] = k == i ? s : p[k];
   for (int k = 0; k < 3; ++k) y[k] = k == j ? u : y[k];
+  for (int k = 0; k < 3; ++k) q[k] = b0[k] + u * d[k];
   return true;
 }
 
@@ -109,10 +111,16 @@ projection_round(const double* ha, const double* hb, const double* R, const doub
   const int y_free = free_coordinates(y, hb);
   const int i = kEdgeDirection[p_free];
   const int j = kEdgeDirection[y_free];
-  bool y_fits = true;  // y is B's point closest to p
+  bool y_fits = true;    // y is B's point closest to p
+  bool q_ready = false;  // q already holds y in A's frame
   if (i >= 0 && j >= 0) {
-    if (!move_to_crossing_edges(ha, hb, R, t, i, j, p, y)) return Round::kParallelEdges;
-    closest_in_b(R, t, hb, p, y);
+    if (!move_to_crossing_edges(ha, hb, R, t, i, j, p, y, q)) return Round::kParallelEdges;
+    // The closest points of the edges are mostly B's point closest to p already: then the jump's q serves,
+    // and the step onto A need not wait for B's closest point to be moved to A's frame.
+    double y_closest[3];
+    closest_in_b(R, t, hb, p, y_closest);
+    q_ready = distance2(y_closest, y) <= tolerance2;
+    std::copy(y_closest, y_closest + 3, y);
   } else if (i >= 0 && kFaceNormal[y_free] >= 0) {
     const int face = kFaceNormal[y_free];  // B's face normal in A's frame: sign(y_face) R.col(face)
     if (y[face] != 0.0 && step_to_edge_end(y[face] > 0.0 ? R[i + 3 * face] : -R[i + 3 * face], ha[i], i, p))
@@ -122,7 +130,7 @@ projection_round(const double* ha, const double* hb, const double* R, const doub
     y_fits = !(p[face] != 0.0 &&
                step_to_edge_end(p[face] > 0.0 ? R[face + 3 * j] : -R[face + 3 * j], hb[j], j, y));
   }
-  b_to_a(R, t, y, q);
+  if (!q_ready) b_to_a(R, t, y, q);
   double p_next[3];
   closest_in_a(ha, q, p_next);
   if (y_fits && distance2(p_next, p) <= tolerance2) return Round::kMutuallyClosest;
