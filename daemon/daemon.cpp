@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -164,6 +165,9 @@ void Daemon::gather() {
       continue;
     }
     bool sweep_ended = !item->frame;
+    if (item->frame) {
+      closed_sweep_first_.wait([this] { return frames_.waiting(); }, frame_backlog_before_gathering(), stop_);
+    }
     std::vector<SweepFrame> batch;
     if (item->frame) batch.push_back(std::move(*item->frame));
     // Frames of the same sweep waiting behind it are gathered side by side, a thread each.
@@ -231,8 +235,14 @@ void Daemon::handle(GatheredSweep& sweep, std::uint64_t number) {
   SweepTrace trace;
   trace.number = number;
   trace.sweep = &sweep.frames;
-  trace.report = run_pipeline(sweep, number);
-  flush(trace);
+  {
+    const ClosedSweepFirst::Turn turn(closed_sweep_first_);
+    trace.report = run_pipeline(sweep, number);
+    publish_version(trace);
+  }
+  // The viewer's layers and the map state are not what a planner waits for.
+  if (trace.report) layers_.after_sweep(number, sweep.frames, pipeline_.map(), trace.report->changes);
+  save_map_state(trace);
   if (!options_.on_sweep) return;
   trace.version = published_version_;
   trace.acquisition_cpu = acquisition_->cpu_seconds();
@@ -250,7 +260,6 @@ std::optional<SweepReport> Daemon::run_pipeline(GatheredSweep& sweep, std::uint6
         number, report.frames, report.points, report.robot_points, report.hit_voxels, report.free_voxels,
         report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_update,
         report.t_change, report.t_segment, sweeps_.dropped(), dropped_frames());
-    layers_.after_sweep(number, sweep.frames, pipeline_.map(), report.changes);
     return report;
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());
@@ -259,7 +268,7 @@ std::optional<SweepReport> Daemon::run_pipeline(GatheredSweep& sweep, std::uint6
   }
 }
 
-void Daemon::flush(SweepTrace& trace) {
+void Daemon::publish_version(SweepTrace& trace) {
   publish_cost_ = {};
   const Stopwatch boxes;
   keeper_.publish_boxes(pipeline_);
@@ -268,9 +277,16 @@ void Daemon::flush(SweepTrace& trace) {
   trace.persist.cpu -= publish_cost_.cpu;
   trace.publish = publish_cost_;
   published_version_ = keeper_.published().version();
+}
+
+void Daemon::save_map_state(SweepTrace& trace) {
   const Stopwatch map_state;
   keeper_.save_map_state(pipeline_);
   map_state.add_to(trace.map_state);
+}
+
+std::size_t Daemon::frame_backlog_before_gathering() const {
+  return std::max<std::size_t>(1, config_.frame_backlog / 2);
 }
 
 std::uint64_t Daemon::dropped_frames() const {

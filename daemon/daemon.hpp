@@ -19,6 +19,7 @@
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
+#include "closed_sweep_first.hpp"
 #include "daemon_config.hpp"
 #include "frame_queue.hpp"
 #include "health.hpp"
@@ -78,11 +79,16 @@ class Daemon final {
   void handle(GatheredSweep& sweep, std::uint64_t number);
   // Runs the pipeline on the sweep and logs what it did; nullopt if the sweep failed (logged, reported).
   std::optional<SweepReport> run_pipeline(GatheredSweep& sweep, std::uint64_t number);
+  // Frames of the next sweep that may wait while a closed sweep is processed: half the frame queue, so that
+  // a long processing (the first segmentation of a cell) drops none.
+  [[nodiscard]] std::size_t frame_backlog_before_gathering() const;
   // Frames never fused: dropped from the frame queue, in sweeps dropped from the backlog, or by the source.
   [[nodiscard]] std::uint64_t dropped_frames() const;
-  // Saves and publishes what the sweep changed (VersionKeeper::flush), its cost split into saving the boxes,
-  // publishing and saving the map state.
-  void flush(SweepTrace& trace);
+  // Saves and publishes the version the sweep made, if it made one (VersionKeeper::publish_boxes), its cost
+  // split into saving the boxes and publishing.
+  void publish_version(SweepTrace& trace);
+  // Saves the map state with the version (VersionKeeper::save_map_state).
+  void save_map_state(SweepTrace& trace);
   // Gives the pipeline the acquisition's robot model to cut out of the frames (self_filter.enabled), and the
   // robot layer the model to show.
   void use_self_filter();
@@ -98,6 +104,7 @@ class Daemon final {
   VersionKeeper keeper_;
   FrameQueue frames_;
   BoundedMailbox<GatheredSweep> sweeps_;
+  ClosedSweepFirst closed_sweep_first_;  // frames of the next sweep wait while a closed one is processed
   std::atomic<std::uint64_t> frames_in_dropped_sweeps_{0};
   std::uint64_t frame_faults_ = 0;  // frames that failed to fuse (gathering thread)
   std::chrono::steady_clock::time_point next_frame_fault_log_;  // gathering thread
@@ -109,7 +116,7 @@ class Daemon final {
   std::atomic<bool> acquisition_done_{false};
   std::atomic<bool> gathering_done_{false};
   std::string status_fault_;  // the last reason a status was not published, logged once
-  StepCost publish_cost_;     // of the publications during the current flush()
+  StepCost publish_cost_;     // of the publications during the current publish_version()
 };
 
 }  // namespace cellmap::daemon

@@ -83,6 +83,12 @@ class FrameQueue {
     ready_.notify_all();
   }
 
+  /// Frames waiting to be taken.
+  [[nodiscard]] std::size_t waiting() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frames_;
+  }
+
   /// How many frames were dropped before anyone took them.
   [[nodiscard]] std::uint64_t dropped() const {
     std::lock_guard<std::mutex> lock(mutex_);
