@@ -39,8 +39,10 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
       detector_(config.change),
       boxes_(std::move(boxes)),
       next_box_id_(next_box_id) {
-  // The points segmented are occupied voxel centres: boxes hold the whole voxels.
+  // The points segmented are occupied voxel centres: boxes hold the whole voxels. The threads that cast a
+  // sweep's rays are idle while it is segmented (the daemon's gathering waits for its version).
   config_.segment.voxel = config_.occupancy.resolution;
+  config_.segment.threads = config_.occupancy.threads;
   if (config_.settle_sweeps < 0 || config_.settle_sweeps > 100000)
     throw Error("change.settle_sweeps: must be an integer in [0, 100000], got " +
                 std::to_string(config_.settle_sweeps));
@@ -315,7 +317,10 @@ void CellPipeline::cover_the_rest(Reconciled& reconciled) const {
   options.voxel = map_.config().resolution;
   options.max_growth = config_.segment.join_max_growth;
   options.kind = config_.segment.box_kind;
-  cover(reconciled, voxels_outside(map_, *occupied_, reconciled.boxes, config_.change.min_voxels), options);
+  cover(reconciled,
+        voxels_outside(map_, *occupied_, reconciled.boxes, config_.change.min_voxels,
+                       config_.occupancy.threads),
+        options);
 }
 
 }  // namespace cellmap

@@ -7,6 +7,8 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "cellmap/common/parallel.hpp"
+
 namespace cellmap {
 namespace {
 
@@ -147,20 +149,30 @@ bool OccupiedVoxels::in_group_of(const OccupancyMap& map, const Eigen::Vector3d&
 }
 
 std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map, const OccupiedVoxels& voxels,
-                                            const std::vector<Box>& boxes, int min_group) {
+                                            const std::vector<Box>& boxes, int min_group, int threads) {
+  constexpr std::size_t kMinVoxelsPerThread = 4096;  // fewer go faster on one thread than others start
   const double edge = map.config().resolution;
   std::vector<Region> bounds;
   for (const Box& box : boxes) bounds.push_back(bounds_of(box));
-  std::vector<Eigen::Vector3d> outside;
-  for (const octomap::OcTreeKey& key : voxels.keys()) {
-    const Eigen::Vector3d c = map.centre(key);
-    bool held = false;
-    for (std::size_t i = 0; i < boxes.size() && !held; ++i) {
-      held = bounds[i].contains(c) && holds_cube(boxes[i], c, edge);
+  const std::vector<octomap::OcTreeKey>& keys = voxels.keys();
+  const int chunks =
+      int(std::clamp<std::size_t>(keys.size() / kMinVoxelsPerThread, 1, std::size_t(std::max(threads, 1))));
+  // Each thread a contiguous run of the keys, so that the runs joined keep the keys' order.
+  std::vector<std::vector<Eigen::Vector3d>> outside(static_cast<std::size_t>(chunks));
+  parallel_for(chunks, chunks, [&](int chunk) {
+    const std::size_t end = keys.size() * std::size_t(chunk + 1) / std::size_t(chunks);
+    for (std::size_t k = keys.size() * std::size_t(chunk) / std::size_t(chunks); k < end; ++k) {
+      const Eigen::Vector3d c = map.centre(keys[k]);
+      bool held = false;
+      for (std::size_t i = 0; i < boxes.size() && !held; ++i) {
+        held = bounds[i].contains(c) && holds_cube(boxes[i], c, edge);
+      }
+      if (!held && voxels.in_group_of(keys[k], min_group)) outside[std::size_t(chunk)].push_back(c);
     }
-    if (!held && voxels.in_group_of(key, min_group)) outside.push_back(c);
-  }
-  return outside;
+  });
+  for (std::size_t t = 1; t < outside.size(); ++t)
+    outside[0].insert(outside[0].end(), outside[t].begin(), outside[t].end());
+  return std::move(outside[0]);
 }
 
 void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,

@@ -40,10 +40,12 @@ class OccupiedVoxels final {
 };
 
 /// Centres of the occupied voxels that no single box of `boxes` holds whole and that belong to a
-/// 26-connected group of at least `min_group` occupied voxels, sorted by key (z, y, x).
+/// 26-connected group of at least `min_group` occupied voxels, sorted by key (z, y, x); the voxels split
+/// over up to `threads` threads (the result does not depend on it).
 [[nodiscard]] std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map,
                                                           const OccupiedVoxels& voxels,
-                                                          const std::vector<Box>& boxes, int min_group);
+                                                          const std::vector<Box>& boxes, int min_group,
+                                                          int threads = 1);
 
 /// How the safety pass covers what is left out.
 struct CoverParams final {
@@ -56,7 +58,6 @@ struct CoverParams final {
 /// box that grows least to take it if that growth is at most `max_growth` of the box's volume (the box is
 /// then modified, or stays added if it is new), the rest are segmented into new boxes with fresh ids from
 /// `reconciled.next_id`. Keeps `reconciled`'s lists sorted by id.
-void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
-           const CoverParams& options);
+void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C, const CoverParams& options);
 
 }  // namespace cellmap

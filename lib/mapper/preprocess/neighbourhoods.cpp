@@ -4,13 +4,18 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 
 namespace cellmap {
 
 namespace {
+
+// Fewer points per thread than this are searched faster on one thread than the others take to start.
+constexpr int kMinPointsPerThread = 256;
 
 void require_finite(const Cloud& cloud) {
   for (const pcl::PointXYZ& p : cloud) {
@@ -48,7 +53,7 @@ void fit_normal(const Cloud& cloud, int i, const pcl::Indices& found, int count,
 }  // namespace
 
 Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_normals,
-                                      const Eigen::Vector3f& viewpoint) {
+                                      const Eigen::Vector3f& viewpoint, int threads) {
   if (k < 1) throw Error("neighbourhoods: k must be >= 1, got " + std::to_string(k));
   require_finite(cloud);
   const int n = static_cast<int>(cloud.size());
@@ -67,20 +72,25 @@ Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_norma
   pcl::search::KdTree<pcl::PointXYZ> tree(false);
   tree.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}));
   const int searched = k + 1;  // the query point is its own nearest neighbour
-  pcl::Indices found(searched);
-  std::vector<float> found_sq(searched);
-  for (int i = 0; i < n; ++i) {
-    const int count = tree.nearestKSearch(i, searched, found, found_sq);
-    // found[0] is the query point (or a duplicate of it at distance 0).
-    double sum = 0.0;
-    for (int j = 1; j < count; ++j) {
-      result.indices[static_cast<std::size_t>(i) * k + j - 1] = found[j];
-      result.sq_distances[static_cast<std::size_t>(i) * k + j - 1] = found_sq[j];
-      sum += std::sqrt(static_cast<double>(found_sq[j]));  // in double, as PCL does
+  // Each thread a contiguous run of points: a search leaves only that point's entries of `result`.
+  const int chunks = std::clamp(threads, 1, std::max(1, n / kMinPointsPerThread));
+  parallel_for(chunks, chunks, [&](int chunk) {
+    pcl::Indices found(searched);
+    std::vector<float> found_sq(searched);
+    const int end = static_cast<int>(static_cast<long>(n) * (chunk + 1) / chunks);
+    for (int i = static_cast<int>(static_cast<long>(n) * chunk / chunks); i < end; ++i) {
+      const int count = tree.nearestKSearch(i, searched, found, found_sq);
+      // found[0] is the query point (or a duplicate of it at distance 0).
+      double sum = 0.0;
+      for (int j = 1; j < count; ++j) {
+        result.indices[static_cast<std::size_t>(i) * k + j - 1] = found[j];
+        result.sq_distances[static_cast<std::size_t>(i) * k + j - 1] = found_sq[j];
+        sum += std::sqrt(static_cast<double>(found_sq[j]));  // in double, as PCL does
+      }
+      result.mean_distance[i] = static_cast<float>(sum / k);
+      if (with_normals && count >= 3) fit_normal(cloud, i, found, count, viewpoint, result);
     }
-    result.mean_distance[i] = static_cast<float>(sum / k);
-    if (with_normals && count >= 3) fit_normal(cloud, i, found, count, viewpoint, result);
-  }
+  });
   return result;
 }
 

@@ -251,7 +251,8 @@ Prepared prepare(const Cloud& points, const SegmentConfig& config, SegmentStats&
   // One kd-tree search serves both outlier removal (eq. 1) and the features (eq. 2) of the survivors; their
   // normals thus include the removed points' few contributions (sparse outliers are rarely anyone's
   // neighbour).
-  const Neighbourhoods all = compute_neighbourhoods(cropped, config.k, true, points.sensor_origin_.head<3>());
+  const Neighbourhoods all =
+      compute_neighbourhoods(cropped, config.k, true, points.sensor_origin_.head<3>(), config.threads);
   stats.t_features = clock.lap();
   const OutlierResult outliers = remove_outliers(all, config.outlier_u, config.outlier_mode);
   stats.outliers_sparse = outliers.removed_sparse;
