@@ -286,7 +286,7 @@ void Daemon::save_map_state(SweepTrace& trace) {
 }
 
 std::size_t Daemon::frame_backlog_before_gathering() const {
-  return std::max<std::size_t>(1, config_.frame_backlog / 2);
+  return std::max<std::size_t>(1, config_.frame_backlog / 4);
 }
 
 std::uint64_t Daemon::dropped_frames() const {

@@ -79,8 +79,9 @@ class Daemon final {
   void handle(GatheredSweep& sweep, std::uint64_t number);
   // Runs the pipeline on the sweep and logs what it did; nullopt if the sweep failed (logged, reported).
   std::optional<SweepReport> run_pipeline(GatheredSweep& sweep, std::uint64_t number);
-  // Frames of the next sweep that may wait while a closed sweep is processed: half the frame queue, so that
-  // a long processing (the first segmentation of a cell) drops none.
+  // Frames of the next sweep that may wait while a closed sweep is processed: a quarter of the frame queue
+  // (a version's usual processing lets a frame or two of each camera wait), so that a long processing (the
+  // first segmentation of a cell) drops none.
   [[nodiscard]] std::size_t frame_backlog_before_gathering() const;
   // Frames never fused: dropped from the frame queue, in sweeps dropped from the backlog, or by the source.
   [[nodiscard]] std::uint64_t dropped_frames() const;
