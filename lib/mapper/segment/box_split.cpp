@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/parallel.hpp"
 #include "cellmap/segment/free_space.hpp"
 
 namespace cellmap {
@@ -143,13 +144,15 @@ class Components {
   std::vector<int> slot_;  // position of a point in the indices being grouped, -1 = not among them
 };
 
+// Splits segments, one at a time (its scratch space is its own: one per thread).
 class Splitter {
  public:
-  Splitter(const Cloud& cloud, const Neighbourhoods& nb, const BoxSplitParams& params, Segments& out)
-      : cloud_(cloud), params_(params), components_(nb, params.gap), out_(out) {}
+  Splitter(const Cloud& cloud, const Neighbourhoods& nb, const BoxSplitParams& params)
+      : cloud_(cloud), params_(params), components_(nb, params.gap) {}
 
-  // Labels `indices` as one segment, or as the segments of its pieces. Returns whether it was split.
-  bool split(const std::vector<int>& indices, const SeenFreeSpace& space, int depth) {
+  // Appends `indices` to `out` as one segment, or the segments of its pieces. Returns whether it was split.
+  bool split(const std::vector<int>& indices, const SeenFreeSpace& space, int depth,
+             std::vector<std::vector<int>>& out) {
     if (depth < params_.max_depth && indices.size() >= 2) {
       const Box box = fit_box(cloud_, indices, params_.kind, params_.cube);
       const double needed = params_.min_gain * box.volume();
@@ -160,13 +163,12 @@ class Splitter {
           double left = 0;
           for (const std::vector<int>& piece : pieces) left += space.free_volume(piece_box(piece, box));
           if (free - left < needed) continue;
-          for (const std::vector<int>& piece : pieces) split(piece, space, depth + 1);
+          for (const std::vector<int>& piece : pieces) split(piece, space, depth + 1, out);
           return true;
         }
       }
     }
-    for (int i : indices) out_.label[i] = out_.count;
-    ++out_.count;
+    out.push_back(indices);
     return false;
   }
 
@@ -198,7 +200,6 @@ class Splitter {
   const Cloud& cloud_;
   const BoxSplitParams& params_;
   Components components_;
-  Segments& out_;
 };
 
 // The cell-frame bounds of two boxes come within `gap` of each other on every axis.
@@ -325,6 +326,7 @@ void BoxSplitParams::validate() const {
   if (!(min_gain > 0 && min_gain <= 1)) throw Error("box split: min_gain must be in (0, 1]");
   if (!(max_growth >= 0 && max_growth < 1)) throw Error("box split: max_growth must be in [0, 1)");
   if (max_depth < 0) throw Error("box split: max_depth must be >= 0");
+  if (threads < 1) throw Error("box split: threads must be >= 1");
   if (!(angular_step > 0) || !(gap > 0) || !(margin >= 0) || !(adjacency >= 0) || !(cube >= 0)) {
     throw Error("box split: angular_step and gap must be > 0; margin, adjacency and cube >= 0");
   }
@@ -338,16 +340,29 @@ Segments split_by_free_space(const Cloud& cloud, const Neighbourhoods& neighbour
       static_cast<std::size_t>(neighbourhoods.size()) != cloud.size()) {
     throw Error("split: cloud, neighbourhoods and labels differ in size");
   }
+  // Segments are split independently, thread t taking segments t, t + threads, …; their pieces are labelled
+  // in segment order afterwards, so the labels do not depend on the threads.
+  const std::vector<std::vector<int>> members = segments.members();
+  std::vector<std::vector<std::vector<int>>> pieces(members.size());
+  std::vector<char> was_split(members.size(), 0);
+  const int threads = std::clamp(params.threads, 1, std::max(1, static_cast<int>(members.size())));
+  parallel_for(threads, threads, [&](int t) {
+    Splitter splitter(cloud, neighbourhoods, params);
+    for (std::size_t m = std::size_t(t); m < members.size(); m += std::size_t(threads)) {
+      if (members[m].empty()) continue;
+      const SeenFreeSpace space(cloud, members[m], viewpoint, params.angular_step, params.margin);
+      was_split[m] = splitter.split(members[m], space, 0, pieces[m]);
+    }
+  });
   Segments out;
   out.label.assign(cloud.size(), -1);
-  Splitter splitter(cloud, neighbourhoods, params, out);
-  std::size_t split = 0;
-  for (const std::vector<int>& members : segments.members()) {
-    if (members.empty()) continue;
-    const SeenFreeSpace space(cloud, members, viewpoint, params.angular_step, params.margin);
-    split += splitter.split(members, space, 0);
+  for (const std::vector<std::vector<int>>& of_segment : pieces) {
+    for (const std::vector<int>& piece : of_segment) {
+      for (int i : piece) out.label[i] = out.count;
+      ++out.count;
+    }
   }
-  if (split_count) *split_count = split;
+  if (split_count) *split_count = static_cast<std::size_t>(std::count(was_split.begin(), was_split.end(), 1));
   return out;
 }
 

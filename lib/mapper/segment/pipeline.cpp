@@ -74,6 +74,7 @@ BoxSplitParams box_split_params(const SegmentConfig& config, const Cloud& cloud,
   p.angular_step = step / std::max(median(range, 1.0), 10 * step);
   p.margin = std::max(step, 0.5 * config.voxel);
   p.adjacency = std::max(gap, config.voxel);
+  p.threads = config.threads;
   return p;
 }
 

@@ -29,6 +29,7 @@ struct BoxSplitParams final {
   double angular_step = 0.01;  ///< radians: direction bins of SeenFreeSpace (about the point spacing / range)
   double margin = 0.02;        ///< metres: thickness of a seen surface (SeenFreeSpace)
   double adjacency = 0.05;     ///< metres: only boxes whose bounds come this close are considered for joining
+  int threads = 1;  ///< segments are split on up to this many threads (the result does not depend on it)
   /// @throws Error naming the field if a value is out of range.
   void validate() const;
 };

@@ -50,8 +50,8 @@ struct SegmentConfig final {
   /// Metres: the points are centres of voxels of this edge (0 = plain points); boxes hold the whole voxels.
   double voxel = 0.0;
   std::optional<Workspace> workspace;  ///< crop region; none = no crop
-  /// Threads the neighbourhood search is split over (the result does not depend on it); not a config file
-  /// key: the cell pipeline gives it the occupancy map's threads.
+  /// Threads the neighbourhood search and the split by free space are spread over (the result does not
+  /// depend on it); not a config file key: the cell pipeline gives it the occupancy map's threads.
   int threads = 1;
 
   /// Reads a config document (keys as in config/segment.yaml; every key optional, missing = default).
