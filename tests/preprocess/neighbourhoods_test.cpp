@@ -88,22 +88,6 @@ TEST(Neighbourhoods, SubsetRenumbersAndDropsRemovedNeighbours) {
   EXPECT_THROW((void)subset_neighbourhoods(all, {3, 1}), Error);
 }
 
-TEST(Neighbourhoods, ThreadsGiveTheSameNeighbourhoods) {
-  Cloud cloud;  // a wavy 60 × 40 sheet: 2 400 points, enough for 3 threads
-  for (int i = 0; i < 60; ++i) {
-    for (int j = 0; j < 40; ++j) cloud.push_back({0.01f * i, 0.01f * j, 1.0f + 0.02f * std::sin(0.3f * i)});
-  }
-  const Neighbourhoods one = compute_neighbourhoods(cloud, 12, true, Eigen::Vector3f::Zero(), 1);
-  for (const int threads : {2, 3}) {
-    const Neighbourhoods split = compute_neighbourhoods(cloud, 12, true, Eigen::Vector3f::Zero(), threads);
-    EXPECT_EQ(split.indices, one.indices) << threads;
-    EXPECT_EQ(split.sq_distances, one.sq_distances) << threads;
-    EXPECT_EQ(split.mean_distance, one.mean_distance) << threads;
-    EXPECT_EQ(split.normals, one.normals) << threads;
-    EXPECT_EQ(split.curvature, one.curvature) << threads;
-  }
-}
-
 TEST(Neighbourhoods, RejectsBadInput) {
   EXPECT_THROW((void)compute_neighbourhoods(plane_grid(), 0, false), Error);
   Cloud cloud = plane_grid();

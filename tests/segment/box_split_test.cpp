@@ -109,36 +109,6 @@ TEST(BoxSplitTest, BoxesStackedFlushJoinAndDistantOnesDoNot) {
   EXPECT_EQ(join_by_free_space(scene.points, by_object, scene.viewpoint().cast<double>(), never).count, 3);
 }
 
-TEST(BoxSplitTest, SegmentsSplitOnThreadsGetTheSameLabels) {
-  // Three segments (a post on a plate, a table with pallets, a lone box), split on 1, 2 and 3 threads.
-  test::Scene scene(Eigen::Vector3f(0.0f, 0.0f, 1.6f));
-  scene.add_box({-1.0, 0, 0.025}, {0.25, 0.15, 0.025}, kI);
-  scene.add_box({-0.9, 0, 0.2}, {0.04, 0.04, 0.15}, kI);
-  scene.add_box({0, 0, -0.02}, {0.5, 0.4, 0.02}, kI);
-  scene.add_box({-0.3, -0.2, 0.07}, {0.15, 0.12, 0.07}, kI);
-  scene.add_box({0.3, 0.2, 0.07}, {0.15, 0.12, 0.07}, kI);
-  scene.add_box({1.0, 0, 0.1}, {0.15, 0.1, 0.1}, kI);
-  Segments segments;
-  segments.count = 3;
-  for (int object : scene.object) segments.label.push_back(object <= 2 ? 0 : object <= 5 ? 1 : 2);
-  const Neighbourhoods nb = compute_neighbourhoods(scene.points, 12, false);
-  std::size_t one_count = 0;
-  const Segments one =
-      split_by_free_space(scene.points, nb, segments, scene.viewpoint().cast<double>(), params(), &one_count);
-  EXPECT_EQ(one_count, 2u);  // the post off its plate, the pallets off their table; the lone box stays
-  EXPECT_EQ(one.count, 6);
-  for (const int threads : {2, 3}) {
-    BoxSplitParams on_threads = params();
-    on_threads.threads = threads;
-    std::size_t count = 0;
-    const Segments split =
-        split_by_free_space(scene.points, nb, segments, scene.viewpoint().cast<double>(), on_threads, &count);
-    EXPECT_EQ(split.label, one.label) << threads;
-    EXPECT_EQ(split.count, one.count) << threads;
-    EXPECT_EQ(count, one_count) << threads;
-  }
-}
-
 TEST(BoxSplitTest, RefusesInvalidParameters) {
   const test::Scene scene(Eigen::Vector3f(0, 0, 1));
   BoxSplitParams bad = params();
