@@ -27,12 +27,7 @@ std::map<int, std::map<int, int>> objects_per_segment(const test::Scene& scene, 
 }
 
 BoxSplitParams params() {
-  BoxSplitParams p;
-  p.angular_step = 0.005;
-  p.margin = 0.01;
-  p.adjacency = 0.02;
-  p.gap = 0.012;  // the scenes are sampled every 5 mm
-  return p;
+  return test::split_params();
 }
 
 Segments split(const test::Scene& scene, std::size_t* count = nullptr) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cellmap/frame/cloud.hpp"
+#include "cellmap/segment/box_split.hpp"
 
 namespace cellmap::test {
 
@@ -68,5 +69,15 @@ struct Scene {
     object.push_back(id);
   }
 };
+
+/// Split and join parameters for these scenes (sampled every 5 mm, seen from about a metre and a half).
+inline BoxSplitParams split_params() {
+  BoxSplitParams p;
+  p.angular_step = 0.005;
+  p.margin = 0.01;
+  p.adjacency = 0.02;
+  p.gap = 0.012;
+  return p;
+}
 
 }  // namespace cellmap::test

@@ -13,15 +13,6 @@ namespace {
 
 const Eigen::Matrix3d kI = Eigen::Matrix3d::Identity();
 
-BoxSplitParams split_params() {
-  BoxSplitParams p;
-  p.angular_step = 0.005;
-  p.margin = 0.01;
-  p.adjacency = 0.02;
-  p.gap = 0.012;  // the scenes are sampled every 5 mm
-  return p;
-}
-
 TEST(SegmentThreadsTest, NeighbourhoodsAreTheSameOnAnyNumberOfThreads) {
   Cloud cloud;  // a wavy 60 × 40 sheet: 2 400 points, enough for 3 threads
   for (int i = 0; i < 60; ++i) {
@@ -53,11 +44,11 @@ TEST(SegmentThreadsTest, SegmentsSplitOnThreadsGetTheSameLabels) {
   const Neighbourhoods nb = compute_neighbourhoods(scene.points, 12, false);
   std::size_t one_count = 0;
   const Segments one = split_by_free_space(scene.points, nb, segments, scene.viewpoint().cast<double>(),
-                                           split_params(), &one_count);
+                                           test::split_params(), &one_count);
   EXPECT_EQ(one_count, 2u);  // the post off its plate, the pallets off their table; the lone box stays
   EXPECT_EQ(one.count, 6);
   for (const int threads : {2, 3}) {
-    BoxSplitParams on_threads = split_params();
+    BoxSplitParams on_threads = test::split_params();
     on_threads.threads = threads;
     std::size_t count = 0;
     const Segments split =
