@@ -1,10 +1,12 @@
 #include "cellmap/cell/cell_pipeline.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 #include <string_view>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/segment/free_space.hpp"
 #include "coverage.hpp"
 #include "stage_clock.hpp"
 
@@ -27,6 +29,38 @@ constexpr double kRefitShare = 0.1;
 
 bool contains_id(const std::vector<std::uint64_t>& ids, std::uint64_t id) {
   return std::find(ids.begin(), ids.end(), id) != ids.end();
+}
+
+// The smallest box in `like`'s rotation that holds the voxel of edge `voxel` around every point whole.
+Box box_in_rotation(const Cloud& centres, const Box& like, double voxel) {
+  const Eigen::Matrix3d R = like.rotation.toRotationMatrix();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const pcl::PointXYZ& p : centres) {
+    const Eigen::Vector3d local = R.transpose() * (p.getVector3fMap().cast<double>() - like.center);
+    lo = lo.cwiseMin(local);
+    hi = hi.cwiseMax(local);
+  }
+  Box box = like;
+  box.center = like.center + R * (0.5 * (lo + hi));
+  box.half_extents = (0.5 * (hi - lo)).array() + kBoxFitSlack;
+  box.points = centres.size();
+  grow_to_hold_cubes(box, voxel);
+  return box;
+}
+
+// The share of `box`'s volume seen free around the voxel centres it holds, judged as the segmentation
+// judges its boxes (box_split.hpp): direction bins a voxel wide at the median range, surfaces a voxel thick.
+double seen_free_share(const Cloud& centres, const Box& box, const Eigen::Vector3d& viewpoint, double voxel) {
+  std::vector<int> indices(centres.size());
+  std::vector<double> range(centres.size());
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    indices[i] = static_cast<int>(i);
+    range[i] = (centres[i].getVector3fMap().cast<double>() - viewpoint).norm();
+  }
+  std::nth_element(range.begin(), range.begin() + range.size() / 2, range.end());
+  const double step = voxel / std::max(range[range.size() / 2], 10 * voxel);
+  const SeenFreeSpace seen(centres, indices, viewpoint, step, voxel);
+  return seen.free_volume(box) / box.volume();
 }
 
 }  // namespace
@@ -213,12 +247,13 @@ Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
   Scope scope = scope_of(changes);
   add_boxes_within(scope);
   add_emptied_boxes(scope);
-  std::vector<Box> kept;
+  std::vector<Box> kept = scope.shrunk;
   for (const Box& box : boxes_) {
     if (!contains_id(scope.boxes, box.id)) kept.push_back(box);
   }
   Resegmentation result;
-  const std::vector<Box> fitted = fit_boxes(scope.area, kept, result.evidence);
+  std::vector<Box> fitted = fit_boxes(scope.area, kept, result.evidence);
+  fitted.insert(fitted.end(), scope.shrunk.begin(), scope.shrunk.end());
   result.reconciled = reconcile(boxes_, scope.boxes, fitted, next_box_id_, config_.reconcile);
   // Noise alone makes no version: what it added is taken up by the next version a change makes.
   if (config_.cover_every_version && result.reconciled.changed()) cover_the_rest(result.reconciled);
@@ -235,11 +270,61 @@ CellPipeline::Scope CellPipeline::scope_of(const ChangeSet& changes) const {
     scope.area.push_back(region.bounds);
     for (const octomap::OcTreeKey& key : region.vanished) vanished_C.push_back(map_.centre(key));
   }
-  scope.boxes = boxes_touched(boxes_, vanished_C, kRefitShare);
+  const std::vector<std::uint64_t> touched = boxes_touched(boxes_, vanished_C, kRefitShare);
   for (const Box& box : boxes_) {
-    if (contains_id(scope.boxes, box.id)) scope.area.push_back(bounds_of(box).grown(config_.change.margin));
+    if (!contains_id(touched, box.id) || contains_id(scope.boxes, box.id)) continue;
+    scope.boxes.push_back(box.id);
+    if (!shrink_in_place(box, changes, scope))
+      scope.area.push_back(bounds_of(box).grown(config_.change.margin));
   }
   return scope;
+}
+
+// An object taken away from beside another leaves the box they were joined into with the other's voxels:
+// the box of what it still holds, in its own rotation, is what re-segmenting its extent ends in when that
+// box blocks no more seen free space than a join accepts. The boxes within the margin of it are taken in
+// (the part of a slightly moved object that got a box of its own); when something appeared there, the
+// object changed rather than lost a part, and its extent is re-segmented.
+bool CellPipeline::shrink_in_place(const Box& box, const ChangeSet& changes, Scope& scope) const {
+  const double resolution = map_.config().resolution;
+  const Region reach = bounds_of(box).grown(config_.change.margin);
+  for (const ChangeRegion& region : changes.regions) {
+    if (reach.intersection(region.bounds).volume() <= 0) continue;
+    for (const octomap::OcTreeKey& key : region.appeared) {
+      if (reach.contains(map_.centre(key))) return false;
+    }
+  }
+  std::vector<const Box*> taken_in{&box}, neighbours;
+  for (const Box& other : boxes_) {
+    if (other.id == box.id) continue;
+    const Region bounds = bounds_of(other);
+    if (reach.grown(resolution).intersection(bounds).volume() >= bounds.volume()) {
+      if (contains_id(scope.boxes, other.id)) return false;  // re-segmented already
+      taken_in.push_back(&other);
+    } else if (reach.intersection(bounds).volume() > 0) {
+      neighbours.push_back(&other);
+    }
+  }
+  Cloud evidence;
+  for (const Eigen::Vector3d& c : map_.occupied_centres({reach})) {
+    const auto holds_centre = [&](const Box* b) { return b->contains(c); };
+    const auto holds_voxel = [&](const Box* b) { return holds_cube(*b, c, resolution); };
+    if (std::none_of(taken_in.begin(), taken_in.end(), holds_centre) ||
+        std::any_of(neighbours.begin(), neighbours.end(), holds_voxel) ||
+        !occupied_->in_group_of(map_, c, config_.change.min_voxels)) {
+      continue;
+    }
+    evidence.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
+  }
+  if (evidence.empty()) return false;  // it goes: nothing to shrink to
+  const Box shrunk = box_in_rotation(evidence, box, resolution);
+  if (seen_free_share(evidence, shrunk, viewpoint_C_, resolution) > config_.segment.join_max_growth)
+    return false;
+  scope.shrunk.push_back(shrunk);
+  for (const Box* b : taken_in) {
+    if (b != &box) scope.boxes.push_back(b->id);
+  }
+  return true;
 }
 
 // Boxes lying wholly inside the area (to a voxel) join it: the top of a new object published a few sweeps

@@ -1,0 +1,150 @@
+// The cell pipeline's re-segmentation of a box that lost part of its voxels (CellPipeline::resegment on a map
+// settled from a cloud of voxel centres, with the change given by hand): it shrinks in place when the box of
+// what it still holds blocks little seen free space, and its extent is re-segmented when that box would
+// block the space the removal freed or when something appeared beside it. Known answers, milliseconds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/config/yaml_map.hpp"
+
+namespace cellmap {
+namespace {
+
+constexpr double kVoxel = 0.02;  // cellmapd's default resolution
+
+// cellmapd's shipped defaults with axis-aligned boxes (box bounds are then the known answers).
+CellPipelineConfig config() {
+  YamlMap root = YamlMap::load(CELLMAP_SOURCE_DIR "/config/cellmapd.yaml");
+  CellPipelineConfig c = CellPipelineConfig::from_yaml(root);
+  c.segment.box_kind = BoxKind::kAxisAligned;
+  return c;
+}
+
+// The centres of the voxels filling [lo, hi) (metres, multiples of the voxel edge).
+std::vector<Eigen::Vector3d> voxels(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  std::vector<Eigen::Vector3d> out;
+  const Eigen::Vector3i n = ((hi - lo) / kVoxel).array().round().cast<int>();
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      for (int i = 0; i < n.x(); ++i) out.push_back(lo + kVoxel * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
+    }
+  }
+  return out;
+}
+
+Box box_of(std::uint64_t id, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, std::uint64_t points) {
+  Box box;
+  box.id = id;
+  box.center = 0.5 * (lo + hi);
+  box.half_extents = 0.5 * (hi - lo);
+  box.points = points;
+  return box;
+}
+
+// A map holding `occupied` (seen from above the table), the cell's boxes `boxes`, and the change of
+// `vanished` (voxels now free) and `appeared` (voxels of `occupied` that are new) as one region.
+class Table {
+ public:
+  Table(const std::vector<Eigen::Vector3d>& occupied, std::vector<Box> boxes)
+      : pipeline_(config(), std::move(boxes), 10) {
+    Cloud cloud;
+    for (const Eigen::Vector3d& c : occupied) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
+    cloud.sensor_origin_ = Eigen::Vector4f(0.5f, 0.2f, 2.0f, 0.0f);
+    EXPECT_EQ(pipeline_.settle_on(cloud), 0u);
+  }
+
+  [[nodiscard]] Resegmentation resegment(const std::vector<Eigen::Vector3d>& vanished,
+                                         const std::vector<Eigen::Vector3d>& appeared = {}) const {
+    ChangeRegion region;
+    Region extent{Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(-1e9)};
+    const auto add = [&](const Eigen::Vector3d& c, std::vector<octomap::OcTreeKey>& keys) {
+      keys.push_back(pipeline_.map().tree().coordToKey(c.x(), c.y(), c.z()));
+      extent.min = extent.min.cwiseMin(c);
+      extent.max = extent.max.cwiseMax(c);
+    };
+    for (const Eigen::Vector3d& c : vanished) add(c, region.vanished);
+    for (const Eigen::Vector3d& c : appeared) add(c, region.appeared);
+    region.bounds = extent.grown(0.5 * kVoxel + config().change.margin);
+    ChangeSet changes;
+    changes.regions.push_back(region);
+    return pipeline_.resegment(changes);
+  }
+
+ private:
+  CellPipeline pipeline_;
+};
+
+// Every voxel of `centres` wholly inside one box of `boxes`.
+void expect_held(const std::vector<Box>& boxes, const std::vector<Eigen::Vector3d>& centres) {
+  std::size_t outside = 0;
+  for (const Eigen::Vector3d& c : centres) {
+    const auto holds = [&](const Box& b) {
+      return b.contains(c - Eigen::Vector3d::Constant(0.5 * kVoxel), 1e-6) &&
+             b.contains(c + Eigen::Vector3d::Constant(0.5 * kVoxel), 1e-6);
+    };
+    outside += std::none_of(boxes.begin(), boxes.end(), holds) ? 1 : 0;
+  }
+  EXPECT_EQ(outside, 0u);
+}
+
+// A crate (0.3 × 0.2 × 0.06 m) taken off a table slab (1 × 0.4 × 0.04 m) that its box was joined with: the
+// box shrinks to the slab, keeps its id (bounds IoU 0.4) and nothing is re-segmented.
+TEST(CellPipelineResegmentTest, ABoxThatLostAnObjectShrinksInPlaceToWhatItStillHolds) {
+  const std::vector<Eigen::Vector3d> slab = voxels({0, 0, 0.70}, {1.0, 0.4, 0.74});
+  const std::vector<Eigen::Vector3d> crate = voxels({0.34, 0.1, 0.74}, {0.64, 0.3, 0.80});
+  const Table table(slab, {box_of(3, {0, 0, 0.70}, {1.0, 0.4, 0.80}, slab.size() + crate.size())});
+
+  const Resegmentation result = table.resegment(crate);
+  EXPECT_EQ(result.evidence, 0u) << "the slab's voxels were re-segmented";
+  const Reconciled& r = result.reconciled;
+  ASSERT_EQ(r.modified.size(), 1u);
+  EXPECT_TRUE(r.added.empty());
+  EXPECT_TRUE(r.removed.empty());
+  const Box& shrunk = r.modified[0];
+  EXPECT_EQ(shrunk.id, 3u);
+  EXPECT_EQ(shrunk.points, slab.size());
+  const Region bounds = bounds_of(shrunk);
+  EXPECT_NEAR(bounds.min.z(), 0.70, 1e-5);
+  EXPECT_NEAR(bounds.max.z(), 0.74, 1e-5);
+  EXPECT_NEAR(bounds.min.x(), 0.0, 1e-5);
+  EXPECT_NEAR(bounds.max.x(), 1.0, 1e-5);
+  expect_held(r.boxes, slab);
+}
+
+// A crate taken from between two slabs its box was joined with: the box of what is left would span the
+// 0.4 m the crate freed, seen free from above, so the extent is re-segmented into a box per slab.
+TEST(CellPipelineResegmentTest, ABoxThatWouldBlockTheFreedSpaceIsReSegmented) {
+  std::vector<Eigen::Vector3d> slabs = voxels({0, 0, 0.70}, {0.3, 0.4, 0.74});
+  const std::vector<Eigen::Vector3d> right = voxels({0.7, 0, 0.70}, {1.0, 0.4, 0.74});
+  slabs.insert(slabs.end(), right.begin(), right.end());
+  const std::vector<Eigen::Vector3d> crate = voxels({0.3, 0, 0.70}, {0.7, 0.4, 0.80});
+  const Table table(slabs, {box_of(3, {0, 0, 0.70}, {1.0, 0.4, 0.80}, slabs.size() + crate.size())});
+
+  const Resegmentation result = table.resegment(crate);
+  EXPECT_EQ(result.evidence, slabs.size());
+  const std::vector<Box>& boxes = result.reconciled.boxes;
+  EXPECT_EQ(boxes.size(), 2u);
+  expect_held(boxes, slabs);
+  for (const Box& b : boxes) EXPECT_FALSE(b.contains({0.5, 0.2, 0.72})) << "box " << b.id << " spans the gap";
+}
+
+// The crate's voxels went while others appeared within change.margin of its box (the crate moved rather than
+// went): the object changed, so the extent is re-segmented even though the box of what is left is tight.
+TEST(CellPipelineResegmentTest, ABoxWithSomethingNewBesideItIsReSegmented) {
+  std::vector<Eigen::Vector3d> occupied = voxels({0, 0, 0.70}, {1.0, 0.4, 0.74});
+  const std::size_t slab = occupied.size();
+  const std::vector<Eigen::Vector3d> crate = voxels({0.34, 0.1, 0.74}, {0.64, 0.3, 0.80});
+  const std::vector<Eigen::Vector3d> moved = voxels({0.64, 0.1, 0.74}, {0.70, 0.3, 0.80});
+  occupied.insert(occupied.end(), moved.begin(), moved.end());
+  const Table table(occupied, {box_of(3, {0, 0, 0.70}, {1.0, 0.4, 0.80}, slab + crate.size())});
+
+  const Resegmentation result = table.resegment(crate, moved);
+  EXPECT_EQ(result.evidence, occupied.size());
+  expect_held(result.reconciled.boxes, occupied);
+}
+
+}  // namespace
+}  // namespace cellmap
