@@ -544,6 +544,14 @@ void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator
   std::uint64_t last = kNoKey;
   for (std::size_t block_begin = begin; block_begin < end; block_begin += kBlock) {
     const std::size_t count = std::min(end - block_begin, kBlock);
+#if defined(__SSE2__)
+    // The next block's points into the cache meanwhile (4 points per 64-byte line): the points of a frame are
+    // read once, and waiting for them was most of this function's time (grabber frames, 2 threads: 10.2–11.1
+    // → 7.8–8.0 ms per fusion of 3 frames).
+    const std::size_t ahead = std::min(end, block_begin + 2 * kBlock);
+    for (std::size_t i = block_begin + kBlock; i < ahead; i += 4)
+      _mm_prefetch(reinterpret_cast<const char*>(points.data() + i), _MM_HINT_T0);
+#endif
     converter.keys(points.data() + block_begin, count, block, redo);
     std::size_t n = 0;
     for (std::size_t i = 0; i < count; ++i) {
