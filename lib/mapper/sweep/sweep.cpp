@@ -65,7 +65,12 @@ Scan move_to_scan(Frame& frame) {
   const Eigen::Vector3f t_CS = frame.X_CS.translation().cast<float>();
   auto& points = frame.points_S.points;
   std::size_t kept = 0;
-  for (const pcl::PointXYZ& p : points) {
+  // A frame's points are read once, from memory, and waiting for them was most of this loop's time: each
+  // 64-byte line is asked for 4 KB before it is read.
+  constexpr std::size_t kAhead = 256;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i % 4 == 0 && i + kAhead < points.size()) __builtin_prefetch(&points[i + kAhead]);
+    const pcl::PointXYZ p = points[i];
     if (finite(p)) to_cell(R_CS, t_CS, p, points[kept++]);
   }
   points.resize(kept);
