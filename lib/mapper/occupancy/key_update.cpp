@@ -712,11 +712,18 @@ SweepRays sweep_rays(const Sweep& sweep, const octomap::OcTree& grid, double max
 std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& bricks,
                                       const octomap::OcTree& grid, int threads) {
   std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
-  run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
+  // Blocks of rays dealt out in turn: neighbouring rays are of about the same length, far and near ones lie
+  // in different parts of an image, so contiguous halves can cost the threads very different times.
+  constexpr std::size_t kRaysPerBlock = 256;
+  const std::size_t count = rays.rays.size(), stride = kRaysPerBlock * std::size_t(threads);
+  parallel_for(threads, threads, [&](int thread) {
+    const std::size_t t = std::size_t(thread);
     sets[t].assign(bricks.bits() / 64, 0);
     DenseCursor cursor(bricks, sets[t].data());
-    for (std::size_t r = begin; r < end; ++r)
-      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+    for (std::size_t block = t * kRaysPerBlock; block < count; block += stride) {
+      for (std::size_t r = block; r < std::min(count, block + kRaysPerBlock); ++r)
+        walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+    }
   });
   std::vector<std::uint64_t>& crossed = sets[0];
   for (std::size_t t = 1; t < sets.size(); ++t) {
