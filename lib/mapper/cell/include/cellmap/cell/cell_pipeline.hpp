@@ -151,8 +151,8 @@ class CellPipeline final {
   /// more (its evidence cleared piece by piece, too little at a time to be a change) goes. A box that lost
   /// voxels with nothing appearing within change.margin of it shrinks in place instead (its rotation kept,
   /// the boxes lying within that margin taken in) when the shrunk box blocks at most segment.join.max_growth
-  /// of its volume in seen free space: what a join accepts, so re-segmenting its extent would not split it
-  /// (a 1 m box's 3 600 voxels cost 50–90 ms to re-segment, about a millisecond to shrink). Const and
+  /// of its volume in seen free space: what a join accepts, and no split by free space could gain
+  /// segment.split.min_gain on it (a 3 000-voxel slab: 1.4 ms shrunk, 23 ms re-segmented). Const and
   /// repeatable, so one change can be evaluated on a fixed state (`cellmap bench segment` times it against
   /// resegment_everything()).
   [[nodiscard]] Resegmentation resegment(const ChangeSet& changes) const;
