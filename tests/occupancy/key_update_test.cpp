@@ -158,14 +158,20 @@ TEST(KeyUpdateTest, ClearOnlyRayStopsBeforeItsEndVoxel) {
   EXPECT_EQ(std::count(free.begin(), free.end(), tree.coordToKey(0.95, 0.05, 0.05)), 1);
 }
 
+// Each thread de-duplicates its own share of the points and clear-only ends: voxels shared by two shares
+// get their ray twice, which must not change the result.
 TEST(KeyUpdateTest, ResultDoesNotDependOnThreads) {
   octomap::OcTree tree(0.05);
-  const Sweep sweep = one_scan(tilted_pose());
-  const KeyUpdate one = compute_key_update(sweep, tree, 5.0, 1);
-  for (const int threads : {2, 3, 7}) {
-    const KeyUpdate many = compute_key_update(sweep, tree, 5.0, threads);
-    EXPECT_EQ(many.occupied_keys(), one.occupied_keys());
-    EXPECT_EQ(many.free_keys(), one.free_keys());
+  Sweep with_clear;
+  with_clear.scans.push_back(with_clear_rays(one_scan(tilted_pose()).scans[0]));
+  for (const Sweep& sweep : {one_scan(tilted_pose()), with_clear}) {
+    const KeyUpdate one = compute_key_update(sweep, tree, 5.0, 1);
+    for (const int threads : {2, 3, 7}) {
+      const KeyUpdate many = compute_key_update(sweep, tree, 5.0, threads);
+      EXPECT_EQ(many.occupied_keys(), one.occupied_keys());
+      EXPECT_EQ(many.free_keys(), one.free_keys());
+      EXPECT_EQ(many.free_count, one.free_count);
+    }
   }
 }
 
@@ -198,6 +204,29 @@ TEST(KeyUpdateTest, HugeSweepBoxFallsBackToSortingWithSameResult) {
   EXPECT_EQ(ours.free_keys(), sorted(free));
   EXPECT_EQ(ours.occupied_count, occupied.size());
   EXPECT_GT(free.size(), 100u);
+}
+
+// One scan whose points lie more than 200 m apart spans more than 2^28 voxels: its end voxels are
+// de-duplicated by sorting, and the far points' rays are cut at max_range.
+TEST(KeyUpdateTest, HugeScanBoxFallsBackToSortingWithSameResult) {
+  octomap::OcTree tree(0.01);
+  Sweep sweep;
+  Scan& scan = sweep.scans.emplace_back();
+  scan.origin_C = Eigen::Vector3d(0.003, -0.002, 0.001);
+  for (const double offset : {0.0, 150.0}) {
+    for (int i = 0; i < 20; ++i) {
+      scan.points_C.push_back(pcl::PointXYZ(float(offset + 0.5 + 0.01 * i), float(0.2 - 0.03 * i - offset),
+                                            float(0.1 + 0.1 * offset)));
+    }
+  }
+  const auto [free, occupied] = octomap_sweep_update(sweep, tree);
+  for (const int threads : {1, 2}) {
+    const KeyUpdate ours = compute_key_update(sweep, tree, 5.0, threads);
+    EXPECT_EQ(ours.occupied_keys(), sorted(occupied));
+    EXPECT_EQ(ours.free_keys(), sorted(free));
+  }
+  EXPECT_EQ(occupied.size(), 20u);
+  EXPECT_GT(free.size(), 500u);
 }
 
 TEST(KeyUpdateTest, SkipsNonFinitePointsAndRejectsBadOrigins) {

@@ -378,17 +378,6 @@ void walk(const Origin& origin, const Ray& ray, const octomap::OcTree& grid, con
   }
 }
 
-// Runs fn(begin, end, thread) over [0, n) split into `threads` contiguous chunks, on that many threads.
-template <class Fn>
-void run_parallel(int threads, std::size_t n, Fn&& fn) {
-  const int count = std::max(threads, 1);
-  const std::size_t chunk = (n + std::size_t(count) - 1) / std::size_t(count);
-  parallel_for(count, count, [&](int t) {
-    const std::size_t begin = std::min(n, std::size_t(t) * chunk);
-    fn(begin, std::min(n, begin + chunk), std::size_t(t));
-  });
-}
-
 constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
 // OctoMap's coordToKeyChecked arithmetic, inlined (it is out of line in the library): key = floor(x /
@@ -567,68 +556,6 @@ void append_point_keys(const std::vector<pcl::PointXYZ, Eigen::aligned_allocator
   }
 }
 
-// The packed endpoint keys of one scan, per thread chunk of its points (consecutive repeats dropped), and
-// of its clear-only ray ends, with the box of all of them.
-struct ScanKeys {
-  std::vector<std::vector<std::uint64_t>> points;
-  std::vector<std::uint64_t> clear;
-  KeyBox box;
-};
-
-ScanKeys scan_keys(const Scan& scan, const octomap::OcTree& grid, int threads) {
-  const auto& points = scan.points_C.points;
-  const KeyConverter converter(grid);
-  ScanKeys out;
-  out.points.resize(static_cast<std::size_t>(threads));
-  std::vector<KeyBox> boxes(static_cast<std::size_t>(threads));
-  run_parallel(threads, points.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
-    append_point_keys(points, begin, end, converter, out.points[t], boxes[t]);
-  });
-  for (const pcl::PointXYZ& p : scan.clear_C.points) {
-    const std::uint64_t packed = converter.key(p.x, p.y, p.z);
-    if (packed == kNoKey) continue;
-    out.clear.push_back(packed);
-    out.box.extend(unpack_key(packed));
-  }
-  for (const KeyBox& b : boxes) {
-    if (!b.empty()) out.box.extend(b);
-  }
-  return out;
-}
-
-// The distinct voxels of one scan: those holding a point, and the ends of its clear-only rays that hold none.
-struct DistinctKeys {
-  std::vector<Key> points;
-  std::vector<Key> clear;
-};
-
-// The distinct keys of `keys`, in first-seen order (a bit set over their box, or sorting when the box is
-// huge).
-DistinctKeys distinct(const ScanKeys& keys) {
-  DistinctKeys out;
-  if (keys.box.volume() > kMaxDenseVoxels) {
-    std::vector<std::uint64_t> all;
-    for (const auto& list : keys.points) all.insert(all.end(), list.begin(), list.end());
-    const std::vector<std::uint64_t> points = sorted_unique(std::move(all));
-    for (const std::uint64_t p : points) out.points.push_back(unpack_key(p));
-    for (const std::uint64_t p : sorted_unique(keys.clear)) {
-      if (!std::binary_search(points.begin(), points.end(), p)) out.clear.push_back(unpack_key(p));
-    }
-    return out;
-  }
-  BitSet seen(keys.box.volume());
-  const BoxIndex index(keys.box);
-  for (const auto& list : keys.points) {
-    for (const std::uint64_t p : list) {
-      if (!seen.test_and_set(index(p))) out.points.push_back(unpack_key(p));
-    }
-  }
-  for (const std::uint64_t p : keys.clear) {
-    if (!seen.test_and_set(index(p))) out.clear.push_back(unpack_key(p));
-  }
-  return out;
-}
-
 enum class RayEnd { kVoxel, kCut, kOutside };
 
 // The ray from `origin` to the centre of voxel `end` (kVoxel); one that ends farther than `max_range` is cut
@@ -656,13 +583,81 @@ RayEnd ray_to(const octomap::OcTree& grid, const Origin& origin, const Key& end,
                                                                                  : RayEnd::kOutside;
 }
 
-// The rays of a sweep: per scan, one to each distinct endpoint voxel; the hits among the ends; the key box of
-// all origins and ends.
-struct SweepRays {
-  std::vector<Origin> origins;
+// The rays one thread made from its share of a scan's points and clear-only ray ends: one to each distinct
+// voxel of its share, the hits among their ends, and the key box of the ends. A voxel that points of two
+// shares hold gets a ray from each: the same ray, which marks the same voxels twice.
+struct RayShare {
   std::vector<Ray> rays;
   std::vector<Key> hits;
   KeyBox box;
+};
+
+// The packed keys of one share: its points' (consecutive repeats dropped) and its clear-only ray ends', with
+// the box of all of them.
+struct ShareKeys {
+  std::vector<std::uint64_t> points, clear;
+  KeyBox box;
+};
+
+// The distinct keys of `keys`, points first, then the clear-only ends that hold no point (a bit set over
+// their box, or sorting when the box is huge), passed to take(packed, is_point).
+template <class Take>
+void for_each_distinct(const ShareKeys& keys, const Take& take) {
+  if (keys.box.volume() > kMaxDenseVoxels) {
+    const std::vector<std::uint64_t> points = sorted_unique(keys.points);
+    for (const std::uint64_t p : points) take(p, true);
+    for (const std::uint64_t p : sorted_unique(keys.clear)) {
+      if (!std::binary_search(points.begin(), points.end(), p)) take(p, false);
+    }
+    return;
+  }
+  BitSet seen(keys.box.volume());
+  const BoxIndex index(keys.box);
+  for (const std::uint64_t p : keys.points) {
+    if (!seen.test_and_set(index(p))) take(p, true);
+  }
+  for (const std::uint64_t p : keys.clear) {
+    if (!seen.test_and_set(index(p))) take(p, false);
+  }
+}
+
+// The rays of one share from `origin` (scan `s`): one to each distinct voxel of `keys`; those of points
+// within range are hits.
+RayShare share_rays(const ShareKeys& keys, const octomap::OcTree& grid, double max_range,
+                    const Origin& origin, std::uint32_t s) {
+  RayShare out;
+  out.rays.reserve(keys.points.size() + keys.clear.size());
+  for_each_distinct(keys, [&](std::uint64_t packed, bool point) {
+    Ray ray{};
+    const Key key = unpack_key(packed);
+    const RayEnd end = ray_to(grid, origin, key, max_range, ray);
+    if (end == RayEnd::kOutside) return;
+    if (point && end == RayEnd::kVoxel) out.hits.push_back(key);
+    ray.cut = end == RayEnd::kCut;
+    ray.origin = s;
+    out.box.extend(ray.end_key);
+    out.rays.push_back(ray);
+  });
+  return out;
+}
+
+// Thread t's share [begin, end) of n items split into `threads` contiguous chunks.
+std::pair<std::size_t, std::size_t> share_of(std::size_t n, int threads, int t) {
+  const std::size_t chunk = (n + std::size_t(threads) - 1) / std::size_t(threads);
+  const std::size_t begin = std::min(n, std::size_t(t) * chunk);
+  return {begin, std::min(n, begin + chunk)};
+}
+
+// The rays of a sweep: per scan and thread, its share's rays (see RayShare); the key box of all origins and
+// ends.
+struct SweepRays {
+  std::vector<Origin> origins;
+  std::vector<RayShare> shares;
+  KeyBox box;
+
+  [[nodiscard]] bool empty() const {
+    return std::all_of(shares.begin(), shares.end(), [](const RayShare& s) { return s.rays.empty(); });
+  }
 };
 
 // Scan `s`'s origin, as OctoMap sees it. @throws Error if it is not finite or outside the key range.
@@ -676,35 +671,45 @@ Origin scan_origin(const Scan& scan, std::size_t s, const octomap::OcTree& grid)
   return origin;
 }
 
-// Adds a ray from origin `s` to each of `ends`; those within range are hits when `hit`.
-void add_rays(const octomap::OcTree& grid, double max_range, std::uint32_t s, const std::vector<Key>& ends,
-              bool hit, SweepRays& out) {
-  for (const Key& k : ends) {
-    Ray ray{};
-    const RayEnd end = ray_to(grid, out.origins[s], k, max_range, ray);
-    if (end == RayEnd::kOutside) continue;
-    if (hit && end == RayEnd::kVoxel) out.hits.push_back(k);
-    ray.cut = end == RayEnd::kCut;
-    ray.origin = s;
-    out.box.extend(ray.end_key);
-    out.rays.push_back(ray);
+// Adds scan `s`'s rays to `out`, its points and clear-only ray ends split into one share per thread, each
+// thread converting, de-duplicating and making the rays of its own share.
+void add_scan_rays(const Scan& scan, std::uint32_t s, const octomap::OcTree& grid, double max_range,
+                   int threads, SweepRays& out) {
+  const KeyConverter converter(grid);
+  const Origin& origin = out.origins[s];
+  const std::size_t first = out.shares.size();
+  out.shares.resize(first + std::size_t(threads));
+  parallel_for(threads, threads, [&](int t) {
+    ShareKeys keys;
+    const auto [begin, end] = share_of(scan.points_C.size(), threads, t);
+    append_point_keys(scan.points_C.points, begin, end, converter, keys.points, keys.box);
+    const auto [clear_begin, clear_end] = share_of(scan.clear_C.size(), threads, t);
+    append_point_keys(scan.clear_C.points, clear_begin, clear_end, converter, keys.clear, keys.box);
+    if (!keys.box.empty()) out.shares[first + std::size_t(t)] = share_rays(keys, grid, max_range, origin, s);
+  });
+  for (std::size_t i = first; i < out.shares.size(); ++i) {
+    if (!out.shares[i].box.empty()) out.box.extend(out.shares[i].box);
   }
 }
 
-// Per scan: distinct endpoint voxels; those within range are hits, every one gets a ray.
 SweepRays sweep_rays(const Sweep& sweep, const octomap::OcTree& grid, double max_range, int threads) {
   SweepRays out;
   for (std::size_t s = 0; s < sweep.scans.size(); ++s) {
-    const Scan& scan = sweep.scans[s];
-    out.origins.push_back(scan_origin(scan, s, grid));
+    out.origins.push_back(scan_origin(sweep.scans[s], s, grid));
     out.box.extend(out.origins.back().key);
-    const ScanKeys keys = scan_keys(scan, grid, threads);
-    if (keys.box.empty()) continue;
-    const DistinctKeys ends = distinct(keys);
-    add_rays(grid, max_range, static_cast<std::uint32_t>(s), ends.points, true, out);
-    add_rays(grid, max_range, static_cast<std::uint32_t>(s), ends.clear, false, out);
+    add_scan_rays(sweep.scans[s], static_cast<std::uint32_t>(s), grid, max_range, threads, out);
   }
   return out;
+}
+
+// The rays of `rays` in blocks of at most `size`, to be dealt out to threads.
+std::vector<std::pair<const Ray*, std::size_t>> ray_blocks(const SweepRays& rays, std::size_t size) {
+  std::vector<std::pair<const Ray*, std::size_t>> blocks;
+  for (const RayShare& share : rays.shares) {
+    for (std::size_t begin = 0; begin < share.rays.size(); begin += size)
+      blocks.emplace_back(share.rays.data() + begin, std::min(size, share.rays.size() - begin));
+  }
+  return blocks;
 }
 
 // Walks the rays on `threads` threads, each into its own bit set over `bricks`, and returns their union
@@ -714,15 +719,14 @@ std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& br
   std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
   // Blocks of rays dealt out in turn: neighbouring rays are of about the same length, far and near ones lie
   // in different parts of an image, so contiguous halves can cost the threads very different times.
-  constexpr std::size_t kRaysPerBlock = 256;
-  const std::size_t count = rays.rays.size(), stride = kRaysPerBlock * std::size_t(threads);
+  const auto blocks = ray_blocks(rays, 256);
   parallel_for(threads, threads, [&](int thread) {
     const std::size_t t = std::size_t(thread);
     sets[t].assign(bricks.bits() / 64, 0);
     DenseCursor cursor(bricks, sets[t].data());
-    for (std::size_t block = t * kRaysPerBlock; block < count; block += stride) {
-      for (std::size_t r = block; r < std::min(count, block + kRaysPerBlock); ++r)
-        walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+    for (std::size_t b = t; b < blocks.size(); b += std::size_t(threads)) {
+      for (const Ray* ray = blocks[b].first; ray != blocks[b].first + blocks[b].second; ++ray)
+        walk(rays.origins[ray->origin], *ray, grid, cursor);
     }
   });
   std::vector<std::uint64_t>& crossed = sets[0];
@@ -735,10 +739,13 @@ std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& br
 // Walks the rays on `threads` threads, listing the packed keys they cross: sorted, each once.
 std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcTree& grid, int threads) {
   std::vector<std::vector<std::uint64_t>> lists(static_cast<std::size_t>(threads));
-  run_parallel(threads, rays.rays.size(), [&](std::size_t begin, std::size_t end, std::size_t t) {
-    SparseCursor cursor(lists[t]);
-    for (std::size_t r = begin; r < end; ++r)
-      walk(rays.origins[rays.rays[r].origin], rays.rays[r], grid, cursor);
+  const auto blocks = ray_blocks(rays, 256);
+  parallel_for(threads, threads, [&](int t) {
+    SparseCursor cursor(lists[std::size_t(t)]);
+    for (std::size_t b = std::size_t(t); b < blocks.size(); b += std::size_t(threads)) {
+      for (const Ray* ray = blocks[b].first; ray != blocks[b].first + blocks[b].second; ++ray)
+        walk(rays.origins[ray->origin], *ray, grid, cursor);
+    }
   });
   std::vector<std::uint64_t> all;
   for (const auto& list : lists) all.insert(all.end(), list.begin(), list.end());
@@ -747,10 +754,12 @@ std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcT
 
 // Fills `update` from the dense bit sets: the hits' bits, the crossed voxels that are no hit, the non-empty
 // bricks in the OcTree's depth-first order (sorted by index, not as 1 KB structs).
-void dense_bricks(const BrickGrid& bricks, const std::vector<Key>& hits,
+void dense_bricks(const BrickGrid& bricks, const std::vector<RayShare>& shares,
                   const std::vector<std::uint64_t>& crossed, KeyUpdate& update) {
   std::vector<std::uint64_t> occupied(bricks.bits() / 64, 0);
-  for (const Key& k : hits) set_bit(occupied, bricks.index(k));
+  for (const RayShare& share : shares) {
+    for (const Key& k : share.hits) set_bit(occupied, bricks.index(k));
+  }
   std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton of the base, brick)
   for (std::uint64_t b = 0; b < bricks.bricks(); ++b) {
     std::uint64_t any = 0;
@@ -775,10 +784,12 @@ void dense_bricks(const BrickGrid& bricks, const std::vector<Key>& hits,
 }
 
 // Fills `update` from sorted key lists: the hits, the crossed keys (sorted, each once) that are no hit.
-void sparse_bricks(const std::vector<Key>& hits, const std::vector<std::uint64_t>& crossed,
+void sparse_bricks(const std::vector<RayShare>& shares, const std::vector<std::uint64_t>& crossed,
                    KeyUpdate& update) {
   std::vector<std::uint64_t> packed_hits;
-  for (const Key& k : hits) packed_hits.push_back(pack_key(k));
+  for (const RayShare& share : shares) {
+    for (const Key& k : share.hits) packed_hits.push_back(pack_key(k));
+  }
   const std::vector<std::uint64_t> occupied = sorted_unique(std::move(packed_hits));
   std::map<std::uint64_t, KeyBrick> bricks;  // by packed brick base
   auto mark = [&](std::uint64_t p, bool hit) {
@@ -824,13 +835,13 @@ KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, do
   threads = std::max(threads, 1);
   SweepRays rays = sweep_rays(sweep, grid, max_range, threads);
   KeyUpdate update;
-  if (rays.rays.empty()) return update;
+  if (rays.empty()) return update;
   rays.box.grow();
   const BrickGrid bricks(rays.box);
   if (bricks.dense()) {
-    dense_bricks(bricks, rays.hits, walk_dense(rays, bricks, grid, threads), update);
+    dense_bricks(bricks, rays.shares, walk_dense(rays, bricks, grid, threads), update);
   } else {
-    sparse_bricks(rays.hits, walk_sparse(rays, grid, threads), update);
+    sparse_bricks(rays.shares, walk_sparse(rays, grid, threads), update);
   }
   return update;
 }

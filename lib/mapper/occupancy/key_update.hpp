@@ -58,9 +58,11 @@ struct KeyUpdate final {
 /// de-duplicated, then one ray is walked (Amanatides–Woo) from the scan's `origin_C` to each distinct
 /// endpoint voxel. A point farther than `max_range` (metres, measured to its voxel centre) marks nothing
 /// occupied; its ray clears free space up to `max_range` only. A scan's clear-only ray ends (`clear_C`) are
-/// snapped and de-duplicated the same way (ends in a voxel that holds a point of the scan are dropped: its
-/// ray is walked already) and walked like a point's ray, but mark nothing occupied: a clear-only ray to voxel
-/// k clears exactly OctoMap's `computeRayKeys(origin, centre(k))`. For a one-scan sweep this equals OctoMap's
+/// snapped the same way and walked like a point's ray, but mark nothing occupied: a clear-only ray to voxel k
+/// clears exactly OctoMap's `computeRayKeys(origin, centre(k))`. Each thread de-duplicates the end voxels of
+/// its own share of the points and clear-only ends (an end that a point of its share holds needs no
+/// clear-only ray); an end voxel of two shares gets the same ray twice, which marks the same voxels. For a
+/// one-scan sweep this equals OctoMap's
 /// `computeDiscreteUpdate(scan, origin, free, occupied, max_range)`; for several scans it is the union over
 /// the scans, with occupied winning over free across the whole sweep.
 ///
