@@ -692,6 +692,7 @@ void add_scan_rays(const Scan& scan, std::uint32_t s, const octomap::OcTree& gri
   }
 }
 
+// The rays of every scan of `sweep`, with their origins.
 SweepRays sweep_rays(const Sweep& sweep, const octomap::OcTree& grid, double max_range, int threads) {
   SweepRays out;
   for (std::size_t s = 0; s < sweep.scans.size(); ++s) {
