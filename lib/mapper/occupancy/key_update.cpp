@@ -626,6 +626,8 @@ void for_each_distinct(const ShareKeys& keys, const Take& take) {
 RayShare share_rays(const ShareKeys& keys, const octomap::OcTree& grid, double max_range,
                     const Origin& origin, std::uint32_t s) {
   RayShare out;
+  // At most one ray per key: reserved at once, so that no ray is copied as the list grows (pages past the
+  // rays made are never touched; without it, grabber fusion measured up to 10 % slower).
   out.rays.reserve(keys.points.size() + keys.clear.size());
   for_each_distinct(keys, [&](std::uint64_t packed, bool point) {
     Ray ray{};
@@ -703,14 +705,28 @@ SweepRays sweep_rays(const Sweep& sweep, const octomap::OcTree& grid, double max
   return out;
 }
 
-// The rays of `rays` in blocks of at most `size`, to be dealt out to threads.
-std::vector<std::pair<const Ray*, std::size_t>> ray_blocks(const SweepRays& rays, std::size_t size) {
+// Blocks of rays dealt out in turn: neighbouring rays are of about the same length, far and near ones lie in
+// different parts of an image, so contiguous halves can cost the threads very different times.
+constexpr std::size_t kRaysPerBlock = 256;
+
+// The rays of `rays` in blocks of at most kRaysPerBlock.
+std::vector<std::pair<const Ray*, std::size_t>> ray_blocks(const SweepRays& rays) {
   std::vector<std::pair<const Ray*, std::size_t>> blocks;
   for (const RayShare& share : rays.shares) {
-    for (std::size_t begin = 0; begin < share.rays.size(); begin += size)
-      blocks.emplace_back(share.rays.data() + begin, std::min(size, share.rays.size() - begin));
+    for (std::size_t begin = 0; begin < share.rays.size(); begin += kRaysPerBlock)
+      blocks.emplace_back(share.rays.data() + begin, std::min(kRaysPerBlock, share.rays.size() - begin));
   }
   return blocks;
+}
+
+// Walks thread `t`'s blocks of `blocks` (t, t + threads, …) into `cursor`.
+template <class Cursor>
+void walk_dealt(const SweepRays& rays, const std::vector<std::pair<const Ray*, std::size_t>>& blocks,
+                std::size_t t, int threads, const octomap::OcTree& grid, const Cursor& cursor) {
+  for (std::size_t b = t; b < blocks.size(); b += std::size_t(threads)) {
+    for (const Ray* ray = blocks[b].first; ray != blocks[b].first + blocks[b].second; ++ray)
+      walk(rays.origins[ray->origin], *ray, grid, cursor);
+  }
 }
 
 // Walks the rays on `threads` threads, each into its own bit set over `bricks`, and returns their union
@@ -718,17 +734,11 @@ std::vector<std::pair<const Ray*, std::size_t>> ray_blocks(const SweepRays& rays
 std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& bricks,
                                       const octomap::OcTree& grid, int threads) {
   std::vector<std::vector<std::uint64_t>> sets(static_cast<std::size_t>(threads));
-  // Blocks of rays dealt out in turn: neighbouring rays are of about the same length, far and near ones lie
-  // in different parts of an image, so contiguous halves can cost the threads very different times.
-  const auto blocks = ray_blocks(rays, 256);
+  const auto blocks = ray_blocks(rays);
   parallel_for(threads, threads, [&](int thread) {
     const std::size_t t = std::size_t(thread);
     sets[t].assign(bricks.bits() / 64, 0);
-    DenseCursor cursor(bricks, sets[t].data());
-    for (std::size_t b = t; b < blocks.size(); b += std::size_t(threads)) {
-      for (const Ray* ray = blocks[b].first; ray != blocks[b].first + blocks[b].second; ++ray)
-        walk(rays.origins[ray->origin], *ray, grid, cursor);
-    }
+    walk_dealt(rays, blocks, t, threads, grid, DenseCursor(bricks, sets[t].data()));
   });
   std::vector<std::uint64_t>& crossed = sets[0];
   for (std::size_t t = 1; t < sets.size(); ++t) {
@@ -740,13 +750,9 @@ std::vector<std::uint64_t> walk_dense(const SweepRays& rays, const BrickGrid& br
 // Walks the rays on `threads` threads, listing the packed keys they cross: sorted, each once.
 std::vector<std::uint64_t> walk_sparse(const SweepRays& rays, const octomap::OcTree& grid, int threads) {
   std::vector<std::vector<std::uint64_t>> lists(static_cast<std::size_t>(threads));
-  const auto blocks = ray_blocks(rays, 256);
+  const auto blocks = ray_blocks(rays);
   parallel_for(threads, threads, [&](int t) {
-    SparseCursor cursor(lists[std::size_t(t)]);
-    for (std::size_t b = std::size_t(t); b < blocks.size(); b += std::size_t(threads)) {
-      for (const Ray* ray = blocks[b].first; ray != blocks[b].first + blocks[b].second; ++ray)
-        walk(rays.origins[ray->origin], *ray, grid, cursor);
-    }
+    walk_dealt(rays, blocks, std::size_t(t), threads, grid, SparseCursor(lists[std::size_t(t)]));
   });
   std::vector<std::uint64_t> all;
   for (const auto& list : lists) all.insert(all.end(), list.begin(), list.end());

@@ -70,8 +70,8 @@ struct KeyUpdate final {
 /// points and walks the rays on `threads` threads (≥ 1: the caller and parallel_for's helper threads, kept
 /// for the calling thread's next call); the result does not depend on the count. Several threads may call it
 /// at once (it only reads `grid`). Memory: per thread, a bit set over the bounding key box of the sweep
-/// (≈ 1.2 MB for a 5 × 5 × 3 m box at 2 cm); boxes beyond 2^28 voxels fall back to sorting keys (slower, same
-/// result).
+/// (≈ 1.2 MB for a 5 × 5 × 3 m box at 2 cm) and one over the box of its share's end voxels; boxes beyond 2^28
+/// voxels fall back to sorting keys (slower, same result).
 /// @throws Error if a scan origin is not finite or outside the tree's key range, or `max_range` is not > 0.
 [[nodiscard]] KeyUpdate compute_key_update(const Sweep& sweep, const octomap::OcTree& grid, double max_range,
                                            int threads);
