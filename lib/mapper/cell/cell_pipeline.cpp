@@ -359,15 +359,13 @@ void CellPipeline::add_emptied_boxes(Scope& scope) const {
 std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
                                          std::size_t& evidence) const {
   Cloud cloud;
+  CubeHolders kept_boxes(kept, map_.config().resolution);
   for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
     // A group of fewer than change.min_voxels voxels touching nothing else is noise (flying pixels that
     // collected their hits where no ray clears them), as for change detection: not an obstacle.
     if (!occupied_->in_group_of(map_, c, config_.change.min_voxels)) continue;
     // Evidence a kept box already holds needs no new box (e.g. the table around a new object).
-    const bool covered = std::any_of(kept.begin(), kept.end(), [&](const Box& box) {
-      return holds_cube(box, c, map_.config().resolution);
-    });
-    if (!covered) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
+    if (!kept_boxes.hold(c)) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
   }
   evidence = cloud.size();
   if (cloud.empty()) return {};

@@ -105,6 +105,34 @@ bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge) {
   return (p.cwiseAbs() + cube_half(R, edge) - box.half_extents).maxCoeff() <= kTolerance;
 }
 
+CubeHolders::CubeHolders(const std::vector<Box>& boxes, double edge) {
+  boxes_.reserve(boxes.size());
+  for (const Box& box : boxes) {
+    const Eigen::Matrix3d R = box.rotation.toRotationMatrix();
+    boxes_.push_back({bounds_of(box), R, box.center, box.half_extents, cube_half(R, edge)});
+  }
+}
+
+// holds_cube's test with the box's part precomputed; a held cube's centre lies inside the box by half an
+// edge, so the bounds never turn a held cube away.
+bool CubeHolders::holds(const Held& box, const Eigen::Vector3d& centre_C) {
+  if (!box.bounds.contains(centre_C)) return false;
+  const Eigen::Vector3d p = box.rotation.transpose() * (centre_C - box.center);
+  return (p.cwiseAbs() + box.cube_half - box.half_extents).maxCoeff() <= kTolerance;
+}
+
+bool CubeHolders::hold(const Eigen::Vector3d& centre_C) {
+  if (boxes_.empty()) return false;
+  if (holds(boxes_[last_], centre_C)) return true;
+  for (std::size_t i = 0; i < boxes_.size(); ++i) {
+    if (i != last_ && holds(boxes_[i], centre_C)) {
+      last_ = i;
+      return true;
+    }
+  }
+  return false;
+}
+
 OccupiedVoxels::OccupiedVoxels(const OccupancyMap& map)
     : keys_(map.occupied_keys()), set_(keys_.begin(), keys_.end()) {}
 
@@ -151,23 +179,18 @@ bool OccupiedVoxels::in_group_of(const OccupancyMap& map, const Eigen::Vector3d&
 std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map, const OccupiedVoxels& voxels,
                                             const std::vector<Box>& boxes, int min_group, int threads) {
   constexpr std::size_t kMinVoxelsPerThread = 4096;  // fewer go faster on one thread than others start
-  const double edge = map.config().resolution;
-  std::vector<Region> bounds;
-  for (const Box& box : boxes) bounds.push_back(bounds_of(box));
   const std::vector<octomap::OcTreeKey>& keys = voxels.keys();
   const int chunks =
       int(std::clamp<std::size_t>(keys.size() / kMinVoxelsPerThread, 1, std::size_t(std::max(threads, 1))));
   // Each thread a contiguous run of the keys, so that the runs joined keep the keys' order.
   std::vector<std::vector<Eigen::Vector3d>> outside(static_cast<std::size_t>(chunks));
   parallel_for(chunks, chunks, [&](int chunk) {
+    CubeHolders holders(boxes, map.config().resolution);
     const std::size_t end = keys.size() * std::size_t(chunk + 1) / std::size_t(chunks);
     for (std::size_t k = keys.size() * std::size_t(chunk) / std::size_t(chunks); k < end; ++k) {
       const Eigen::Vector3d c = map.centre(keys[k]);
-      bool held = false;
-      for (std::size_t i = 0; i < boxes.size() && !held; ++i) {
-        held = bounds[i].contains(c) && holds_cube(boxes[i], c, edge);
-      }
-      if (!held && voxels.in_group_of(keys[k], min_group)) outside[std::size_t(chunk)].push_back(c);
+      if (!holders.hold(c) && voxels.in_group_of(keys[k], min_group))
+        outside[std::size_t(chunk)].push_back(c);
     }
   });
   for (std::size_t t = 1; t < outside.size(); ++t)

@@ -17,6 +17,27 @@ namespace cellmap {
 /// Whether `box` holds the whole axis-aligned cube of edge `edge` around `centre_C` (0.1 µm tolerance).
 [[nodiscard]] bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge);
 
+/// Whether some box of a set holds a voxel's whole cube (holds_cube of each), answered faster than asking
+/// each box in turn: each box's rotation and bounds are worked out once, and the box that held the last
+/// voxel asked is asked first (voxels asked in key order mostly lie in the box of the one before). Holds
+/// its own copy of what it needs; not thread-safe (one instance per thread).
+class CubeHolders final {
+ public:
+  CubeHolders(const std::vector<Box>& boxes, double edge);
+  [[nodiscard]] bool hold(const Eigen::Vector3d& centre_C);
+
+ private:
+  struct Held {
+    Region bounds;
+    Eigen::Matrix3d rotation;
+    Eigen::Vector3d center, half_extents, cube_half;  // cube_half: the cube's, along the box's axes
+  };
+  [[nodiscard]] static bool holds(const Held& box, const Eigen::Vector3d& centre_C);
+
+  std::vector<Held> boxes_;
+  std::size_t last_ = 0;
+};
+
 /// The occupied voxels of a map, hashed for neighbour queries; kept up with the map sweep by sweep from the
 /// flips each update reports, so that a version does not pay a pass over the whole map for them.
 class OccupiedVoxels final {
