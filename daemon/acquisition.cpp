@@ -192,6 +192,7 @@ class CameraLoop final {
 
   [[nodiscard]] const CameraInput& camera() const { return camera_; }
   [[nodiscard]] std::string describe() const { return kind_ + " (camera '" + camera_.name() + "')"; }
+  [[nodiscard]] const std::string& name() const { return camera_.name(); }
 
  private:
   CameraInput camera_;
@@ -225,12 +226,16 @@ class CameraAcquisition final : public Acquisition {
   void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) override {
     std::atomic<bool> done{false};
     std::thread robot([&] {
+      name_this_thread("robot state");
       while (robot_ && !stop && !done) robot_->pump(milliseconds(100));
     });
     std::vector<std::thread> cameras;
     std::atomic<std::size_t> ended{0};
     for (auto& loop : loops_) {
-      cameras.emplace_back([&, camera = loop.get()] { run_camera(*camera, stop, done, ended, max_sweeps); });
+      cameras.emplace_back([&, camera = loop.get()] {
+        name_this_thread("cam " + camera->name());
+        run_camera(*camera, stop, done, ended, max_sweeps);
+      });
     }
     for (std::thread& camera : cameras) camera.join();
     done = true;

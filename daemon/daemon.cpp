@@ -117,9 +117,18 @@ void Daemon::use_self_filter() {
 }
 
 void Daemon::run(const Signals& signals) {
-  std::thread acquisition([this] { acquire(); });
-  std::thread gathering([this] { gather(); });
-  std::thread processing([this] { process(); });
+  std::thread acquisition([this] {
+    name_this_thread("acquisition");
+    acquire();
+  });
+  std::thread gathering([this] {
+    name_this_thread("gathering");
+    gather();
+  });
+  std::thread processing([this] {
+    name_this_thread("processing");
+    process();
+  });
   while (!stop_) {
     const std::optional<int> signal = signals.wait_for(milliseconds(200));
     if (!signal) continue;

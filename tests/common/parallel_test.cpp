@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -36,6 +37,17 @@ TEST(ParallelTest, ItemTRunsOnThreadTAndHelpersAreKeptBetweenCalls) {
   EXPECT_NE(first[2], first[1]);
   EXPECT_NE(first[2], first[0]);
   EXPECT_EQ(second, first);
+}
+
+// Names show in top -H and perf: cut to Linux's 15 characters, and each helper named after its caller.
+TEST(ParallelTest, ThreadsAreNamedAndHelpersAfterTheirCaller) {
+  std::vector<std::string> names(3);
+  std::thread caller([&] {
+    name_this_thread("a name longer than fifteen");
+    parallel_for(3, 3, [&](int t) { names[static_cast<std::size_t>(t)] = this_thread_name(); });
+  });
+  caller.join();
+  EXPECT_EQ(names, (std::vector<std::string>{"a name longer t", "a name longe+1", "a name longe+2"}));
 }
 
 TEST(ParallelTest, NestedCallsAndOtherCallingThreadsRunTheirOwnHelpers) {

@@ -1,5 +1,7 @@
 #include "cellmap/sensor/replay_source.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -135,8 +137,14 @@ class ReplaySource::Reader final {
   };
 
   void run() {
-    // Per thread on Linux; a failure leaves the thread at the process's priority, which only costs latency.
+    name_this_thread("read " + source_.name());
+    // SCHED_IDLE, not only nice 19: a nice-19 thread still runs out its slice (up to 4–5 ms of PNG decoding
+    // here) before a woken fusion thread gets the CPU; an idle-policy thread yields at once. Per thread on
+    // Linux, allowed without privileges; a failure leaves the thread at nice 19 or the process's priority,
+    // which only costs latency.
     (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);
+    const sched_param idle{};
+    (void)::pthread_setschedparam(::pthread_self(), SCHED_IDLE, &idle);
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
       changed_.wait(lock, [&] { return stop_ || (asked_ != kNone && !started_); });

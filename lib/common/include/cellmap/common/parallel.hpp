@@ -2,6 +2,7 @@
 // Splitting a loop over a few threads: the one thread splitter of the library (the simulator's rays, the
 // occupancy map's ray casting), and the CPU time of a thread with the helpers it split its work onto.
 
+#include <pthread.h>
 #include <time.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -20,6 +22,18 @@ inline double thread_cpu_seconds() {
   timespec t{};
   ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+
+/// Names the calling thread for top -H, ps, gdb and perf (Linux keeps 15 characters of it; longer names are
+/// cut there). A failure only leaves the name as it was.
+inline void name_this_thread(const std::string& name) {
+  (void)::pthread_setname_np(::pthread_self(), name.substr(0, 15).c_str());
+}
+
+/// The calling thread's name ("" if it cannot be read).
+inline std::string this_thread_name() {
+  char name[16] = {};
+  return ::pthread_getname_np(::pthread_self(), name, sizeof name) == 0 ? name : "";
 }
 
 namespace detail {
@@ -68,7 +82,11 @@ class HelperPool {
     busy_ = true;
     while (static_cast<int>(threads_.size()) < helpers) {
       const int index = static_cast<int>(threads_.size()) + 1;
-      threads_.emplace_back([this, index] { serve(index); });
+      // A helper is named after the thread it helps: "gathering+1" is the gathering thread's first.
+      threads_.emplace_back([this, index, name = this_thread_name()] {
+        name_this_thread(name.substr(0, 12) + "+" + std::to_string(index));
+        serve(index);
+      });
     }
     {
       const std::lock_guard<std::mutex> lock(mutex_);

@@ -78,7 +78,7 @@ struct ReplayConfig final {
 /// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
 /// frame file exists (kError naming the first problem otherwise); next() returns each frame when it is
 /// due, its pixels converted to points then, and turns kEnded after the last. The files are read ahead on a
-/// thread of the source's own at the lowest CPU priority (nice 19), so a frame comes at its recorded time
+/// thread of the source's own at the lowest CPU priority (SCHED_IDLE), so a frame comes at its recorded time
 /// as a camera's does and decoding a recording takes only CPU time the frames' processing leaves (it is
 /// the recording's cost, not the frame's; a camera delivers pixels); a frame whose file is still being
 /// read when it is due comes late, and a file that cannot be read turns kError when its frame is due.
