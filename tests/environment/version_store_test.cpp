@@ -9,6 +9,7 @@
 #include "support/test_support.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -42,6 +43,13 @@ Environment content(std::uint64_t version) {
     boxes.push_back(box);
   }
   return Environment("cell-a", version, static_cast<std::int64_t>(version) * 1'000'000'000, boxes);
+}
+
+// The file name of the box-id marker `next-box-id-<n>`.
+std::string marker_name(std::uint64_t n) {
+  char name[48];
+  std::snprintf(name, sizeof name, "next-box-id-%020llu", static_cast<unsigned long long>(n));
+  return name;
 }
 
 std::string blob_of(std::uint64_t version) {
@@ -300,6 +308,34 @@ TEST(VersionStoreTest, BoxIdCounterIsKeptWithTheVersionsAndNeverGoesBack) {
   EXPECT_TRUE(store.recovered().problems.empty());
 }
 
+// The marker reserves ids ahead: versions that hand out ids within the reserve write no new marker, the
+// one that passes it writes one (and removes the old), and a clean reopen takes the counter, not the marker.
+TEST(VersionStoreTest, MarkerIsRaisedOnlyWhenTheIdsPassItsReserve) {
+  test::TempDir dir;
+  const auto markers = [&] {
+    std::vector<std::string> names;
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir.path())) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("next-box-id-", 0) == 0) names.push_back(name);
+    }
+    return names;
+  };
+  const std::uint64_t reserve = VersionStore::kBoxIdsReserved;
+  {
+    VersionStore store(dir.path(), "cell-a");
+    store.save(Environment("cell-a", 1, 1, {box_with_id(1)}), std::nullopt, 2);
+    EXPECT_EQ(markers(), std::vector<std::string>{marker_name(2 + reserve)});
+    for (std::uint64_t v = 2; v <= 5; ++v) {
+      store.save(Environment("cell-a", v, v, {box_with_id(v)}), std::nullopt, v + 1);
+      EXPECT_EQ(markers(), std::vector<std::string>{marker_name(2 + reserve)}) << v;
+    }
+    store.save(Environment("cell-a", 6, 6, {box_with_id(1)}), std::nullopt, 3 + reserve);
+    EXPECT_EQ(markers(), std::vector<std::string>{marker_name(3 + 2 * reserve)});
+  }
+  VersionStore store(dir.path(), "cell-a");
+  EXPECT_EQ(store.recovered().next_box_id, 3 + reserve);
+}
+
 // Version 4 added box 5 and is lost (its blob or its JSON): the store falls back to version 3, whose boxes
 // end at id 3 and whose own counter says 5. Both ids 4 (removed in 3) and 5 (added in 4) may have been
 // published, and the counter is above them.
@@ -317,7 +353,9 @@ TEST(VersionStoreTest, LostNewestVersionDoesNotBringBackItsBoxIds) {
     std::ofstream(dir.path() / lost, std::ios::trunc) << "garbage";
     VersionStore store(dir.path(), "cell-a");
     EXPECT_EQ(store.recovered().environment.version(), 3u) << lost;
-    EXPECT_EQ(store.recovered().next_box_id, 6u) << lost << ": an id handed out before would come again";
+    // From the marker, which reserved ids ahead of the counter of version 1.
+    EXPECT_EQ(store.recovered().next_box_id, 4u + VersionStore::kBoxIdsReserved)
+        << lost << ": an id handed out before would come again";
     EXPECT_EQ(store.next_version(), 5u) << lost;
   }
 }
@@ -333,7 +371,7 @@ TEST(VersionStoreTest, SnapshotsOfAnOlderVersionWithoutTheCounterStillOpen) {
   nlohmann::json doc = nlohmann::json::parse(read_file(snapshot));
   doc.erase("next_box_id");
   std::ofstream(snapshot, std::ios::trunc) << doc.dump(1);
-  fs::remove(dir.path() / "next-box-id-00000000000000000040");
+  fs::remove(dir.path() / marker_name(40 + VersionStore::kBoxIdsReserved));
 
   VersionStore store(dir.path(), "cell-a");
   EXPECT_EQ(store.recovered().environment, content(3));
@@ -386,7 +424,7 @@ TEST(VersionStoreTest, RemovedDirectoryIsNoticedAndRecreatedByTheNextSave) {
   VersionStore store(state, "cell-a");
   EXPECT_EQ(store.recovered().environment, content(2));
   EXPECT_EQ(store.recovered().next_box_id, 20u);
-  EXPECT_TRUE(fs::exists(state / "next-box-id-00000000000000000020"));
+  EXPECT_TRUE(fs::exists(state / marker_name(20 + VersionStore::kBoxIdsReserved)));
 }
 
 }  // namespace

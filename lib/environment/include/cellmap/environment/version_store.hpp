@@ -18,9 +18,10 @@ struct RecoveredState final {
   Environment environment;
   /// The opaque blob saved with that snapshot (the daemon's map state), if one was saved.
   std::optional<std::filesystem::path> blob;
-  /// Above every box id the cell ever handed out, as far as the directory tells (>= 1): the highest
-  /// `next-box-id-<n>` marker, the snapshot's `next_box_id` and its boxes' ids + 1. Corrupt snapshots or a
-  /// lost blob do not lower it.
+  /// Above every box id the cell ever handed out, as far as the directory tells (>= 1): the snapshot's
+  /// `next_box_id` and its boxes' ids + 1, and the `next-box-id-<n>` marker when a newer version may have
+  /// gone out (its snapshot was corrupt) or the snapshot has no `next_box_id`. Corrupt snapshots or a lost
+  /// blob do not lower it; the ids then jump by at most VersionStore::kBoxIdsReserved.
   std::uint64_t next_box_id = 1;
   /// One line per state file that was corrupt, truncated or unreadable and was skipped (then renamed to
   /// `<name>.corrupt` so an operator can inspect it), and one per snapshot in an older format. Empty when
@@ -34,7 +35,8 @@ struct RecoveredState final {
 ///
 /// Files: `environment-<version>.json` (the boxes JSON plus "cell", "stamp_ns", "next_box_id" and the blob's
 /// size/checksum), `environment-<version>.blob` (opaque, optional) and `next-box-id-<n>` (an empty marker
-/// whose name is above every box id handed out so far; a name survives what corrupts a file's content). Every
+/// whose name is above every box id handed out so far, by up to kBoxIdsReserved; a name survives what
+/// corrupts a file's content). Every
 /// file is written with write_file_atomically; the snapshot JSON is written last and is the commit point of
 /// a version. The newest two intact versions are kept (the current one and the previous good one); older
 /// ones are deleted.
@@ -59,6 +61,9 @@ class VersionStore final {
   [[nodiscard]] std::uint64_t next_version() const { return highest_used_ + 1; }
   /// Above every box id handed out so far: recovered().next_box_id, raised by each save().
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
+  /// How far the marker reaches above the counter when a save raises it: only a save whose ids pass it
+  /// writes a new marker, and a lost newest snapshot makes the ids jump by at most this much.
+  static constexpr std::uint64_t kBoxIdsReserved = 1024;
 
   /// The restart rule, in one place: the environment to announce first after opening. That is the recovered
   /// one, unless a number above it may have gone out (next_version() > its version + 1: a newer snapshot was
