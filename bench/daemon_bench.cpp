@@ -234,13 +234,18 @@ std::string source_yaml(const Camera& camera, const fs::path& dir, int sweep_fra
 
 // --- the run ---------------------------------------------------------------------------------------------
 
+std::int64_t ns_of(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+}
+
 // What the processing thread reported, sweep by sweep.
 class Traces {
  public:
   void add(const daemon::SweepTrace& trace) {
     Sweep sweep;
     sweep.stamp = trace.sweep->stamp;
-    sweep.taken_ns = now_ns();
+    sweep.taken_ns = ns_of(trace.taken);
+    sweep.published_ns = ns_of(trace.published);
     for (const SweepFrame& f : trace.sweep->frames) ++sweep.frames_by_camera[f.frame.sensor];
     sweep.report = trace.report;
     if (sweep.report) sweep.report->changes = {};
@@ -254,7 +259,8 @@ class Traces {
   }
   struct Sweep {
     double stamp = 0.0;
-    std::int64_t taken_ns = 0;
+    std::int64_t taken_ns = 0;      // when the processing thread took the sweep
+    std::int64_t published_ns = 0;  // when its version went out
     std::map<std::string, std::size_t> frames_by_camera;
     std::optional<SweepReport> report;
     daemon::StepCost persist, publish, map_state;
@@ -504,8 +510,7 @@ DaemonRun run_daemon(const Options& options, const Recording& recording, daemon:
   });
   const double cpu_start = process_cpu_seconds();
   result.load_start = load_average();
-  result.start_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(first_frame_due.time_since_epoch()).count();
+  result.start_ns = ns_of(first_frame_due);
   daemon.run(signals);
   result.seconds = static_cast<double>(now_ns() - result.start_ns) / 1e9;
   result.cpu = process_cpu_seconds() - cpu_start;
@@ -527,11 +532,11 @@ void print_frames(const Options& options, const Recording& recording, const std:
                 recording.frames(), static_cast<double>(fused) / options.seconds);
   }
   std::printf("frames dropped: %zu of %zu\n", played - t.fused, played);
-  std::vector<double> waits;  // from a sweep's last frame being due to its processing
+  std::vector<double> waits;  // from a sweep's last frame being due to the end of its processing
   for (const Traces::Sweep& s : run.sweeps)
-    waits.push_back(static_cast<double>(s.taken_ns - run.start_ns) / 1e6 - s.stamp * 1e3);
-  std::printf("sweep delay, last frame due to handled: p50 %.0f ms, max %.0f ms\n", percentile(waits, 0.5),
-              percentile(waits, 1.0));
+    waits.push_back(static_cast<double>(s.published_ns - run.start_ns) / 1e6 - s.stamp * 1e3);
+  std::printf("sweep delay, last frame due to its version out: p50 %.0f ms, max %.0f ms\n",
+              percentile(waits, 0.5), percentile(waits, 1.0));
   std::printf("sweeps processed: %zu, versions published: %zu\n", run.sweeps.size(), t.versions);
   std::printf(
       "gathering thread busy %.0f %% of the run (wall time fusing frames as they came), processing thread "
@@ -570,6 +575,43 @@ void print_latency(const DaemonRun& run, const SubscriberProcess& subscriber) {
       latencies.size(), percentile(latencies, 0.5), percentile(latencies, 0.99), percentile(latencies, 1.0));
 }
 
+// The slowest versions' latency split where it went: from the confirming frame being due until the
+// processing thread took its sweep (the last frames' fusion, or a sweep still being processed), the close
+// stage by stage, and from the publishing call's return to the subscriber's arrival (delivery, sharing the
+// cores with the map state and the next frames; negative when the subscriber ran before the publisher
+// got the core back).
+void print_slowest(const DaemonRun& run, const SubscriberProcess& subscriber, std::size_t count) {
+  const std::map<std::uint64_t, std::int64_t> arrivals = subscriber.arrivals();
+  struct Split {
+    double latency, gathered, close, delivery;
+    const Traces::Sweep* sweep;
+  };
+  std::vector<Split> splits;
+  for (const Traces::Sweep* s : confirming_sweeps(run.sweeps)) {
+    const auto arrival = arrivals.find(s->version);
+    if (arrival == arrivals.end() || !s->report) continue;
+    const double due_ms = static_cast<double>(run.start_ns) / 1e6 + s->stamp * 1e3;
+    const double taken_ms = static_cast<double>(s->taken_ns) / 1e6;
+    const double published_ms = static_cast<double>(s->published_ns) / 1e6;
+    const double arrival_ms = static_cast<double>(arrival->second) / 1e6;
+    splits.push_back(
+        {arrival_ms - due_ms, taken_ms - due_ms, published_ms - taken_ms, arrival_ms - published_ms, s});
+  }
+  std::sort(splits.begin(), splits.end(),
+            [](const Split& a, const Split& b) { return a.latency > b.latency; });
+  if (splits.size() > count) splits.resize(count);
+  std::printf(
+      "slowest versions, ms: latency = due to taken + close (update, change, re-segmentation, "
+      "persist, publish) + delivery; voxels re-segmented, re-segmentation CPU\n");
+  for (const Split& x : splits) {
+    const SweepReport& r = *x.sweep->report;
+    std::printf("  version %llu: %.1f = %.1f + %.1f (%.1f, %.1f, %.1f, %.1f, %.1f) + %.1f; %zu, %.1f\n",
+                static_cast<unsigned long long>(x.sweep->version), x.latency, x.gathered, x.close,
+                1e3 * r.t_update, 1e3 * r.t_change, 1e3 * r.t_segment, 1e3 * x.sweep->persist.wall,
+                1e3 * x.sweep->publish.wall, x.delivery, r.evidence, 1e3 * r.cpu_segment);
+  }
+}
+
 void print_ratios(const std::vector<Camera>& cameras, const Totals& t, std::size_t played) {
   const auto [anchor, bench_fusion] = fusion_per_frame(cameras);
   const double daemon_fusion = t.fused ? t.fuse / static_cast<double>(t.fused) : NAN;
@@ -603,6 +645,7 @@ int run(const Options& options) {
   print_close(daemon_run.sweeps);
   print_cpu(daemon_run, t, played);
   print_latency(daemon_run, subscriber);
+  print_slowest(daemon_run, subscriber, 3);
   print_ratios(cameras, t, played);
   return daemon_run.finished ? 0 : 1;
 }

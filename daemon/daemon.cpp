@@ -244,11 +244,13 @@ void Daemon::handle(GatheredSweep& sweep, std::uint64_t number) {
   SweepTrace trace;
   trace.number = number;
   trace.sweep = &sweep.frames;
+  trace.taken = Clock::now();
   {
     const ClosedSweepFirst::Turn turn(closed_sweep_first_);
     trace.report = run_pipeline(sweep, number);
     publish_version(trace);
   }
+  trace.published = Clock::now();
   // The viewer's layers and the map state are not what a planner waits for.
   if (trace.report) layers_.after_sweep(number, sweep.frames, pipeline_.map(), trace.report->changes);
   save_map_state(trace);

@@ -44,8 +44,10 @@ struct SweepTrace {
   StepCost persist;                   ///< saving the version the sweep made (its boxes), if it made one
   StepCost publish;                   ///< publishing it (snapshot and delta)
   StepCost map_state;                 ///< saving the map state with it, after publishing
-  std::uint64_t version = 0;          ///< the version subscribers have after the sweep
-  double acquisition_cpu = 0.0;       ///< CPU seconds the sweep source's threads used so far
+  std::chrono::steady_clock::time_point taken;      ///< when the processing thread took the sweep
+  std::chrono::steady_clock::time_point published;  ///< when its version went out (or it was done with)
+  std::uint64_t version = 0;                        ///< the version subscribers have after the sweep
+  double acquisition_cpu = 0.0;                     ///< CPU seconds the sweep source's threads used so far
 };
 
 /// What the command line adds to the config.
