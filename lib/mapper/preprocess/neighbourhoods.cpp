@@ -1,7 +1,5 @@
 #include "cellmap/preprocess/neighbourhoods.hpp"
 
-#include <pcl/search/kdtree.h>
-
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -9,6 +7,7 @@
 
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/parallel.hpp"
+#include "cellmap/preprocess/point_search.hpp"
 
 namespace cellmap {
 
@@ -68,9 +67,7 @@ Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_norma
   }
   if (n == 0) return result;
 
-  // Unsorted kd-tree, as PCL's StatisticalOutlierRemoval builds it: k-NN results come nearest first anyway.
-  pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}));
+  const PointSearch tree(cloud);
   const int searched = k + 1;  // the query point is its own nearest neighbour
   // Each thread a contiguous run of points: a search leaves only that point's entries of `result`.
   const int chunks = std::clamp(threads, 1, std::max(1, n / kMinPointsPerThread));
@@ -79,7 +76,7 @@ Neighbourhoods compute_neighbourhoods(const Cloud& cloud, int k, bool with_norma
     std::vector<float> found_sq(searched);
     const int end = static_cast<int>(static_cast<long>(n) * (chunk + 1) / chunks);
     for (int i = static_cast<int>(static_cast<long>(n) * chunk / chunks); i < end; ++i) {
-      const int count = tree.nearestKSearch(i, searched, found, found_sq);
+      const int count = tree.nearest(cloud[i], searched, found, found_sq);
       // found[0] is the query point (or a duplicate of it at distance 0).
       double sum = 0.0;
       for (int j = 1; j < count; ++j) {

@@ -1,7 +1,5 @@
 #include "cellmap/segment/convex_merge.hpp"
 
-#include <pcl/search/kdtree.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -9,6 +7,7 @@
 #include <unordered_map>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/preprocess/point_search.hpp"
 
 namespace cellmap {
 namespace {
@@ -59,12 +58,10 @@ Boundaries boundaries_of(const Neighbourhoods& nb, const Segments& segments, dou
 class PatchFinder {
  public:
   PatchFinder(const Cloud& cloud, const Neighbourhoods& nb, const Segments& segments, double radius)
-      : cloud_(cloud), nb_(nb), segments_(segments), radius_(radius), tree_(false) {
-    tree_.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}));
-  }
+      : cloud_(cloud), nb_(nb), segments_(segments), radius_(radius), tree_(cloud) {}
   Patch at(int centre, int segment) {
     Patch p;
-    tree_.radiusSearch(cloud_[centre], radius_, near_, near_sq_);
+    tree_.within(cloud_[centre], radius_, false, near_, near_sq_);
     for (int q : near_) {
       if (segments_.label[q] != segment) continue;
       p.centroid += cloud_[q].getVector3fMap();
@@ -81,7 +78,7 @@ class PatchFinder {
   const Neighbourhoods& nb_;
   const Segments& segments_;
   double radius_;
-  pcl::search::KdTree<pcl::PointXYZ> tree_;
+  PointSearch tree_;
   pcl::Indices near_;
   std::vector<float> near_sq_;
 };

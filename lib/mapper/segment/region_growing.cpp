@@ -2,14 +2,13 @@
 // "Workspace Registration and Collision Detection for Industrial Robotics Applications", AIRoV 2024.
 #include "cellmap/segment/region_growing.hpp"
 
-#include <pcl/search/kdtree.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <unordered_map>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/preprocess/point_search.hpp"
 
 namespace cellmap {
 
@@ -111,9 +110,7 @@ std::vector<int> attach_in_waves(std::vector<int> still, const Neighbourhoods& n
 // Euclidean clusters of `still` at the gap: those of at least min_points become segments of their own.
 void cluster_the_rest(const Cloud& cloud, const std::vector<int>& still, Segments& segments, double gap,
                       int min_points, LeftoverStats& stats) {
-  pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(Cloud::ConstPtr(&cloud, [](const Cloud*) {}),
-                     std::make_shared<const pcl::Indices>(still.begin(), still.end()));
+  const PointSearch tree(cloud, still);
   std::unordered_map<int, bool> visited;
   for (int i : still) visited[i] = false;
   pcl::Indices near;
@@ -123,7 +120,7 @@ void cluster_the_rest(const Cloud& cloud, const std::vector<int>& still, Segment
     std::vector<int> group{start};
     visited[start] = true;
     for (std::size_t g = 0; g < group.size(); ++g) {
-      tree.radiusSearch(cloud[group[g]], gap, near, near_sq);
+      tree.within(cloud[group[g]], gap, false, near, near_sq);
       for (int other : near) {
         if (!visited[other]) {
           visited[other] = true;

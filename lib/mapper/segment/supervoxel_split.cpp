@@ -1,11 +1,11 @@
 #include "cellmap/segment/supervoxel_split.hpp"
 
-#include <pcl/search/kdtree.h>
 #include <pcl/segmentation/supervoxel_clustering.h>
 
 #include <unordered_map>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/preprocess/point_search.hpp"
 #include "cellmap/segment/fit.hpp"
 
 namespace cellmap {
@@ -30,14 +30,12 @@ std::vector<std::uint32_t> supervoxel_labels(const Cloud::Ptr& part, const Split
     if (labels[i] != 0) with_label.push_back(static_cast<int>(i));
   }
   if (with_label.empty() || with_label.size() == part->size()) return labels;
-  pcl::search::KdTree<pcl::PointXYZ> tree(false);
-  tree.setInputCloud(part, std::make_shared<const pcl::Indices>(with_label.begin(), with_label.end()));
+  const PointSearch tree(*part, with_label);
   pcl::Indices found(1);
   std::vector<float> found_sq(1);
   std::vector<std::uint32_t> filled = labels;
   for (std::size_t i = 0; i < part->size(); ++i) {
-    if (labels[i] == 0 && tree.nearestKSearch((*part)[i], 1, found, found_sq) > 0)
-      filled[i] = labels[found[0]];
+    if (labels[i] == 0 && tree.nearest((*part)[i], 1, found, found_sq) > 0) filled[i] = labels[found[0]];
   }
   return filled;
 }

@@ -35,10 +35,10 @@ struct Neighbourhoods final {
   }
 };
 
-/// Builds a kd-tree (pcl::search::KdTree over FLANN) on `cloud` and finds each point's k nearest neighbours.
-/// With `with_normals`, also the covariance (eq. 2), normals oriented toward `viewpoint` (the sensor origin,
-/// same frame as the cloud) and curvature. Cost: one kd-tree build and n k-NN queries, split over up to
-/// `threads` threads (the result does not depend on it).
+/// Builds a kd-tree (PointSearch, as pcl::search::KdTree builds it) on `cloud` and finds each point's k
+/// nearest neighbours. With `with_normals`, also the covariance (eq. 2), normals oriented toward `viewpoint`
+/// (the sensor origin, same frame as the cloud) and curvature. Cost: one kd-tree build and n k-NN queries,
+/// split over up to `threads` threads (the result does not depend on it).
 /// @throws Error if k < 1 or the cloud has a non-finite point.
 [[nodiscard]] Neighbourhoods compute_neighbourhoods(
     const Cloud& cloud, int k, bool with_normals, const Eigen::Vector3f& viewpoint = Eigen::Vector3f::Zero(),
