@@ -30,32 +30,32 @@ struct __attribute__((visibility("hidden"))) PointSearch::Tree {
       coordinates.insert(coordinates.end(), {p.x, p.y, p.z});
       original.push_back(at);
     }
-    identity = subset == nullptr;
     if (n == 0) return;
     index = std::make_unique<Index>(flann::Matrix<float>(coordinates.data(), n, 3),
                                     flann::KDTreeSingleIndexParams(15));
     index->buildIndex();
   }
 
-  // What FLANN found (tree order, or nearest first) as indices into the cloud and squared distances.
+  // Searches `found` (a FLANN result set) and returns its first `count` (all if 0) as indices into the cloud
+  // and squared distances, in the tree's order or nearest first.
   template <typename Found>
-  int copy_out(Found& found, std::size_t count, bool sorted, pcl::Indices& indices,
-               std::vector<float>& sq_distances) const {
-    std::vector<std::size_t> at(count);
+  int search(Found found, const pcl::PointXYZ& query, std::size_t count, bool sorted, pcl::Indices& indices,
+             std::vector<float>& sq_distances) const {
+    const float point[3] = {query.x, query.y, query.z};
+    index->findNeighbors(found, point, flann::SearchParams(-1, 0.0f, sorted));  // exact, as PCL's
+    count = count ? std::min(count, found.size()) : found.size();
+    thread_local std::vector<std::size_t> at;  // FLANN's indices, one allocation per thread
+    at.resize(count);
     sq_distances.resize(count);
     if (count > 0) found.copy(at.data(), sq_distances.data(), count, sorted);
     indices.resize(count);
-    for (std::size_t i = 0; i < count; ++i)
-      indices[i] = identity ? static_cast<pcl::index_t>(at[i]) : original[at[i]];
+    for (std::size_t i = 0; i < count; ++i) indices[i] = original[at[i]];
     return static_cast<int>(count);
   }
 
   std::vector<float> coordinates;  // x, y, z of each indexed point
   std::vector<int> original;       // the cloud index of each indexed point
-  bool identity = true;
   std::unique_ptr<Index> index;
-  // As pcl::KdTreeFLANN searches: exact (checks -1, eps 0).
-  flann::SearchParams nearest_params{-1, 0.0f, true};
 };
 
 PointSearch::PointSearch(const Cloud& cloud) : tree_(std::make_unique<Tree>(cloud, nullptr)) {}
@@ -79,16 +79,10 @@ int PointSearch::nearest(const pcl::PointXYZ& query, int k, pcl::Indices& indice
     sq_distances.clear();
     return 0;
   }
-  const float point[3] = {query.x, query.y, query.z};
   // FLANN's own choice for k-NN: a heap above 250 neighbours, a sorted array below.
-  if (wanted > KNN_HEAP_THRESHOLD) {
-    flann::KNNResultSet2<float> found(wanted);
-    tree_->index->findNeighbors(found, point, tree_->nearest_params);
-    return tree_->copy_out(found, std::min(found.size(), wanted), true, indices, sq_distances);
-  }
-  flann::KNNSimpleResultSet<float> found(wanted);
-  tree_->index->findNeighbors(found, point, tree_->nearest_params);
-  return tree_->copy_out(found, std::min(found.size(), wanted), true, indices, sq_distances);
+  if (wanted > KNN_HEAP_THRESHOLD)
+    return tree_->search(flann::KNNResultSet2<float>(wanted), query, wanted, true, indices, sq_distances);
+  return tree_->search(flann::KNNSimpleResultSet<float>(wanted), query, wanted, true, indices, sq_distances);
 }
 
 int PointSearch::within(const pcl::PointXYZ& query, double radius, bool sorted, pcl::Indices& indices,
@@ -98,11 +92,8 @@ int PointSearch::within(const pcl::PointXYZ& query, double radius, bool sorted, 
     sq_distances.clear();
     return 0;
   }
-  const float point[3] = {query.x, query.y, query.z};
-  flann::RadiusResultSet<float> found(static_cast<float>(radius * radius));
-  flann::SearchParams params(-1, 0.0f, sorted);
-  tree_->index->findNeighbors(found, point, params);
-  return tree_->copy_out(found, found.size(), sorted, indices, sq_distances);
+  const flann::RadiusResultSet<float> found(static_cast<float>(radius * radius));
+  return tree_->search(found, query, 0, sorted, indices, sq_distances);
 }
 
 }  // namespace cellmap
