@@ -1,6 +1,7 @@
 #include "cellmap/common/parallel.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <atomic>
 #include <stdexcept>
@@ -84,6 +85,24 @@ TEST(ParallelTest, HelperCpuCountsForTheCallingThread) {
   const double helpers = (cpu_seconds_with_helpers() - before) - (thread_cpu_seconds() - own_before);
   EXPECT_GT(helpers, 0.04);
   EXPECT_LT(helpers, 0.5);
+}
+
+// The helper may run on every CPU the process may use but the one its caller was on when the call began, so
+// a scheduler that packs woken threads onto the waker's CPU cannot run it behind its caller.
+TEST(ParallelTest, HelpersAreKeptOffTheCallersCpu) {
+  cpu_set_t allowed;
+  ASSERT_EQ(::sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  if (CPU_COUNT(&allowed) < 2) GTEST_SKIP() << "one CPU: nowhere else to run a helper";
+  for (int call = 0; call < 20; ++call) {
+    cpu_set_t helper{};
+    parallel_for(2, 2, [&](int t) {
+      if (t == 1) ASSERT_EQ(::pthread_getaffinity_np(::pthread_self(), sizeof helper, &helper), 0);
+    });
+    EXPECT_EQ(CPU_COUNT(&helper), CPU_COUNT(&allowed) - 1);
+    cpu_set_t both;
+    CPU_OR(&both, &helper, &allowed);
+    EXPECT_TRUE(CPU_EQUAL(&both, &allowed)) << "a helper allowed a CPU the process may not use";
+  }
 }
 
 }  // namespace

@@ -159,11 +159,14 @@ class Splitter {
       const double free = space.free_volume(box);
       // Pieces can at most free what the box blocks: skip the search when that is too little.
       if (free >= needed) {
-        for (const std::vector<std::vector<int>>& pieces : candidates(indices, box)) {
+        const auto frees_enough = [&](const std::vector<std::vector<int>>& pieces) {
           double left = 0;
           for (const std::vector<int>& piece : pieces) left += space.free_volume(piece_box(piece, box));
-          if (free - left < needed) continue;
-          for (const std::vector<int>& piece : pieces) split(piece, space, depth + 1, out);
+          return free - left >= needed;
+        };
+        if (std::optional<std::vector<std::vector<int>>> pieces =
+                first_division(indices, box, frees_enough)) {
+          for (const std::vector<int>& piece : *pieces) split(piece, space, depth + 1, out);
           return true;
         }
       }
@@ -181,20 +184,22 @@ class Splitter {
     return along_cloud.volume() < along_part.volume() ? along_cloud : along_part;
   }
 
-  // Ways to divide a part, tried in order: its connected pieces (when it has several), then each cut with
-  // the connected pieces of both sides.
-  std::vector<std::vector<std::vector<int>>> candidates(const std::vector<int>& indices, const Box& box) {
-    std::vector<std::vector<std::vector<int>>> out;
+  // The first way to divide a part that `accept`s, of these in order: its connected pieces (when it has
+  // several), then each cut with the connected pieces of both sides. Each is grouped only once the ones
+  // before it were refused: grouping is most of a split's cost, and the first division usually passes.
+  template <class Accept>
+  std::optional<std::vector<std::vector<int>>> first_division(const std::vector<int>& indices, const Box& box,
+                                                              const Accept& accept) {
     std::vector<std::vector<int>> whole = components_.of(indices);
-    if (whole.size() > 1) out.push_back(std::move(whole));
+    if (whole.size() > 1 && accept(whole)) return whole;
     for (const Cut& cut : best_cuts(cloud_, indices, box, params_.cube)) {
       const auto middle = cut.order.begin() + static_cast<std::ptrdiff_t>(cut.at);
       std::vector<std::vector<int>> pieces = components_.of({cut.order.begin(), middle});
       for (std::vector<int>& piece : components_.of({middle, cut.order.end()}))
         pieces.push_back(std::move(piece));
-      out.push_back(std::move(pieces));
+      if (accept(pieces)) return pieces;
     }
-    return out;
+    return std::nullopt;
   }
 
   const Cloud& cloud_;

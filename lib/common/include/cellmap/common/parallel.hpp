@@ -3,10 +3,12 @@
 // occupancy map's ray casting), and the CPU time of a thread with the helpers it split its work onto.
 
 #include <pthread.h>
+#include <sched.h>
 #include <time.h>
 
 #include <algorithm>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <functional>
@@ -58,7 +60,9 @@ namespace detail {
 // Helper threads kept for one calling thread's parallel_for calls: starting a thread costs tens of µs (and
 // page faults for its stack), and the occupancy map splits its work twice per scan. Helpers wait on a
 // condition variable between calls (no spinning: they use no CPU while idle) and end with the calling
-// thread.
+// thread. Helpers are kept off the caller's CPU: a scheduler that packs woken threads onto the waker's CPU
+// (seen on 2-vCPU VMs: a 5 ms share then started 1-7 ms late, after the caller's) would otherwise run a
+// helper behind its caller instead of beside it.
 class HelperPool {
  public:
   HelperPool() = default;
@@ -88,6 +92,7 @@ class HelperPool {
         serve(index);
       });
     }
+    keep_helpers_off(::sched_getcpu());
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       share_ = &share;
@@ -111,6 +116,21 @@ class HelperPool {
   }
 
  private:
+  // Allows the helpers every CPU the process may use but `caller_cpu`; a failure, or a machine with one CPU,
+  // leaves them where the scheduler puts them.
+  void keep_helpers_off(int caller_cpu) {
+    if (caller_cpu < 0 || caller_cpu >= CPU_SETSIZE) return;
+    if (caller_cpu == helpers_kept_off_ && threads_.size() == helpers_placed_) return;
+    cpu_set_t others;
+    if (::sched_getaffinity(0, sizeof others, &others) != 0) return;
+    CPU_CLR(caller_cpu, &others);
+    if (CPU_COUNT(&others) == 0) return;
+    for (std::thread& thread : threads_)
+      (void)::pthread_setaffinity_np(thread.native_handle(), sizeof others, &others);
+    helpers_kept_off_ = caller_cpu;
+    helpers_placed_ = threads_.size();
+  }
+
   void serve(int index) {
     std::uint64_t seen = 0;
     for (;;) {
@@ -140,6 +160,8 @@ class HelperPool {
   int helpers_ = 0, pending_ = 0;
   double cpu_ = 0.0;
   bool stop_ = false, busy_ = false;
+  int helpers_kept_off_ = -1;       // the CPU the helpers were last kept off
+  std::size_t helpers_placed_ = 0;  // helpers that were
 };
 
 inline HelperPool& helper_pool() {
