@@ -240,9 +240,11 @@ class Joiner {
 
   // Joins the cheapest pair while one is cheap enough; returns the number of joins.
   std::size_t run() {
+    std::vector<std::pair<std::size_t, std::size_t>> candidates;
     for (std::size_t a = 0; a < parts_.size(); ++a) {
-      for (std::size_t b = a + 1; b < parts_.size(); ++b) consider(a, b);
+      for (std::size_t b = a + 1; b < parts_.size(); ++b) candidates.emplace_back(a, b);
     }
+    consider(candidates);
     std::size_t joins = 0;
     while (!pairs_.empty()) {
       const auto cheapest = std::min_element(pairs_.begin(), pairs_.end());
@@ -257,9 +259,11 @@ class Joiner {
                                            std::get<1>(p) == b || std::get<2>(p) == b;
                                   }),
                    pairs_.end());
+      candidates.clear();
       for (std::size_t c = 0; c < parts_.size(); ++c) {
-        if (c != a && parts_[c].live) consider(std::min(a, c), std::max(a, c));
+        if (c != a && parts_[c].live) candidates.emplace_back(std::min(a, c), std::max(a, c));
       }
+      consider(candidates);
     }
     return joins;
   }
@@ -276,17 +280,32 @@ class Joiner {
   }
 
  private:
-  // Records the pair when joining it is cheap enough.
-  void consider(std::size_t a, std::size_t b) {
-    const Part &x = parts_[a], &y = parts_[b];
-    if (!near(x.box, y.box, params_.adjacency)) return;
+  // Records the pairs of parts that are cheap enough to join, in the order given. Each pair's cost is judged
+  // on its own, so they are spread over the threads (pair i on thread i mod threads: near pairs, which cost
+  // the free-space judgements, lie anywhere in the list).
+  void consider(const std::vector<std::pair<std::size_t, std::size_t>>& candidates) {
+    std::vector<double> cost(candidates.size());
+    const int threads = std::clamp(params_.threads, 1, std::max(1, static_cast<int>(candidates.size())));
+    parallel_for(threads, threads, [&](int t) {
+      for (std::size_t i = std::size_t(t); i < candidates.size(); i += std::size_t(threads))
+        cost[i] = join_cost(parts_[candidates[i].first], parts_[candidates[i].second]);
+    });
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      if (cost[i] <= params_.max_growth)
+        pairs_.emplace_back(cost[i], candidates[i].first, candidates[i].second);
+    }
+  }
+
+  // The free space the box of two parts' union blocks beyond their own boxes, as a share of its volume;
+  // infinite for parts too far apart to be joined.
+  [[nodiscard]] double join_cost(const Part& x, const Part& y) const {
+    if (!near(x.box, y.box, params_.adjacency)) return std::numeric_limits<double>::infinity();
     const Box joined = quick_union(x, y);
     std::vector<const SeenFreeSpace*> views;
     for (const auto& v : x.views) views.push_back(v.get());
     for (const auto& v : y.views) views.push_back(v.get());
     const double added = free_volume(joined, views) - free_volume(x.box, views) - free_volume(y.box, views);
-    const double cost = added / joined.volume();
-    if (cost <= params_.max_growth) pairs_.emplace_back(cost, a, b);
+    return added / joined.volume();
   }
 
   // The smaller of the two boxes that keep one part's axes and hold both parts: a cheap stand-in for the
