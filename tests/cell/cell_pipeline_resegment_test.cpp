@@ -1,7 +1,9 @@
 // The cell pipeline's re-segmentation of a box that lost part of its voxels (CellPipeline::resegment on a map
 // settled from a cloud of voxel centres, with the change given by hand): it shrinks in place when the box of
 // what it still holds blocks little seen free space, and its extent is re-segmented when that box would
-// block the space the removal freed or when something appeared beside it. Known answers, milliseconds.
+// block the space the removal freed or when something appeared beside it; and (sweeps of a box scene) an
+// object whose box went before its removal was confirmed is reported when it comes back. Known answers,
+// milliseconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/config/yaml_map.hpp"
+#include "occupancy/box_scene.hpp"
 
 namespace cellmap {
 namespace {
@@ -144,6 +147,67 @@ TEST(CellPipelineResegmentTest, ABoxWithSomethingNewBesideItIsReSegmented) {
   const Resegmentation result = table.resegment(crate, moved);
   EXPECT_EQ(result.evidence, occupied.size());
   expect_held(result.reconciled.boxes, occupied);
+}
+
+// An object taken away and put back after a version (made by another change) dropped its box but before the
+// change detector would have confirmed the removal: its return is reported and boxed like any new object,
+// not taken for its voxels falling back to their confirmed state (which would leave it outside every box).
+TEST(CellPipelineResegmentTest, AnObjectPutBackAfterItsBoxWentIsReportedAgain) {
+  // A table (y down: its surface at y = 0.5) seen from 0.9 m above it, rays about 1 cm apart on it, so that
+  // every voxel there is crossed each sweep; `object` hangs 10 cm above it (its box holds nothing else) all
+  // along but for a few sweeps, `other` is put on the table far from it.
+  const testing::AlignedBox table{{-1.0, 0.5, 0.0}, {1.0, 0.6, 2.5}};
+  const testing::AlignedBox object{{-0.4, 0.2, 1.3}, {-0.2, 0.4, 1.5}},
+      other{{0.2, 0.3, 1.3}, {0.4, 0.5, 1.5}};
+  PinholeIntrinsics camera = testing::kinect_intrinsics(120, 90);
+  camera.fx = camera.fy = 220.0;
+  Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
+  X_CS.translate(Eigen::Vector3d(0.003, -0.4, 0.007));
+  X_CS.rotate(Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX()));
+  CellPipelineConfig c = config();
+  c.settle_sweeps = 2;
+  CellPipeline pipeline(c, {}, 1);
+  const auto sweep = [&](const std::vector<testing::AlignedBox>& scene) {
+    Sweep s;
+    s.scans.push_back(testing::render_scan(scene, X_CS, camera));
+    return pipeline.process(s);
+  };
+  for (int n = 0; n < c.settle_sweeps + 3; ++n) (void)sweep({table, object});
+  ASSERT_EQ(pipeline.voxels_outside_boxes(c.change.min_voxels), 0u);
+  const Eigen::Vector3d top(-0.31, 0.21, 1.39);  // a voxel of the object's top
+  const auto boxes_holding_top = [&] {
+    const std::vector<Box>& boxes = pipeline.boxes();
+    return std::count_if(boxes.begin(), boxes.end(), [&](const Box& b) { return b.contains(top); });
+  };
+  ASSERT_EQ(boxes_holding_top(), 1);
+
+  // The object away: its voxels turn free in sweep `clear`, to be confirmed gone persist_sweeps − 1 sweeps
+  // later. `other` is put down so that its change is reported in sweep `clear`: a version meanwhile, in
+  // which the object's box, emptied, goes.
+  const int clear = c.occupancy.sweeps_to_clear();
+  const int put_down = clear - (c.occupancy.sweeps_to_occupy() + c.change.persist_sweeps - 2);
+  ASSERT_GE(put_down, 1);
+  SweepReport report;
+  for (int n = 1; n <= clear; ++n) {
+    report = sweep(n >= put_down ? std::vector<testing::AlignedBox>{table, other}
+                                 : std::vector<testing::AlignedBox>{table});
+    if (n < clear) {
+      EXPECT_FALSE(report.change) << "a version in sweep " << n;
+    }
+  }
+  ASSERT_TRUE(report.change) << "no version while the object's voxels were free but not confirmed so";
+  ASSERT_EQ(pipeline.map().state(top), VoxelState::free);
+  EXPECT_EQ(boxes_holding_top(), 0);
+
+  // Back at once: one hit fills its voxels again (they have only just turned free). Reported as a change
+  // persist_sweeps sweeps later, and boxed.
+  int reported_after = 0;
+  for (int n = 1; n <= c.change.persist_sweeps + 1 && reported_after == 0; ++n) {
+    if (sweep({table, object, other}).change) reported_after = n;
+  }
+  EXPECT_EQ(reported_after, c.change.persist_sweeps) << "0: the object came back unreported";
+  EXPECT_EQ(boxes_holding_top(), 1);
+  EXPECT_EQ(pipeline.voxels_outside_boxes(c.change.min_voxels), 0u);
 }
 
 }  // namespace

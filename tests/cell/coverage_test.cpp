@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 namespace cellmap {
 namespace {
@@ -55,6 +57,49 @@ TEST(CubeHoldersTest, AgreesWithHoldsCubeOnEveryVoxel) {
     }
   }
   EXPECT_GT(held, 1000);  // the boxes hold many voxels: the test asks both answers often
+}
+
+// The centres of the 2 cm voxels filling [lo, hi) (metres, multiples of 2 cm).
+std::vector<Eigen::Vector3d> voxels(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  std::vector<Eigen::Vector3d> out;
+  const Eigen::Vector3i n = ((hi - lo) / 0.02).array().round().cast<int>();
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      for (int i = 0; i < n.x(); ++i) out.push_back(lo + 0.02 * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
+    }
+  }
+  return out;
+}
+
+// A 2 m × 1 m × 0.28 m box with two groups of voxels outside it: a row on its top face (a surface filling
+// in, within reach) grows it; a 0.3 m × 0.08 m × 0.2 m object against its side reaches 8 cm beyond it, and
+// gets a box of its own, although taking it voxel by voxel would grow the box by less than a tenth.
+TEST(CoverTest, AGroupWithinReachGrowsTheBoxAnObjectBeyondItGetsABoxOfItsOwn) {
+  Reconciled reconciled;
+  reconciled.boxes = {box_at({1.0, 0.5, 0.14}, {1.0, 0.5, 0.14}, 0.0)};
+  reconciled.boxes[0].id = 1;
+  reconciled.next_id = 2;
+  std::vector<Eigen::Vector3d> outside = voxels({0.5, 0.5, 0.28}, {0.7, 0.52, 0.30});
+  const std::vector<Eigen::Vector3d> object = voxels({0.86, 1.0, 0.0}, {1.16, 1.08, 0.2});
+  outside.insert(outside.end(), object.begin(), object.end());
+  CoverParams options;
+  options.reach = 0.04;
+  cover(reconciled, outside, options);
+
+  ASSERT_EQ(reconciled.boxes.size(), 2u);
+  ASSERT_EQ(reconciled.modified.size(), 1u);
+  EXPECT_EQ(reconciled.modified[0].id, 1u);
+  const Region grown = bounds_of(reconciled.boxes[0]);
+  EXPECT_NEAR(grown.max.z(), 0.30, 1e-6);
+  EXPECT_NEAR(grown.max.y(), 1.0, 1e-6) << "the box grew into the object";
+  ASSERT_EQ(reconciled.added.size(), 1u);
+  EXPECT_EQ(reconciled.added[0].id, 2u);
+  EXPECT_EQ(reconciled.next_id, 3u);
+  for (const Eigen::Vector3d& c : object) EXPECT_TRUE(holds_cube(reconciled.added[0], c, 0.02));
+  for (const Eigen::Vector3d& c : outside) {
+    const auto holds = [&](const Box& b) { return holds_cube(b, c, 0.02); };
+    EXPECT_TRUE(std::any_of(reconciled.boxes.begin(), reconciled.boxes.end(), holds));
+  }
 }
 
 }  // namespace

@@ -170,6 +170,42 @@ TEST(ChangeDetectorTest, AddedAndRemovedBoxGiveOneRegionEach) {
   EXPECT_EQ(detector.pending(), 0u);
 }
 
+// A box taken away and put back before its removal is confirmed: its voxels fall back to their confirmed
+// state and nothing is reported. After accept_vanished (its voxels free, their vanish not reported but taken
+// as confirmed), putting it back is reported as an appearance, persist_sweeps sweeps later.
+TEST(ChangeDetectorTest, ABoxPutBackIsReportedOnlyAfterItsVanishWasAccepted) {
+  const PinholeIntrinsics camera = small_camera(120, 90, 220.0);
+  const AlignedBox box{{-0.15, 0.3, 1.21}, {0.1, 0.5, 1.45}};
+  std::vector<AlignedBox> with_box = table_scene();
+  with_box.push_back(box);
+  for (const bool accept : {false, true}) {
+    OccupancyMap map;
+    ChangeConfig config;
+    ChangeDetector detector(config);
+    for (int i = 0; i < 10; ++i) (void)detector.update(map.integrate(sweep_of(with_box, camera)), map);
+    // Away until its voxels are free in the map (sweeps_to_clear sweeps), not longer: no vanish confirmed
+    // (the table it hid appears meanwhile).
+    for (int i = 0; i < map.config().sweeps_to_clear(); ++i) {
+      for (const ChangeRegion& r :
+           detector.update(map.integrate(sweep_of(table_scene(), camera)), map).regions)
+        ASSERT_TRUE(r.vanished.empty()) << "sweep " << i + 1 << " after taking the box away";
+    }
+    const std::vector<octomap::OcTreeKey> pending = detector.pending_vanished();
+    ASSERT_GT(pending.size(), 50u);
+    if (accept) detector.accept_vanished(pending);
+    EXPECT_EQ(detector.pending_vanished().empty(), accept);
+    std::size_t regions = 0;
+    int reported_at = 0;
+    for (int i = 1; i <= config.persist_sweeps + 2; ++i) {
+      const ChangeSet changes = detector.update(map.integrate(sweep_of(with_box, camera)), map);
+      regions += changes.regions.size();
+      if (!changes.empty() && reported_at == 0) reported_at = i;
+    }
+    EXPECT_EQ(regions, accept ? 1u : 0u) << (accept ? "accepted" : "not accepted");
+    EXPECT_EQ(reported_at, accept ? config.persist_sweeps : 0);
+  }
+}
+
 // A map and its detector saved while a new box's flips wait for confirmation (as a daemon saves them with a
 // version) and read back: the copy reports the box at the same sweep and as the same region as the original.
 // A fresh detector on the saved map never reports it: the voxels do not flip again.

@@ -238,9 +238,23 @@ void CellPipeline::apply(Resegmentation resegmentation, SweepReport& report) {
   next_box_id_ = reconciled.next_id;
   if (reconciled.changed()) {
     boxes_ = reconciled.boxes;
+    accept_unboxed_vanishes();
     report.change = std::move(reconciled);
   }
   report.boxes = boxes_.size();
+}
+
+// A voxel that has vanished from the map but not yet by the change detector's count, and that no box holds
+// any more, counts as gone for the detector from now on: the boxes let it go, so its object coming back
+// before the detector would have confirmed the removal must be reported, not taken for the voxel falling
+// back to its confirmed state (which would leave it outside every box, unreported).
+void CellPipeline::accept_unboxed_vanishes() {
+  CubeHolders held(boxes_, map_.config().resolution);
+  std::vector<octomap::OcTreeKey> unboxed;
+  for (const octomap::OcTreeKey& key : detector_.pending_vanished()) {
+    if (!held.hold(map_.centre(key))) unboxed.push_back(key);
+  }
+  detector_.accept_vanished(unboxed);
 }
 
 Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
@@ -399,6 +413,7 @@ void CellPipeline::cover_the_rest(Reconciled& reconciled) const {
   CoverParams options;
   options.voxel = map_.config().resolution;
   options.max_growth = config_.segment.join_max_growth;
+  options.reach = 2 * options.voxel;  // a surface's noise moves it by about a voxel
   options.kind = config_.segment.box_kind;
   cover(reconciled,
         voxels_outside(map_, *occupied_, reconciled.boxes, config_.change.min_voxels,

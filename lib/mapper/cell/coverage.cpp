@@ -33,14 +33,20 @@ Box grown_to_hold(const Box& box, const Eigen::Vector3d& centre_C, double edge) 
   return grown;
 }
 
-// Index of the box of `boxes` that takes the cube with the least growth, at most max_growth of its volume;
-// -1 if none may.
-int cheapest_growth(const std::vector<Box>& boxes, const Eigen::Vector3d& centre_C, const CoverParams& o) {
+// Index of the box of `boxes` that takes the cube around `centre_C` with the least growth, -1 if none may:
+// the cube must lie within `reach` of the box as it was before the pass (`before`, same order), and the box's
+// growth in the pass stay at most max_growth of that volume.
+int cheapest_growth(const std::vector<Box>& boxes, const std::vector<Box>& before,
+                    const Eigen::Vector3d& centre_C, const CoverParams& o) {
   int best = -1;
   double best_added = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const double added = grown_to_hold(boxes[i], centre_C, o.voxel).volume() - boxes[i].volume();
-    if (added <= o.max_growth * boxes[i].volume() && added < best_added) {
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    Box reachable = before[i];
+    reachable.half_extents.array() += o.reach;
+    if (!holds_cube(reachable, centre_C, o.voxel)) continue;
+    const Box grown = grown_to_hold(boxes[i], centre_C, o.voxel);
+    const double added = grown.volume() - boxes[i].volume();
+    if (grown.volume() - before[i].volume() <= o.max_growth * before[i].volume() && added < best_added) {
       best = static_cast<int>(i);
       best_added = added;
     }
@@ -83,6 +89,36 @@ std::vector<std::vector<Eigen::Vector3d>> connected_groups(const std::vector<Eig
     }
   }
   return groups;
+}
+
+// Grows `boxes` (`before`: as they were before the pass, same order) to take every voxel of `group`, each by
+// the box that grows least for it, and lists the boxes grown in `grown`. A group that some voxel of lies
+// beyond every box's reach is an object, or part of one, rather than a surface filling in: it leaves the
+// boxes as they were and returns false, so that it gets a box of its own instead of hiding in an older one.
+bool take_group(std::vector<Box>& boxes, const std::vector<Box>& before,
+                const std::vector<Eigen::Vector3d>& group, const CoverParams& options,
+                std::vector<std::size_t>& grown) {
+  std::vector<Box> taking = boxes;
+  for (const Eigen::Vector3d& c : group) {
+    const int taker = cheapest_growth(taking, before, c, options);
+    if (taker < 0) return false;
+    taking[static_cast<std::size_t>(taker)] =
+        grown_to_hold(taking[static_cast<std::size_t>(taker)], c, options.voxel);
+    grown.push_back(static_cast<std::size_t>(taker));
+  }
+  std::sort(grown.begin(), grown.end());
+  grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
+  boxes = std::move(taking);
+  return true;
+}
+
+// A new box holding every voxel of `group` whole.
+Box box_of_group(const std::vector<Eigen::Vector3d>& group, const CoverParams& options) {
+  Box box = fit_box(group, options.kind, options.voxel);
+  for (const Eigen::Vector3d& c : group) {
+    if (!holds_cube(box, c, options.voxel)) box = grown_to_hold(box, c, options.voxel);
+  }
+  return box;
 }
 
 // Records box `box` (already in reconciled.boxes) as changed: added stays added, else modified.
@@ -201,24 +237,23 @@ std::vector<Eigen::Vector3d> voxels_outside(const OccupancyMap& map, const Occup
 void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C,
            const CoverParams& options) {
   std::vector<Box>& boxes = reconciled.boxes;
-  std::vector<Eigen::Vector3d> rest;
+  const std::vector<Box> before = boxes;
+  std::vector<Eigen::Vector3d> outside;
   for (const Eigen::Vector3d& c : centres_C) {
     const auto holds = [&](const Box& box) { return holds_cube(box, c, options.voxel); };
-    if (std::any_of(boxes.begin(), boxes.end(), holds)) continue;
-    const int best = cheapest_growth(boxes, c, options);
-    if (best < 0) {
-      rest.push_back(c);
-      continue;
-    }
-    boxes[best] = grown_to_hold(boxes[best], c, options.voxel);
-    record_grown(reconciled, boxes[best]);
+    if (std::none_of(boxes.begin(), boxes.end(), holds)) outside.push_back(c);
   }
-  for (const std::vector<Eigen::Vector3d>& group : connected_groups(rest, options.voxel)) {
-    Box box = fit_box(group, options.kind, options.voxel);
-    for (const Eigen::Vector3d& c : group) {
-      if (!holds_cube(box, c, options.voxel)) box = grown_to_hold(box, c, options.voxel);
+  std::vector<Box> fresh;
+  for (const std::vector<Eigen::Vector3d>& group : connected_groups(outside, options.voxel)) {
+    std::vector<std::size_t> grown;
+    if (take_group(boxes, before, group, options, grown)) {
+      for (std::size_t i : grown) record_grown(reconciled, boxes[i]);
+    } else {
+      fresh.push_back(box_of_group(group, options));
+      fresh.back().id = reconciled.next_id++;
     }
-    box.id = reconciled.next_id++;
+  }
+  for (const Box& box : fresh) {
     boxes.push_back(box);
     reconciled.added.push_back(box);
   }

@@ -70,15 +70,19 @@ class OccupiedVoxels final {
 
 /// How the safety pass covers what is left out.
 struct CoverParams final {
-  double voxel = 0.02;      ///< voxel edge, metres
-  double max_growth = 0.1;  ///< a box may grow by this share of its volume to take a voxel (the join rule)
+  double voxel = 0.02;  ///< voxel edge, metres
+  /// A box may grow by this share of its volume (as it was before the pass) to take voxels (the join rule).
+  double max_growth = 0.1;
+  double reach = 0.04;                ///< metres: a box takes only voxels whose cube lies this close to it
   BoxKind kind = BoxKind::kOriented;  ///< of the new boxes
 };
 
-/// Makes the boxes of `reconciled` hold every voxel of `centres_C` whole: each voxel, in order, goes to the
-/// box that grows least to take it if that growth is at most `max_growth` of the box's volume (the box is
-/// then modified, or stays added if it is new), the rest are segmented into new boxes with fresh ids from
-/// `reconciled.next_id`. Keeps `reconciled`'s lists sorted by id.
+/// Makes the boxes of `reconciled` hold every voxel of `centres_C` whole. The voxels no box holds are taken
+/// in 26-connected groups: a group whose every voxel lies within `reach` of a box goes to the boxes, each
+/// voxel to the box that grows least to take it, no box growing by more than `max_growth` of its volume in
+/// the pass (a box grown is then modified, or stays added if it is new); any other group (an object, or the
+/// part of one its change has not reported yet) gets a new box with a fresh id from `reconciled.next_id`,
+/// rather than hide in an older box. Keeps `reconciled`'s lists sorted by id.
 void cover(Reconciled& reconciled, const std::vector<Eigen::Vector3d>& centres_C, const CoverParams& options);
 
 }  // namespace cellmap

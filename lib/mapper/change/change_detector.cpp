@@ -154,6 +154,22 @@ ChangeSet ChangeDetector::update(const OccupancyUpdate& update, const OccupancyM
   return changes;
 }
 
+std::vector<Key> ChangeDetector::pending_vanished() const {
+  std::vector<Key> keys;
+  for (const auto& [key, pending] : pending_) {
+    if (pending.was_occupied) keys.push_back(key);
+  }
+  std::sort(keys.begin(), keys.end(), zyx_less);
+  return keys;
+}
+
+void ChangeDetector::accept_vanished(const std::vector<Key>& keys) {
+  for (const Key& key : keys) {
+    const auto it = pending_.find(key);
+    if (it != pending_.end() && it->second.was_occupied) pending_.erase(it);
+  }
+}
+
 // A pending voxel that flips again is back at its confirmed state; any other starts pending.
 void ChangeDetector::record_flips(const OccupancyUpdate& update) {
   auto flip = [&](const Key& key, bool now_occupied) {

@@ -204,6 +204,7 @@ class CellPipeline final {
   // holds every change gathered since the first that waits.
   [[nodiscard]] bool resegmentation_due(ChangeSet& changes);
   void apply(Resegmentation resegmentation, SweepReport& report);
+  void accept_unboxed_vanishes();
 
   CellPipelineConfig config_;
   std::unique_ptr<SelfFilter> filter_;  // set by filter_robot()

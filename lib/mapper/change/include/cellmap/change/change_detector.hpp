@@ -82,6 +82,14 @@ class ChangeDetector final {
 
   /// Voxels whose flip is still waiting for confirmation.
   [[nodiscard]] std::size_t pending() const { return pending_.size(); }
+  /// The pending voxels that were occupied at their last confirmed state (free now, not yet confirmed so),
+  /// sorted (z, y, x). If they fill again before confirmation, nothing is reported.
+  [[nodiscard]] std::vector<octomap::OcTreeKey> pending_vanished() const;
+  /// Takes the vanish of each pending voxel of `keys` that was occupied as confirmed, without reporting it:
+  /// free is its confirmed state from now on, so filling again is a change (keys not pending so are left
+  /// alone). For voxels whose boxes were dropped before the detector confirmed them gone: their object
+  /// coming back must be reported, not taken for a flip back to the confirmed state.
+  void accept_vanished(const std::vector<octomap::OcTreeKey>& keys);
   [[nodiscard]] const ChangeConfig& config() const { return config_; }
 
   /// Writes what the detector remembers between sweeps (the sweep count, the pending flips, the appeared
