@@ -112,25 +112,45 @@ class Components {
   Components(const Neighbourhoods& nb, double gap)
       : nb_(nb), sq_gap_(static_cast<float>(gap * gap)), slot_(static_cast<std::size_t>(nb.size()), -1) {}
 
+  // Flooded from each point not yet reached along its own neighbour links; a link to a point another flood
+  // reached (the links are not symmetric) joins the two floods' labels. Groups in the order of their first
+  // point in `indices`, each point in that order: what joining every linked pair would give, for a fraction
+  // of the look-ups (a link mostly leads to a point of the flood at hand).
   std::vector<std::vector<int>> of(const std::vector<int>& indices) {
     for (std::size_t s = 0; s < indices.size(); ++s) slot_[indices[s]] = static_cast<int>(s);
-    std::vector<int> parent(indices.size());
-    for (std::size_t s = 0; s < parent.size(); ++s) parent[s] = static_cast<int>(s);
+    std::vector<int> flood(indices.size(), -1), joined;  // joined: per flood, the flood it joined
     const auto find = [&](int x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      while (joined[x] != x) x = joined[x] = joined[joined[x]];
       return x;
     };
-    for (std::size_t s = 0; s < indices.size(); ++s) {
-      for (int j = 0; j < nb_.k; ++j) {
-        const int other = nb_.neighbour(indices[s], j);
-        if (other < 0 || nb_.sq_distance(indices[s], j) > sq_gap_) break;
-        if (slot_[other] >= 0) parent[find(static_cast<int>(s))] = find(slot_[other]);
+    std::vector<int> stack;
+    for (std::size_t seed = 0; seed < indices.size(); ++seed) {
+      if (flood[seed] >= 0) continue;
+      const int label = static_cast<int>(joined.size());
+      joined.push_back(label);
+      flood[seed] = label;
+      stack.assign(1, static_cast<int>(seed));
+      while (!stack.empty()) {
+        const int s = stack.back();
+        stack.pop_back();
+        for (int j = 0; j < nb_.k; ++j) {
+          const int other = nb_.neighbour(indices[s], j);
+          if (other < 0 || nb_.sq_distance(indices[s], j) > sq_gap_) break;
+          const int t = slot_[other];
+          if (t < 0) continue;
+          if (flood[t] < 0) {
+            flood[t] = label;
+            stack.push_back(t);
+          } else if (flood[t] != label) {
+            joined[find(flood[t])] = find(label);
+          }
+        }
       }
     }
     std::vector<std::vector<int>> groups;
-    std::vector<int> group_of(indices.size(), -1);
+    std::vector<int> group_of(joined.size(), -1);
     for (std::size_t s = 0; s < indices.size(); ++s) {
-      int& g = group_of[find(static_cast<int>(s))];
+      int& g = group_of[find(flood[s])];
       if (g < 0) g = static_cast<int>(groups.size()), groups.emplace_back();
       groups[g].push_back(indices[s]);
     }
