@@ -35,6 +35,27 @@ Box frame_box(const Eigen::Matrix3d& R, const Eigen::Vector3d& low, const Eigen:
   return box;
 }
 
+// The volume frame_box(R, low, high, cube) has, worked out without building the box: the cubes' growth of
+// the half extents depends on R alone.
+class FrameBoxVolume {
+ public:
+  FrameBoxVolume(const Eigen::Matrix3d& R, double cube) {
+    Box box;
+    box.rotation = Eigen::Quaterniond(R).normalized();
+    box.half_extents.setZero();
+    grow_to_hold_cubes(box, cube);
+    growth_ = box.half_extents;
+  }
+  [[nodiscard]] double operator()(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const {
+    Eigen::Vector3d half = (0.5 * (high - low)).array() + kBoxFitSlack;
+    half += growth_;
+    return 8.0 * half.prod();
+  }
+
+ private:
+  Eigen::Vector3d growth_;
+};
+
 // One way to cut a part in two across an axis of its box: the first `at` points of `order` go one way.
 struct Cut {
   std::vector<int> order;
@@ -72,12 +93,12 @@ std::optional<Cut> best_cut(const Points& local, const std::vector<int>& indices
                   tail_high = -tail_low;
   Cut best;
   best.volume = std::numeric_limits<double>::infinity();
+  const FrameBoxVolume box_volume(R, cube);
   for (std::size_t at = n; at-- > min;) {  // the points from `at` on form the other side
     tail_low = tail_low.cwiseMin(local[order[at]]);
     tail_high = tail_high.cwiseMax(local[order[at]]);
     if (n - at < min) continue;
-    const double volume = frame_box(R, low[at - 1], high[at - 1], cube).volume() +
-                          frame_box(R, tail_low, tail_high, cube).volume();
+    const double volume = box_volume(low[at - 1], high[at - 1]) + box_volume(tail_low, tail_high);
     if (volume < best.volume) best.at = at, best.volume = volume;
   }
   for (std::size_t k : order) best.order.push_back(indices[k]);
