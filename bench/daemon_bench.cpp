@@ -61,6 +61,7 @@ struct Options {
   double change_every = 4.0;     // seconds between the crate appearing and going
   double pass_seconds = 2.0;     // the gantry's time from one end of the table to the other
   int stops = 20;                // distinct gantry positions rendered per pass (a frame shows the nearest)
+  int phase = 0;                 // frames of the gantry's back and forth gone by at the first frame
   double no_return_range = 4.5;  // the Kinect's (time-of-flight)
   int settle_sweeps = 15;        // change.settle_sweeps (cellmapd's default)
   int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
@@ -146,9 +147,9 @@ class Recording {
   }
 
   // The gantry's stop nearest to where it is at frame i: back and forth along the default plan's line over
-  // the table.
+  // the table, `phase` frames into it at frame 0.
   [[nodiscard]] int stop_of(std::size_t i) const {
-    const std::size_t j = i % (2 * pass_frames_);
+    const std::size_t j = (i + static_cast<std::size_t>(options_.phase)) % (2 * pass_frames_);
     const double along =
         j < pass_frames_ ? double(j) / double(pass_frames_) : 2.0 - double(j) / double(pass_frames_);
     return static_cast<int>(std::lround(along * (stops_ - 1)));
@@ -456,10 +457,11 @@ void write_recordings(const Options& options, const Recording& recording, std::v
   for (Camera& camera : cameras) recording.write(camera);
   std::printf(
       "recordings: %zu frames per camera at %.1f Hz (%.1f s), Kinect v2 512x424 (no_return_range %.1f m) "
-      "and RealSense D435 848x480; the crate appears or goes %zu times from %.1f s on, every %.1f s; "
-      "rendered and written in %.1f s\n",
-      recording.frames(), options.rate, options.seconds, options.no_return_range, recording.changes(),
-      options.warmup, options.change_every,
+      "and RealSense D435 848x480; the gantry %d frames into its back and forth at the first frame; the "
+      "crate "
+      "appears or goes %zu times from %.1f s on, every %.1f s; rendered and written in %.1f s\n",
+      recording.frames(), options.rate, options.seconds, options.no_return_range, options.phase,
+      recording.changes(), options.warmup, options.change_every,
       std::chrono::duration<double>(Clock::now() - render_start).count());
 }
 
@@ -675,6 +677,11 @@ int main(int argc, char** argv) {
                  "frames that close a sweep (sweep_frames; 0 = only sweep_period)")
       ->check(CLI::Range(0, 100000));
   app.add_option("--stops", options.stops, "gantry positions rendered per pass")->check(CLI::Range(2, 1000));
+  app.add_option(
+         "--phase", options.phase,
+         "frames of the gantry's back and forth gone by at the first frame: where the sweeps (grouped "
+         "from the first frame's stamp) fall in its passes")
+      ->check(CLI::Range(0, 100000));
   app.add_option("--domain", options.domain, "DDS domain id")->check(CLI::Range(0, 232));
   CLI11_PARSE(app, argc, argv);
   try {
