@@ -36,7 +36,10 @@
 #include <thread>
 #include <vector>
 
+#include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/cell/frame_grouper.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/research/evaluate.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 #include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/sim/default_scene.hpp"
@@ -67,6 +70,7 @@ struct Options {
   int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
   int domain = 144;
   int anchor_frames = 6;  // frames per camera fused by the anchor
+  bool offline = false;   // the recordings through the cell pipeline alone, boxes scored (run_offline)
 };
 
 using bench::Arrival;
@@ -626,6 +630,118 @@ void print_ratios(const std::vector<Camera>& cameras, const Totals& t, std::size
               played ? static_cast<double>(t.fused) / static_cast<double>(played) : NAN);
 }
 
+// --- offline: the recordings through the cell pipeline alone, the boxes scored ---------------------------
+
+// How the boxes stand for the cell as it is: their count, the free space they block over the obstacles' own
+// volume (the whole cell, research/evaluate.hpp), and the crate: boxed on its own while it stands there (a
+// box with IoU >= 0.2 with it, holding its centre), its place free while it is away.
+struct Standing {
+  std::size_t boxes = 0;
+  double blocked = 0.0;
+  bool crate_there = false, crate_boxed = false, place_free = false;
+};
+
+Standing standing(const std::vector<Box>& boxes, bool crate_there) {
+  sim::Scene scene = sim::default_scene();
+  if (crate_there) scene.obstacles.push_back(crate());
+  const sim::BoxScore score = sim::score_boxes(scene.obstacles, boxes, Cloud(), scene.cell, 0.02);
+  const Eigen::Vector3d centre = crate().X_CO.translation();
+  const bool held = std::any_of(boxes.begin(), boxes.end(), [&](const Box& b) { return b.contains(centre); });
+  Standing out;
+  out.boxes = boxes.size();
+  out.blocked = score.blocked_free_space;
+  out.crate_there = crate_there;
+  for (const sim::ObjectScore& o : score.objects) out.crate_boxed |= o.name == "bench_crate" && o.iou >= 0.2;
+  out.crate_boxed = out.crate_boxed && held;
+  out.place_free = !held;
+  return out;
+}
+
+// The cameras' replays as cellmapd opens them (their directories, poses and intrinsics).
+std::vector<std::unique_ptr<ReplaySource>> open_replays(const std::vector<Camera>& cameras,
+                                                        const fs::path& dir) {
+  std::vector<std::unique_ptr<ReplaySource>> replays;
+  for (const Camera& camera : cameras) {
+    ReplayConfig config;
+    config.name = camera.name;
+    config.directory = (dir / camera.name).string();
+    replays.push_back(std::make_unique<ReplaySource>(config));
+    const SourceStatus status = replays.back()->open();
+    if (!status.reason.empty()) throw Error("replay " + camera.name + ": " + status.reason);
+  }
+  return replays;
+}
+
+void print_standing(double stamp, const Standing& s) {
+  std::printf(
+      "  at %5.2f s, the crate %s: %zu boxes blocking %.1f %% of the obstacles' volume in free space; %s\n",
+      stamp, s.crate_there ? "there" : "away", s.boxes, 100 * s.blocked,
+      s.crate_there ? (s.crate_boxed ? "the crate boxed on its own" : "the crate NOT boxed on its own")
+                    : (s.place_free ? "its place free" : "its place blocked"));
+}
+
+// Plays the recordings through CellPipeline on this thread, frame by frame in stamp order, grouped into
+// sweeps by cellmapd's FrameGrouper: the daemon's versions without its threads, DDS or timing, so a run is
+// the same every time. Prints each version, how the boxes stand before each change of the crate and at the
+// end, and how often the crate was boxed on its own.
+int run_offline(const Options& options) {
+  const ScratchDir dir;
+  const Recording recording(options, dir.path);
+  std::vector<Camera> cameras{
+      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
+      {"realsense", d435_848x480(), 0.0}};
+  write_recordings(options, recording, cameras);
+  const daemon::DaemonConfig config = daemon_config(options, cameras, dir.path);
+  const std::vector<std::unique_ptr<ReplaySource>> replays = open_replays(cameras, dir.path);
+  CellPipeline pipeline(config.pipeline);
+  FrameGrouper grouper(config.sources.front().grouping);
+  FrameSweep open;
+  std::size_t versions = 0;
+  const auto close = [&] {
+    if (open.frames.empty()) return;
+    const double stamp = open.stamp;
+    const SweepReport report = pipeline.process(std::move(open));
+    open = {};
+    if (!report.change) return;
+    std::printf("version %zu at %5.2f s: +%zu ~%zu -%zu, %zu boxes; %zu voxels re-segmented in %.1f ms\n",
+                ++versions, stamp, report.change->added.size(), report.change->modified.size(),
+                report.change->removed.size(), report.boxes, report.evidence, 1e3 * report.t_segment);
+    if (versions == 1) print_standing(stamp, standing(pipeline.boxes(), false));
+  };
+  std::size_t there = 0, boxed = 0, away = 0, freed = 0;
+  for (std::size_t i = 0; i < recording.frames(); ++i) {
+    for (std::size_t c = 0; c < cameras.size(); ++c) {
+      Frame frame = replays[c]->load(i);
+      frame.X_CS = replays[c]->poses()[i].X_CE * cameras[c].X_ES;
+      const FramePlace place = grouper.place(frame.sensor, frame.stamp);
+      if (place.ends_open_sweep) close();
+      open.stamp = frame.stamp;
+      open.frames.push_back(SweepFrame{std::move(frame), std::nullopt, cameras[c].no_return_range});
+      if (place.completes_sweep) close();
+    }
+    const double t = recording.stamp_of(i);
+    const bool last = i + 1 == recording.frames();
+    if (t < options.warmup ||
+        (!last && recording.crate_at(recording.stamp_of(i + 1)) == recording.crate_at(t)))
+      continue;
+    const Standing now = standing(pipeline.boxes(), recording.crate_at(t));
+    print_standing(t, now);
+    if (now.crate_there) {
+      ++there;
+      boxed += now.crate_boxed ? 1 : 0;
+    } else {
+      ++away;
+      freed += now.place_free ? 1 : 0;
+    }
+  }
+  close();
+  std::printf(
+      "versions: %zu for %zu changes of the crate; the crate boxed on its own %zu of %zu times, its place "
+      "free %zu of %zu times (just before each change, and at the end)\n",
+      versions, recording.changes(), boxed, there, freed, away);
+  return 0;
+}
+
 int run(const Options& options) {
   const ScratchDir dir;
   const Recording recording(options, dir.path);
@@ -683,9 +799,12 @@ int main(int argc, char** argv) {
          "from the first frame's stamp) fall in its passes")
       ->check(CLI::Range(0, 100000));
   app.add_option("--domain", options.domain, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_flag("--offline", options.offline,
+               "play the recordings through the cell pipeline alone, as fast as it goes, and score the boxes "
+               "before each change of the crate (no daemon, no DDS, no timing: the same every run)");
   CLI11_PARSE(app, argc, argv);
   try {
-    return run(options);
+    return options.offline ? run_offline(options) : run(options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench daemon: %s\n", e.what());
     return 1;

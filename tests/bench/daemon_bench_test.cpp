@@ -30,4 +30,16 @@ TEST(DaemonBenchTest, FusesEveryFrameOfBothCamerasAtALowRate) {
       << run.output;
 }
 
+TEST(DaemonBenchTest, OfflineScoresTheCrateBeforeEachOfItsChanges) {
+  // 5 Hz for 14 s, the crate there from 6 to 10 s: the pipeline alone boxes it on its own while it stands and
+  // frees its place once it is gone. No DDS here, so no domain.
+  const BenchRun run =
+      run_bench("--offline --rate 5 --seconds 14 --settle-sweeps 3 --warmup 6 --change-every 4");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_GE(number_after(run.output, "versions:"), 2) << run.output;
+  EXPECT_NE(run.output.find("the crate boxed on its own 1 of 1 times, its place free 1 of 1 times"),
+            std::string::npos)
+      << run.output;
+}
+
 }  // namespace
