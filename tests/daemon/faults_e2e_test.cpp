@@ -204,6 +204,8 @@ TEST(SecuredVersionKeeperTest, RefusedDdsWriteIsRetriedUntilItGoesOut) {
   argv.insert(argv.end(), flags.begin(), flags.end());
   test::ChildProcess echo(argv);
   ASSERT_TRUE(publisher.wait_for_subscribers(1, test::kDaemonPatience)) << "the tool's echo never matched";
+  ASSERT_TRUE(publisher.wait_for_snapshot_readers(1, test::kDaemonPatience))
+      << "the tool's echo never matched the snapshots";
 
   bool refuse = false;
   const test::TempDir dir;

@@ -20,7 +20,8 @@ EnvironmentPublisher::EnvironmentPublisher(const dds::Participant& participant, 
       delta_topic_(participant, &cellmap_msg_EnvironmentDelta_desc, kEnvironmentDeltaTopic),
       status_topic_(participant, &cellmap_msg_Status_desc, kStatusTopic),
       snapshot_writer_(participant, snapshot_topic_, writer_qos(in_cell(environment_qos(), cell_))),
-      delta_writer_(participant, delta_topic_, writer_qos(in_cell(environment_delta_qos(delta_depth), cell_))),
+      delta_writer_(participant, delta_topic_,
+                    writer_qos(in_cell(environment_delta_qos(delta_depth), cell_))),
       status_writer_(participant, status_topic_, writer_qos(in_cell(status_qos(), cell_))) {}
 
 void EnvironmentPublisher::check_version(const Environment& env) const {
@@ -58,6 +59,11 @@ void EnvironmentPublisher::publish_status(const CellStatus& status) {
 
 bool EnvironmentPublisher::wait_for_subscribers(std::uint32_t count, std::chrono::nanoseconds timeout) const {
   return delta_writer_.wait_for_readers(count, timeout);
+}
+
+bool EnvironmentPublisher::wait_for_snapshot_readers(std::uint32_t count,
+                                                     std::chrono::nanoseconds timeout) const {
+  return snapshot_writer_.wait_for_readers(count, timeout);
 }
 
 std::uint32_t EnvironmentPublisher::subscribers_joined() const {

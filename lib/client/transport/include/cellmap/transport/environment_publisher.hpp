@@ -39,6 +39,10 @@ class EnvironmentPublisher final {
   /// Blocks until `count` readers of the delta topic (every subscriber and monitor has one) matched or the
   /// timeout passed; true if they did.
   bool wait_for_subscribers(std::uint32_t count, std::chrono::nanoseconds timeout) const;
+  /// As above for readers of the snapshot topic (monitors, and subscribers while they need a snapshot):
+  /// the two topics' readers match independently, so a sample written before its topic matched reaches a
+  /// late reader only as that topic's history.
+  bool wait_for_snapshot_readers(std::uint32_t count, std::chrono::nanoseconds timeout) const;
   /// How many readers of the delta topic ever matched (grows by one per subscriber that joins).
   [[nodiscard]] std::uint32_t subscribers_joined() const;
 
