@@ -149,6 +149,41 @@ TEST(CellPipelineResegmentTest, ABoxWithSomethingNewBesideItIsReSegmented) {
   expect_held(result.reconciled.boxes, occupied);
 }
 
+// A crate put on the table is one new box, exactly its voxels' bounds: the table's box holds the rest.
+TEST(CellPipelineResegmentTest, ANewObjectOneBoxHoldsTightlyIsThatBox) {
+  std::vector<Eigen::Vector3d> occupied = voxels({0, 0, 0.70}, {1.0, 0.4, 0.74});
+  const Box slab = box_of(3, {0, 0, 0.70}, {1.0, 0.4, 0.74}, occupied.size());
+  const std::vector<Eigen::Vector3d> crate = voxels({0.34, 0.1, 0.74}, {0.64, 0.3, 0.80});
+  occupied.insert(occupied.end(), crate.begin(), crate.end());
+  const Table table(occupied, {slab});
+
+  const Resegmentation result = table.resegment({}, crate);
+  EXPECT_EQ(result.evidence, crate.size());
+  ASSERT_EQ(result.reconciled.added.size(), 1u);
+  const Box& added = result.reconciled.added.front();
+  EXPECT_TRUE(added.center.isApprox(Eigen::Vector3d(0.49, 0.2, 0.77), 1e-6)) << added.center.transpose();
+  EXPECT_TRUE(added.half_extents.isApprox(Eigen::Vector3d(0.15, 0.1, 0.03), 1e-3))
+      << added.half_extents.transpose();
+  expect_held(result.reconciled.boxes, occupied);
+}
+
+// A flat L put on the table: its one box would block a quarter of itself in space seen free, so it is
+// segmented, and its two arms get a box each.
+TEST(CellPipelineResegmentTest, ANewObjectOneBoxWouldHoldLooselyIsSegmented) {
+  std::vector<Eigen::Vector3d> occupied = voxels({0, 0, 0.70}, {1.0, 0.4, 0.74});
+  const Box slab = box_of(3, {0, 0, 0.70}, {1.0, 0.4, 0.74}, occupied.size());
+  std::vector<Eigen::Vector3d> l_shape = voxels({0.2, 0.04, 0.74}, {0.6, 0.14, 0.80});
+  const std::vector<Eigen::Vector3d> arm = voxels({0.2, 0.14, 0.74}, {0.3, 0.36, 0.80});
+  l_shape.insert(l_shape.end(), arm.begin(), arm.end());
+  occupied.insert(occupied.end(), l_shape.begin(), l_shape.end());
+  const Table table(occupied, {slab});
+
+  const Resegmentation result = table.resegment({}, l_shape);
+  EXPECT_EQ(result.evidence, l_shape.size());
+  EXPECT_EQ(result.reconciled.added.size(), 2u);
+  expect_held(result.reconciled.boxes, occupied);
+}
+
 // An object taken away and put back after a version (made by another change) dropped its box but before the
 // change detector would have confirmed the removal: its return is reported and boxed like any new object,
 // not taken for its voxels falling back to their confirmed state (which would leave it outside every box).

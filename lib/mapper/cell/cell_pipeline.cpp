@@ -383,8 +383,27 @@ std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const 
   }
   evidence = cloud.size();
   if (cloud.empty()) return {};
+  if (std::optional<Box> box = one_tight_box(cloud)) return {*box};
   cloud.sensor_origin_ = Eigen::Vector4f(viewpoint_C_.x(), viewpoint_C_.y(), viewpoint_C_.z(), 0.0f);
   return segment_cloud(cloud, config_.segment).boxes.boxes;
+}
+
+// Evidence that is one connected piece, and whose one box blocks at most join_max_growth of its volume in
+// seen free space, is that box when segments are split and joined by free space: the join would make one box
+// of any parts the segmentation cut it into (their union blocks no more than that), and no cut frees
+// min_gain (> join_max_growth) of it. Such is a compact object on its own, or a surface coming into view
+// piece by piece; its segmentation would end in the same box at several times the cost.
+std::optional<Box> CellPipeline::one_tight_box(const Cloud& cloud) const {
+  if (config_.segment.split_method != SplitMethod::kFreeSpace || config_.segment.join_max_growth <= 0)
+    return std::nullopt;
+  const double voxel = map_.config().resolution;
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(cloud.size());
+  for (const pcl::PointXYZ& p : cloud) centres.push_back(p.getVector3fMap().cast<double>());
+  if (connected_groups(centres, voxel).size() != 1) return std::nullopt;
+  const Box box = fit_box(centres, config_.segment.box_kind, voxel);
+  if (seen_free_share(cloud, box, viewpoint_C_, voxel) > config_.segment.join_max_growth) return std::nullopt;
+  return box;
 }
 
 Resegmentation CellPipeline::resegment_everything() const {

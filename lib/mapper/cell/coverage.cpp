@@ -54,43 +54,6 @@ int cheapest_growth(const std::vector<Box>& boxes, const std::vector<Box>& befor
   return best;
 }
 
-// Groups of 26-connected voxels (centres on the voxel grid), in the order of their first voxel.
-std::vector<std::vector<Eigen::Vector3d>> connected_groups(const std::vector<Eigen::Vector3d>& centres_C,
-                                                           double voxel) {
-  const auto cell_of = [&](const Eigen::Vector3d& c) {
-    return Eigen::Vector3i((c / voxel).array().floor().cast<int>());
-  };
-  const auto hash = [](const Eigen::Vector3i& v) {
-    return (static_cast<std::size_t>(v.x()) * 73856093u) ^ (static_cast<std::size_t>(v.y()) * 19349663u) ^
-           (static_cast<std::size_t>(v.z()) * 83492791u);
-  };
-  std::unordered_map<Eigen::Vector3i, int, decltype(hash)> index(centres_C.size(), hash);
-  for (std::size_t i = 0; i < centres_C.size(); ++i)
-    index.emplace(cell_of(centres_C[i]), static_cast<int>(i));
-  std::vector<int> group(centres_C.size(), -1);
-  std::vector<std::vector<Eigen::Vector3d>> groups;
-  for (std::size_t seed = 0; seed < centres_C.size(); ++seed) {
-    if (group[seed] >= 0) continue;
-    const int g = static_cast<int>(groups.size());
-    groups.emplace_back();
-    std::vector<int> stack{static_cast<int>(seed)};
-    group[seed] = g;
-    while (!stack.empty()) {
-      const int i = stack.back();
-      stack.pop_back();
-      groups[g].push_back(centres_C[i]);
-      const Eigen::Vector3i at = cell_of(centres_C[i]);
-      for (int n = 0; n < 27; ++n) {
-        const auto it = index.find(at + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1));
-        if (it == index.end() || group[it->second] >= 0) continue;
-        group[it->second] = g;
-        stack.push_back(it->second);
-      }
-    }
-  }
-  return groups;
-}
-
 // Grows `boxes` (`before`: as they were before the pass, same order) to take every voxel of `group`, each by
 // the box that grows least for it, and lists the boxes grown in `grown`. A group that some voxel of lies
 // beyond every box's reach is an object, or part of one, rather than a surface filling in: it leaves the
@@ -134,6 +97,42 @@ void record_grown(Reconciled& reconciled, const Box& box) {
 }
 
 }  // namespace
+
+std::vector<std::vector<Eigen::Vector3d>> connected_groups(const std::vector<Eigen::Vector3d>& centres_C,
+                                                           double voxel) {
+  const auto cell_of = [&](const Eigen::Vector3d& c) {
+    return Eigen::Vector3i((c / voxel).array().floor().cast<int>());
+  };
+  const auto hash = [](const Eigen::Vector3i& v) {
+    return (static_cast<std::size_t>(v.x()) * 73856093u) ^ (static_cast<std::size_t>(v.y()) * 19349663u) ^
+           (static_cast<std::size_t>(v.z()) * 83492791u);
+  };
+  std::unordered_map<Eigen::Vector3i, int, decltype(hash)> index(centres_C.size(), hash);
+  for (std::size_t i = 0; i < centres_C.size(); ++i)
+    index.emplace(cell_of(centres_C[i]), static_cast<int>(i));
+  std::vector<int> group(centres_C.size(), -1);
+  std::vector<std::vector<Eigen::Vector3d>> groups;
+  for (std::size_t seed = 0; seed < centres_C.size(); ++seed) {
+    if (group[seed] >= 0) continue;
+    const int g = static_cast<int>(groups.size());
+    groups.emplace_back();
+    std::vector<int> stack{static_cast<int>(seed)};
+    group[seed] = g;
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      groups[g].push_back(centres_C[i]);
+      const Eigen::Vector3i at = cell_of(centres_C[i]);
+      for (int n = 0; n < 27; ++n) {
+        const auto it = index.find(at + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1));
+        if (it == index.end() || group[it->second] >= 0) continue;
+        group[it->second] = g;
+        stack.push_back(it->second);
+      }
+    }
+  }
+  return groups;
+}
 
 bool holds_cube(const Box& box, const Eigen::Vector3d& centre_C, double edge) {
   const Eigen::Matrix3d R = box.rotation.toRotationMatrix();

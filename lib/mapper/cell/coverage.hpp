@@ -68,6 +68,11 @@ class OccupiedVoxels final {
                                                           const std::vector<Box>& boxes, int min_group,
                                                           int threads = 1);
 
+/// The 26-connected groups of voxels given by their centres (on the grid of edge `voxel`), each in the
+/// order its voxels were reached, the groups in the order of their first voxel.
+[[nodiscard]] std::vector<std::vector<Eigen::Vector3d>> connected_groups(
+    const std::vector<Eigen::Vector3d>& centres_C, double voxel);
+
 /// How the safety pass covers what is left out.
 struct CoverParams final {
   double voxel = 0.02;  ///< voxel edge, metres

@@ -194,6 +194,7 @@ class CellPipeline final {
   // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
                                            std::size_t& evidence) const;
+  [[nodiscard]] std::optional<Box> one_tight_box(const Cloud& evidence) const;
   // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
   void cover_the_rest(Reconciled& reconciled) const;
   void restore(const std::string& map_state);
