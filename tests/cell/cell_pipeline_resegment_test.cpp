@@ -159,6 +159,7 @@ TEST(CellPipelineResegmentTest, ANewObjectOneBoxHoldsTightlyIsThatBox) {
 
   const Resegmentation result = table.resegment({}, crate);
   EXPECT_EQ(result.evidence, crate.size());
+  EXPECT_TRUE(result.one_tight_box);
   ASSERT_EQ(result.reconciled.added.size(), 1u);
   const Box& added = result.reconciled.added.front();
   EXPECT_TRUE(added.center.isApprox(Eigen::Vector3d(0.49, 0.2, 0.77), 1e-6)) << added.center.transpose();
@@ -180,8 +181,61 @@ TEST(CellPipelineResegmentTest, ANewObjectOneBoxWouldHoldLooselyIsSegmented) {
 
   const Resegmentation result = table.resegment({}, l_shape);
   EXPECT_EQ(result.evidence, l_shape.size());
+  EXPECT_FALSE(result.one_tight_box);
   EXPECT_EQ(result.reconciled.added.size(), 2u);
   expect_held(result.reconciled.boxes, occupied);
+}
+
+// A surface, rippled so that its box blocks a quarter of itself in space seen free (columns of voxels along
+// x, 0–5 voxels high and back: low at x = 0.29, high at 0.79), x from `x0` to `x1`.
+std::vector<Eigen::Vector3d> ripples(double x0, double x1) {
+  std::vector<Eigen::Vector3d> out;
+  for (double x = x0 + 0.5 * kVoxel; x < x1; x += kVoxel) {
+    const int column = static_cast<int>(std::lround(x / kVoxel - 0.5) + 6) % 10;
+    const double z = 0.70 + kVoxel * (0.5 + (column <= 5 ? column : 10 - column));
+    for (double y = 0.5 * kVoxel; y < 0.4; y += kVoxel) out.emplace_back(x, y, z);
+  }
+  return out;
+}
+
+// The rippled surface comes into view a column further on each side of its box: the box grows to take
+// both (they block little more than the box did), with no segmentation.
+TEST(CellPipelineResegmentTest, ASurfaceComingIntoViewBesideItsBoxGrowsThatBox) {
+  const std::vector<Eigen::Vector3d> seen = ripples(0.3, 0.78);
+  const std::vector<Eigen::Vector3d> occupied = ripples(0.28, 0.8);
+  std::vector<Eigen::Vector3d> appeared = ripples(0.28, 0.3);
+  const std::vector<Eigen::Vector3d> right = ripples(0.78, 0.8);
+  appeared.insert(appeared.end(), right.begin(), right.end());
+  const Table table(occupied, {box_of(4, {0.3, 0, 0.70}, {0.78, 0.4, 0.82}, seen.size())});
+
+  const Resegmentation result = table.resegment({}, appeared);
+  EXPECT_EQ(result.evidence, occupied.size());
+  EXPECT_TRUE(result.one_tight_box);
+  ASSERT_EQ(result.reconciled.boxes.size(), 1u);
+  const Box& grown = result.reconciled.boxes.front();
+  EXPECT_EQ(grown.id, 4u);
+  EXPECT_TRUE(grown.center.isApprox(Eigen::Vector3d(0.54, 0.2, 0.76), 1e-6)) << grown.center.transpose();
+  EXPECT_TRUE(grown.half_extents.isApprox(Eigen::Vector3d(0.26, 0.2, 0.06), 1e-3))
+      << grown.half_extents.transpose();
+  expect_held(result.reconciled.boxes, occupied);
+}
+
+// Walls put up at both ends of the rippled surface: one box of them all would block the space over the
+// whole surface, so they are segmented, and that space stays free.
+TEST(CellPipelineResegmentTest, WallsBesideABoxThatOneBoxWouldHoldLooselyAreSegmented) {
+  const std::vector<Eigen::Vector3d> surface = ripples(0.3, 0.78);
+  std::vector<Eigen::Vector3d> occupied = surface, posts = voxels({0.22, 0, 0.70}, {0.3, 0.4, 1.0});
+  const std::vector<Eigen::Vector3d> right = voxels({0.78, 0, 0.70}, {0.86, 0.4, 1.0});
+  posts.insert(posts.end(), right.begin(), right.end());
+  occupied.insert(occupied.end(), posts.begin(), posts.end());
+  const Table table(occupied, {box_of(4, {0.3, 0, 0.70}, {0.78, 0.4, 0.82}, surface.size())});
+
+  const Resegmentation result = table.resegment({}, posts);
+  EXPECT_EQ(result.evidence, occupied.size());
+  EXPECT_FALSE(result.one_tight_box);
+  expect_held(result.reconciled.boxes, occupied);
+  const Eigen::Vector3d over_the_surface(0.54, 0.2, 0.9);
+  for (const Box& box : result.reconciled.boxes) EXPECT_FALSE(box.contains(over_the_surface)) << box.id;
 }
 
 // An object taken away and put back after a version (made by another change) dropped its box but before the

@@ -48,9 +48,9 @@ Box box_in_rotation(const Cloud& centres, const Box& like, double voxel) {
   return box;
 }
 
-// The share of `box`'s volume seen free around the voxel centres it holds, judged as the segmentation
-// judges its boxes (box_split.hpp): direction bins a voxel wide at the median range, surfaces a voxel thick.
-double seen_free_share(const Cloud& centres, const Box& box, const Eigen::Vector3d& viewpoint, double voxel) {
+// The space seen free around voxel centres, judged as the segmentation judges its boxes (box_split.hpp):
+// direction bins a voxel wide at the median range, surfaces a voxel thick.
+SeenFreeSpace seen_free_around(const Cloud& centres, const Eigen::Vector3d& viewpoint, double voxel) {
   std::vector<int> indices(centres.size());
   std::vector<double> range(centres.size());
   for (std::size_t i = 0; i < centres.size(); ++i) {
@@ -59,8 +59,32 @@ double seen_free_share(const Cloud& centres, const Box& box, const Eigen::Vector
   }
   std::nth_element(range.begin(), range.begin() + range.size() / 2, range.end());
   const double step = voxel / std::max(range[range.size() / 2], 10 * voxel);
-  const SeenFreeSpace seen(centres, indices, viewpoint, step, voxel);
-  return seen.free_volume(box) / box.volume();
+  return SeenFreeSpace(centres, indices, viewpoint, step, voxel);
+}
+
+// The share of `box`'s volume seen free around the voxel centres it holds.
+double seen_free_share(const Cloud& centres, const Box& box, const Eigen::Vector3d& viewpoint, double voxel) {
+  return seen_free_around(centres, viewpoint, voxel).free_volume(box) / box.volume();
+}
+
+// The free space (as `seen` judges it) that `parts` block, each shrunk in its rotation to the voxels of
+// `centres` it holds (each voxel counted in the first part holding it); parts holding none block nothing.
+double free_volume_of_parts(const Cloud& centres, const std::vector<Box>& parts, const SeenFreeSpace& seen,
+                            double voxel) {
+  std::vector<Cloud> held(parts.size());
+  for (const pcl::PointXYZ& p : centres) {
+    const Eigen::Vector3d c = p.getVector3fMap().cast<double>();
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (!parts[i].contains(c)) continue;
+      held[i].push_back(p);
+      break;
+    }
+  }
+  double free = 0.0;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (!held[i].empty()) free += seen.free_volume(box_in_rotation(held[i], parts[i], voxel));
+  }
+  return free;
 }
 
 }  // namespace
@@ -266,7 +290,7 @@ Resegmentation CellPipeline::resegment(const ChangeSet& changes) const {
     if (!contains_id(scope.boxes, box.id)) kept.push_back(box);
   }
   Resegmentation result;
-  std::vector<Box> fitted = fit_boxes(scope.area, kept, result.evidence);
+  std::vector<Box> fitted = fit_boxes(scope.area, kept, scope.within, result);
   fitted.insert(fitted.end(), scope.shrunk.begin(), scope.shrunk.end());
   result.reconciled = reconcile(boxes_, scope.boxes, fitted, next_box_id_, config_.reconcile);
   // Noise alone makes no version: what it added is taken up by the next version a change makes.
@@ -351,8 +375,10 @@ void CellPipeline::add_boxes_within(Scope& scope) const {
     const auto holds = [&](const Region& r) {
       return r.grown(resolution).intersection(bounds).volume() >= bounds.volume();
     };
-    if (!contains_id(scope.boxes, box.id) && std::any_of(scope.area.begin(), scope.area.end(), holds))
+    if (!contains_id(scope.boxes, box.id) && std::any_of(scope.area.begin(), scope.area.end(), holds)) {
       scope.boxes.push_back(box.id);
+      scope.within.push_back(box);
+    }
   }
 }
 
@@ -371,7 +397,7 @@ void CellPipeline::add_emptied_boxes(Scope& scope) const {
 }
 
 std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                         std::size_t& evidence) const {
+                                         const std::vector<Box>& within, Resegmentation& result) const {
   Cloud cloud;
   CubeHolders kept_boxes(kept, map_.config().resolution);
   for (const Eigen::Vector3d& c : map_.occupied_centres(area)) {
@@ -381,19 +407,24 @@ std::vector<Box> CellPipeline::fit_boxes(const std::vector<Region>& area, const 
     // Evidence a kept box already holds needs no new box (e.g. the table around a new object).
     if (!kept_boxes.hold(c)) cloud.push_back(pcl::PointXYZ(c.x(), c.y(), c.z()));
   }
-  evidence = cloud.size();
+  result.evidence = cloud.size();
   if (cloud.empty()) return {};
-  if (std::optional<Box> box = one_tight_box(cloud)) return {*box};
+  if (std::optional<Box> box = one_tight_box(cloud, within)) {
+    result.one_tight_box = true;
+    return {*box};
+  }
   cloud.sensor_origin_ = Eigen::Vector4f(viewpoint_C_.x(), viewpoint_C_.y(), viewpoint_C_.z(), 0.0f);
   return segment_cloud(cloud, config_.segment).boxes.boxes;
 }
 
-// Evidence that is one connected piece, and whose one box blocks at most join_max_growth of its volume in
-// seen free space, is that box when segments are split and joined by free space: the join would make one box
-// of any parts the segmentation cut it into (their union blocks no more than that), and no cut frees
+// Evidence that is one connected piece is one box when that box blocks at most join_max_growth of its
+// volume more seen free space than the boxes it grows from, `parts` (boxes the change area took whole, each
+// shrunk to the evidence it holds; none for a new object: then it must block at most that share in all).
+// That is the join rule: the segmentation would join any parts it cut the evidence into, and no cut frees
 // min_gain (> join_max_growth) of it. Such is a compact object on its own, or a surface coming into view
-// piece by piece; its segmentation would end in the same box at several times the cost.
-std::optional<Box> CellPipeline::one_tight_box(const Cloud& cloud) const {
+// piece by piece beside its old box (the floor beyond the table's end); segmenting it would end in the same
+// box at several times the cost.
+std::optional<Box> CellPipeline::one_tight_box(const Cloud& cloud, const std::vector<Box>& parts) const {
   if (config_.segment.split_method != SplitMethod::kFreeSpace || config_.segment.join_max_growth <= 0)
     return std::nullopt;
   const double voxel = map_.config().resolution;
@@ -402,7 +433,9 @@ std::optional<Box> CellPipeline::one_tight_box(const Cloud& cloud) const {
   for (const pcl::PointXYZ& p : cloud) centres.push_back(p.getVector3fMap().cast<double>());
   if (connected_groups(centres, voxel).size() != 1) return std::nullopt;
   const Box box = fit_box(centres, config_.segment.box_kind, voxel);
-  if (seen_free_share(cloud, box, viewpoint_C_, voxel) > config_.segment.join_max_growth) return std::nullopt;
+  const SeenFreeSpace seen = seen_free_around(cloud, viewpoint_C_, voxel);
+  const double growth = seen.free_volume(box) - free_volume_of_parts(cloud, parts, seen, voxel);
+  if (growth > config_.segment.join_max_growth * box.volume()) return std::nullopt;
   return box;
 }
 
@@ -415,7 +448,7 @@ Resegmentation CellPipeline::resegment_everything() const {
   std::vector<std::uint64_t> scope;
   for (const Box& box : boxes_) scope.push_back(box.id);
   Resegmentation result;
-  const std::vector<Box> fitted = fit_boxes({whole}, {}, result.evidence);
+  const std::vector<Box> fitted = fit_boxes({whole}, {}, {}, result);
   result.reconciled = reconcile(boxes_, scope, fitted, next_box_id_, config_.reconcile);
   cover_the_rest(result.reconciled);
   return result;

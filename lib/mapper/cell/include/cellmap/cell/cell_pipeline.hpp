@@ -92,6 +92,9 @@ struct SweepReport final {
 struct Resegmentation final {
   Reconciled reconciled;
   std::size_t evidence = 0;  ///< occupied voxels that were segmented
+  /// Whether the evidence was taken as one box unsegmented: one connected piece whose box blocks little more
+  /// seen free space than the old boxes it grows from (or, for a new object, little in all).
+  bool one_tight_box = false;
 };
 
 /// The incremental pipeline of one cell. Boxes are fitted to the centres of occupied voxels so that they hold
@@ -182,6 +185,7 @@ class CellPipeline final {
     std::vector<Region> area;
     std::vector<std::uint64_t> boxes;
     std::vector<Box> shrunk;
+    std::vector<Box> within;  // the boxes of `boxes` that lie wholly inside the area
   };
   [[nodiscard]] Scope scope_of(const ChangeSet& changes) const;
   // Whether `box`, which lost evidence to `changes`, shrinks in place (adds its box and the ids it replaces
@@ -191,10 +195,11 @@ class CellPipeline final {
   void add_boxes_within(Scope& scope) const;
   // Adds to `scope` the boxes that hold no obstacle voxel any more.
   void add_emptied_boxes(Scope& scope) const;
-  // Boxes for the occupied voxels in `area` that no box of `kept` covers yet; `evidence` counts those voxels.
+  // Boxes for the occupied voxels in `area` that no box of `kept` covers yet (their count and how they were
+  // fitted go to `result`); `within`: the old boxes lying wholly in the area, which they may grow from.
   [[nodiscard]] std::vector<Box> fit_boxes(const std::vector<Region>& area, const std::vector<Box>& kept,
-                                           std::size_t& evidence) const;
-  [[nodiscard]] std::optional<Box> one_tight_box(const Cloud& evidence) const;
+                                           const std::vector<Box>& within, Resegmentation& result) const;
+  [[nodiscard]] std::optional<Box> one_tight_box(const Cloud& evidence, const std::vector<Box>& parts) const;
   // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
   void cover_the_rest(Reconciled& reconciled) const;
   void restore(const std::string& map_state);
