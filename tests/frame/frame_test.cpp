@@ -132,9 +132,70 @@ TEST(DepthToPointsTest, FlyingPixelFilterDropsExactlyWhatItsDefinitionDrops) {
   EXPECT_GT(dropped, 100u) << "too few edges to test";
 }
 
+// One row: each depth becomes the mean of its neighbours within the radius and within max_depth_jump of it.
+TEST(DepthToPointsTest, SmoothingAveragesNeighboursWithinTheJumpOnly) {
+  DepthImage image;
+  image.intrinsics.width = 6;
+  image.intrinsics.height = 1;
+  image.intrinsics.fx = image.intrinsics.fy = 10.0;
+  image.intrinsics.max_depth_jump = 0.05;
+  image.intrinsics.smoothing_radius = 1;
+  image.depth = {1000, 1010, 1020, 3000, 3000, 0};
+  const Cloud organized = depth_to_points(image, true);  // one row: indexed as a list
+  EXPECT_FLOAT_EQ(organized[0].z, 1.005f);
+  EXPECT_FLOAT_EQ(organized[1].z, 1.010f);
+  EXPECT_FLOAT_EQ(organized[2].z, 1.015f) << "the pixel across the edge is no neighbour";
+  EXPECT_TRUE(std::isnan(organized[3].z)) << "behind the edge: the flying-pixel filter's";
+  EXPECT_FLOAT_EQ(organized[4].z, 3.000f);
+  EXPECT_TRUE(std::isnan(organized[5].z)) << "a hole stays a hole";
+  image.intrinsics.max_depth_jump = 0;
+  EXPECT_FLOAT_EQ(depth_to_points(image, true)[0].z, 1.0f) << "no smoothing without the edge limit";
+}
+
+// Two walls (1 m and 2 m) scattered by ±20 mm: smoothing with radius 2 leaves under a third of the scatter on
+// a wall and none of one wall's depths in the other's.
+TEST(DepthToPointsTest, SmoothingShrinksAFlatSurfacesScatterAndKeepsItsEdge) {
+  DepthImage image;
+  image.intrinsics.width = 60;
+  image.intrinsics.height = 40;
+  image.intrinsics.fx = image.intrinsics.fy = 50.0;
+  image.intrinsics.max_depth_jump = 0.05;
+  std::uint32_t state = 11;
+  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
+  for (int v = 0; v < 40; ++v) {
+    for (int u = 0; u < 60; ++u)
+      image.depth.push_back(std::uint16_t((u < 30 ? 1000 : 2000) + (next() >> 8) % 41 - 20));
+  }
+  const auto scatter = [](const Cloud& organized) {
+    double sum = 0, sq = 0;
+    int n = 0;
+    for (int v = 5; v < 35; ++v) {
+      for (int u = 5; u < 25; ++u) {
+        const double z = organized.at(u, v).z;
+        sum += z, sq += z * z, ++n;
+      }
+    }
+    return std::sqrt(sq / n - (sum / n) * (sum / n));
+  };
+  const double raw = scatter(depth_to_points(image, true));
+  image.intrinsics.smoothing_radius = 2;
+  const Cloud smoothed = depth_to_points(image, true);
+  EXPECT_LT(scatter(smoothed), 0.3 * raw) << raw;
+  for (int v = 0; v < 40; ++v) {
+    for (int u = 0; u < 60; ++u) {
+      const float z = smoothed.at(u, v).z;
+      if (std::isnan(z)) continue;  // the far wall's rim, behind the edge
+      EXPECT_NEAR(z, u < 30 ? 1.0 : 2.0, 0.021) << u << "," << v;
+    }
+  }
+}
+
 TEST(DepthToPointsTest, RejectsSizeMismatchAndBadIntrinsics) {
   DepthImage image = small_image();
   image.depth.pop_back();
+  EXPECT_THROW((void)depth_to_points(image), Error);
+  image = small_image();
+  image.intrinsics.smoothing_radius = kMaxSmoothingRadius + 1;
   EXPECT_THROW((void)depth_to_points(image), Error);
   image = small_image();
   image.intrinsics.fx = 0;

@@ -58,6 +58,13 @@ TEST(DepthIoTest, IntrinsicsYamlIsStrict) {
   write_file_atomically(dir / "off.yaml",
                         "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nmax_depth_jump: 0\n");
   EXPECT_DOUBLE_EQ(read_intrinsics_yaml(dir / "off.yaml").max_depth_jump, 0.0);
+  EXPECT_EQ(k.smoothing_radius, 0);  // smoothing is the recorder's to ask for
+  write_file_atomically(dir / "smooth.yaml",
+                        "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nsmoothing_radius: 2\n");
+  EXPECT_EQ(read_intrinsics_yaml(dir / "smooth.yaml").smoothing_radius, 2);
+  write_file_atomically(dir / "wide.yaml",
+                        "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nsmoothing_radius: 17\n");
+  EXPECT_THROW((void)read_intrinsics_yaml(dir / "wide.yaml"), Error);
   write_file_atomically(dir / "typo.yaml", "width: 4\nheight: 3\nfx: 2\nfy: 2\ncx: 1.5\ncy: 1\nfocal: 3\n");
   EXPECT_THROW((void)read_intrinsics_yaml(dir / "typo.yaml"), Error);
   write_file_atomically(dir / "nofx.yaml", "width: 4\nheight: 3\nfy: 2\ncx: 1.5\ncy: 1\n");

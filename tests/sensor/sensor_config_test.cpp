@@ -50,6 +50,10 @@ TEST(SensorConfigTest, V4l2DefaultsToTheRealSenseIntrinsics) {
   ASSERT_TRUE(v4l2.intrinsics.has_value());
   EXPECT_DOUBLE_EQ(v4l2.intrinsics->fx, realsense_d435_intrinsics(640, 480).fx);
   EXPECT_DOUBLE_EQ(v4l2.intrinsics->min_range, 0.3);
+  EXPECT_EQ(v4l2.intrinsics->smoothing_radius, kStereoSmoothingRadius);
+  EXPECT_EQ(std::get<V4l2Config>(parse("source: v4l2\nv4l2: {smoothing_radius: 0}\n").source)
+                .intrinsics->smoothing_radius,
+            0);
   EXPECT_NE(dynamic_cast<V4l2Source*>(make_depth_source(config).get()), nullptr);
 }
 

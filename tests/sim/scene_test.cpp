@@ -134,6 +134,13 @@ TEST(SceneTest, DefaultSceneIsTheRealisticCell) {
   EXPECT_GE(scene.find_sensor("kinect_v2"), 0);
   EXPECT_GE(scene.find_sensor("realsense_d435"), 0);
   EXPECT_GE(scene.find_sensor("os32c"), 0);
+  // Stereo depth is smoothed, time of flight is not.
+  EXPECT_EQ(default_intrinsics(SensorModel::kRealsenseD435).smoothing_radius, kStereoSmoothingRadius);
+  EXPECT_EQ(default_intrinsics(SensorModel::kKinectV2).smoothing_radius, 0);
+  EXPECT_EQ(without_depth_filter(scene)
+                .sensors[static_cast<std::size_t>(scene.find_sensor("realsense_d435"))]
+                .intrinsics.smoothing_radius,
+            0);
 }
 
 TEST(ObstacleTest, SignedDistanceVolumeAndSurfaceSamples) {

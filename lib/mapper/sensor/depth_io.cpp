@@ -242,6 +242,7 @@ PinholeIntrinsics read_intrinsics_yaml(const std::string& path) {
   k.min_range = map.number("min_range", 0.0, 0.0, 1e3);
   k.max_range = map.number("max_range", 10.0, 1e-9, 1e3);
   k.max_depth_jump = map.number("max_depth_jump", kDefaultMaxDepthJump, 0.0, 10.0);
+  k.smoothing_radius = static_cast<int>(map.integer("smoothing_radius", 0, 0, kMaxSmoothingRadius));
   map.expect_all_read();
   try {
     k.validate();

@@ -173,6 +173,7 @@ std::optional<PinholeIntrinsics> intrinsics_for(openni::VideoStream& stream, con
   k.min_range = config.min_range;
   k.max_range = config.max_range;
   k.max_depth_jump = config.max_depth_jump;
+  k.smoothing_radius = config.smoothing_radius;
   return k;
 }
 

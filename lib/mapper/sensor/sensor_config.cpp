@@ -58,6 +58,8 @@ OpenNI2Config read_openni2_config(YamlMap settings, const std::string& name) {
   openni2.min_range = settings.number("min_range", openni2.min_range, 0, 1000);
   openni2.max_range = settings.number("max_range", openni2.max_range, openni2.min_range + 1e-6, 1000);
   openni2.max_depth_jump = settings.number("max_depth_jump", openni2.max_depth_jump, 0, 10);
+  openni2.smoothing_radius = static_cast<int>(
+      settings.integer("smoothing_radius", openni2.smoothing_radius, 0, kMaxSmoothingRadius));
   openni2.realtime_playback = settings.get<bool>("realtime_playback", true);
   openni2.reconnect = read_reconnect(settings);
   settings.expect_all_read();
@@ -82,6 +84,8 @@ V4l2Config read_v4l2_config(YamlMap settings, const std::string& name) {
   k.min_range = settings.number("min_range", 0.3, 0, 1000);
   k.max_range = settings.number("max_range", 10.0, k.min_range + 1e-6, 1000);
   k.max_depth_jump = settings.number("max_depth_jump", kStereoMaxDepthJump, 0, 10);
+  k.smoothing_radius =
+      static_cast<int>(settings.integer("smoothing_radius", kStereoSmoothingRadius, 0, kMaxSmoothingRadius));
   v4l2.intrinsics = k;
   v4l2.buffers = static_cast<int>(settings.integer("buffers", v4l2.buffers, 2, 32));
   v4l2.reconnect = read_reconnect(settings);

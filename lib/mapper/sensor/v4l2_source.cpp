@@ -164,6 +164,7 @@ PinholeIntrinsics realsense_d435_intrinsics(int width, int height) {
   k.min_range = 0.3;
   k.max_range = 10.0;
   k.max_depth_jump = kStereoMaxDepthJump;
+  k.smoothing_radius = kStereoSmoothingRadius;
   return k;
 }
 

@@ -102,7 +102,8 @@ void write_intrinsics(const std::filesystem::path& path, const PinholeIntrinsics
   out += "fx: " + number(k.fx) + "\nfy: " + number(k.fy) + "\ncx: " + number(k.cx) + "\ncy: " + number(k.cy) +
          "\n";
   out += "depth_scale: " + number(k.depth_scale) + "\nmin_range: " + number(k.min_range) +
-         "\nmax_range: " + number(k.max_range) + "\nmax_depth_jump: " + number(k.max_depth_jump) + "\n";
+         "\nmax_range: " + number(k.max_range) + "\nmax_depth_jump: " + number(k.max_depth_jump) +
+         "\nsmoothing_radius: " + std::to_string(k.smoothing_radius) + "\n";
   write_file_atomically(path, out);
 }
 

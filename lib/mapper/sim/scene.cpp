@@ -179,6 +179,8 @@ PinholeIntrinsics read_intrinsics(YamlMap map, SensorModel model) {
   k.max_range = map.number("max_range", k.max_range, 0.0, 1000.0);
   if (!(k.max_range > k.min_range)) map.fail("max_range", "must be greater than min_range");
   k.max_depth_jump = map.number("max_depth_jump", k.max_depth_jump, 0.0, 10.0);
+  k.smoothing_radius =
+      static_cast<int>(map.integer("smoothing_radius", k.smoothing_radius, 0, kMaxSmoothingRadius));
   map.expect_all_read();
   return k;
 }
@@ -463,7 +465,10 @@ void LineScanner::validate() const {
 }
 
 Scene without_depth_filter(Scene scene) {
-  for (SensorSpec& sensor : scene.sensors) sensor.intrinsics.max_depth_jump = 0;
+  for (SensorSpec& sensor : scene.sensors) {
+    sensor.intrinsics.max_depth_jump = 0;
+    sensor.intrinsics.smoothing_radius = 0;
+  }
   return scene;
 }
 
@@ -493,6 +498,7 @@ PinholeIntrinsics default_intrinsics(SensorModel model) {
       k.width = 640, k.height = 480, k.fx = 383.0, k.fy = 383.0, k.cx = 319.5, k.cy = 239.5;
       k.min_range = 0.2, k.max_range = 10.0;
       k.max_depth_jump = kStereoMaxDepthJump;
+      k.smoothing_radius = kStereoSmoothingRadius;
       return k;
     case SensorModel::kOs32c:
       break;

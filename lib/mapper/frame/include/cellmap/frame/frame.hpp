@@ -31,8 +31,15 @@ struct PinholeIntrinsics final {
   /// 256 × 212, 0.31° pixels: 0.02 → 15°), which other views see. 0 = off (the default here; every
   /// configured camera sets its own, see docs/config.md).
   double max_depth_jump = 0.0;
+  /// Depth smoothing of stereo cameras, pixels: each depth becomes the mean of the depths within this many
+  /// pixels along its row, then along its column, that lie within max_depth_jump of it (edge-preserving:
+  /// needs max_depth_jump > 0). Active stereo matching scatters a flat surface's depths by a few centimetres
+  /// (more with z²); fused at a 2 cm voxel, occupied wins, that scatter makes the surface several voxels
+  /// thick. 0 = off (the default here; RealSense-class cameras set 2, see docs/config.md).
+  int smoothing_radius = 0;
 
-  /// @throws Error if a size or focal length is not positive, the range is empty or max_depth_jump negative.
+  /// @throws Error if a size or focal length is not positive, the range is empty, max_depth_jump negative or
+  /// smoothing_radius outside [0, kMaxSmoothingRadius].
   void validate() const;
 };
 
@@ -43,6 +50,10 @@ inline constexpr double kDefaultMaxDepthJump = 0.02;
 /// several centimetres at 3 m without any edge).
 inline constexpr double kStereoMaxDepthJump = 0.05;
 
+/// smoothing_radius of a configured stereo camera unless its configuration says otherwise, and the largest.
+inline constexpr int kStereoSmoothingRadius = 2;
+inline constexpr int kMaxSmoothingRadius = 16;
+
 /// A raw 16-bit depth image, row-major, `depth.size() == width * height`; 0 means no return.
 struct DepthImage final {
   PinholeIntrinsics intrinsics;
@@ -50,7 +61,8 @@ struct DepthImage final {
 };
 
 /// Back-projects a depth image into the sensor frame: p_S = ((u - cx) z / fx, (v - cy) z / fy, z), leaving
-/// out pixels without a return, outside [min_range, max_range] or on a depth edge (max_depth_jump).
+/// out pixels without a return, outside [min_range, max_range] or on a depth edge (max_depth_jump), after
+/// smoothing the depths (smoothing_radius).
 /// With `organized`, the cloud keeps width × height with NaN for pixels without a valid return (matches PCL's
 /// grabbers); otherwise only valid points are returned. @throws Error if the image size disagrees with the
 /// intrinsics or the intrinsics are invalid.

@@ -39,8 +39,8 @@ void write_depth_png(const std::string& path, const RawDepth& image);
 [[nodiscard]] PinholeIntrinsics read_pcl_intrinsics_xml(const std::string& path);
 
 /// Reads intrinsics from a YAML map with keys width, height, fx, fy, cx, cy, depth_scale (default 0.001),
-/// min_range (default 0), max_range (default 10), max_depth_jump (default kDefaultMaxDepthJump; 0 = off);
-/// unknown keys are refused.
+/// min_range (default 0), max_range (default 10), max_depth_jump (default kDefaultMaxDepthJump; 0 = off),
+/// smoothing_radius (default 0 = off); unknown keys are refused.
 /// @throws Error naming the file and key on a missing, unknown or invalid value.
 [[nodiscard]] PinholeIntrinsics read_intrinsics_yaml(const std::string& path);
 

@@ -25,6 +25,7 @@ struct OpenNI2Config final {
   double min_range = 0.0;   ///< metres; depths outside [min_range, max_range] are no return
   double max_range = 10.0;  ///< metres
   double max_depth_jump = kDefaultMaxDepthJump;  ///< flying-pixel filter (PinholeIntrinsics), 0 = off
+  int smoothing_radius = 0;                      ///< depth smoothing, pixels (PinholeIntrinsics), 0 = off
   ReconnectParams reconnect;
   /// .oni playback: true plays at the recorded rate, false as fast as frames are read.
   bool realtime_playback = true;

@@ -23,7 +23,8 @@
 //             PCL grabber format (<depth><focal_length_x> … <z_multiplication_factor>), as PCL's
 //             ImageGrabber writes beside frame_<time>_depth.tiff;
 //     DIR/intrinsics.yaml
-//             width, height, fx, fy, cx, cy, depth_scale [, min_range, max_range, max_depth_jump]
+//             width, height, fx, fy, cx, cy, depth_scale [, min_range, max_range, max_depth_jump,
+//             smoothing_radius]
 //             (read_intrinsics_yaml). Either way the flying-pixel filter is on (max_depth_jump 0.02) unless
 //             intrinsics.yaml says otherwise.
 //

@@ -9,10 +9,11 @@
 //   pose_tolerance: 0.05                          seconds between a frame and each bracketing robot pose
 //   openni2:  uri ["": first device; or a .oni file], width [640], height [480], fps [30],
 //             format [DEPTH_1_MM | DEPTH_100_UM], intrinsics {fx, fy, cx, cy} [from the device's field of
-//             view], min_range [0], max_range [10], max_depth_jump [0.02], realtime_playback [true]
+//             view], min_range [0], max_range [10], max_depth_jump [0.02], smoothing_radius [0],
+//             realtime_playback [true]
 //   v4l2:     device [/dev/video0], width [848], height [480], fps [30],
 //             intrinsics {fx, fy, cx, cy, depth_scale} [RealSense D435 defaults for the size],
-//             min_range [0.3], max_range [10], max_depth_jump [0.05], buffers [4]
+//             min_range [0.3], max_range [10], max_depth_jump [0.05], smoothing_radius [2], buffers [4]
 //   openni2 and v4l2: frame_timeout [2], reconnect {initial_backoff [0.5], max_backoff [10]}
 //   replay:   directory (required), playback [recorded | fixed | fastest], speed [1], rate_hz [10]
 

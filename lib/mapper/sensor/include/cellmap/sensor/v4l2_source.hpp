@@ -31,7 +31,7 @@ namespace cellmap {
                                                     int height, std::size_t bytes_per_line);
 
 /// The D435 intrinsics listed above for 848×480, 640×480 and 1280×720 (depth_scale 0.001, range 0.3–10 m,
-/// max_depth_jump kStereoMaxDepthJump).
+/// max_depth_jump kStereoMaxDepthJump, smoothing_radius kStereoSmoothingRadius).
 /// @throws Error for other sizes (their intrinsics must come from the config).
 [[nodiscard]] PinholeIntrinsics realsense_d435_intrinsics(int width, int height);
 

@@ -142,8 +142,9 @@ struct Scene final {
   void validate() const;
 };
 
-/// `scene` with every camera's flying-pixel filter off (PinholeIntrinsics::max_depth_jump = 0): the exact
-/// sweep of that scene is the whole surface its cameras see, what a filtered sweep's boxes are scored against.
+/// `scene` with every camera's depth filters off (PinholeIntrinsics::max_depth_jump and smoothing_radius 0):
+/// the exact sweep of that scene is the whole surface its cameras see, what a filtered sweep's boxes are
+/// scored against.
 [[nodiscard]] Scene without_depth_filter(Scene scene);
 
 /// Reads the `robot` section of a scene (or daemon) file: `gantry: {lower, upper, tool_at_zero, [bridge,
