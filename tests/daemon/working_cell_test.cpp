@@ -197,14 +197,24 @@ TEST(WorkingCellTest, JointStampsLate20MsWithTheDefaultPaddingMakeNoRobotBox) {
             << " m in 20 ms; " << versions.size() << " version(s)\n";
 }
 
-// The arm cell as config/arm-cell.yaml has it (both cameras, 0.5 s sweeps, settling 34 sweeps) for `sweeps`
-// sweeps, gathered and queued as in the daemon with `backlog` sweeps of room (`sweep_backlog`), while the
-// processing thread is stalled from sweep `stall_from` to `stall_to` (it takes nothing, as during the first
-// segmentation on a loaded machine); the number of versions.
-int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stall_to, int sweeps) {
-  const std::string config_dir = std::string(CELLMAP_SOURCE_DIR) + "/config";
-  const DaemonConfig config =
-      DaemonConfig::parse(read_file(config_dir + "/arm-cell.yaml"), "arm-cell.yaml", config_dir);
+// The arm cell as config/arm-cell.yaml has it (both cameras, 0.5 s sweeps, settling 34 sweeps), the wrist
+// camera's depths smoothed over `wrist_smoothing` pixels, for `sweeps` sweeps, gathered and queued as in the
+// daemon with `backlog` sweeps of room (`sweep_backlog`), while the processing thread is stalled from sweep
+// `stall_from` to `stall_to` (it takes nothing, as during the first segmentation on a loaded machine); the
+// number of versions.
+int arm_cell_versions_with_a_stall(std::size_t backlog, int stall_from, int stall_to, int sweeps,
+                                   int wrist_smoothing) {
+  const test::TempDir dir;
+  std::string scene = read_file(arm_scene(dir, "", true).string());
+  const std::string wrist_range = "min_range: 0.2, max_range: 10.0}";
+  scene.replace(
+      scene.find(wrist_range), wrist_range.size(),
+      "min_range: 0.2, max_range: 10.0, smoothing_radius: " + std::to_string(wrist_smoothing) + "}");
+  write_file_atomically(dir.path() / "scene.yaml", scene);
+  std::string text = read_file(std::string(CELLMAP_SOURCE_DIR) + "/config/arm-cell.yaml");
+  for (std::size_t at; (at = text.find("scenes/arm_cell.yaml")) != std::string::npos;)
+    text.replace(at, std::string("scenes/arm_cell.yaml").size(), (dir.path() / "scene.yaml").string());
+  const DaemonConfig config = DaemonConfig::parse(text, "arm-cell.yaml", dir.path().string());
   SimulatedCell cell(config.sources, config.robot);
   CellPipeline pipeline(config.pipeline);
   pipeline.filter_robot(cell.robot());
@@ -229,11 +239,15 @@ TEST(WorkingCellTest, AStalledProcessingThreadCatchesUpAndTheUnchangingArmCellMa
   if (!long_tests()) GTEST_SKIP() << "twice 60 sweeps of the arm cell: CELLMAP_LONG_TESTS=1 runs it";
   // Stalled for 7 sweeps right after the first version (sweep 33), as the first segmentation stalled a
   // daemon at load 12; the default backlog holds them all. Each sweep's free space keeps voxels free that the
-  // wrist camera's noisy views of the table mark in other phases of the arm's path; with the newest sweep
-  // only (a backlog of 1), 3.5 s of it are missing: 53 voxels above the table are boxed 7 sweeps later and
-  // removed 5 after that, 3 versions.
-  EXPECT_EQ(arm_cell_versions_with_a_stall(DaemonConfig{}.sweep_backlog, 34, 40, 60), 1);
-  EXPECT_GT(arm_cell_versions_with_a_stall(1, 34, 40, 60), 1) << "the stall made no difference";
+  // wrist camera's noisy views of the table mark in other phases of the arm's path. Its raw depths (no
+  // smoothing) with the newest sweep only (a backlog of 1): 3.5 s of that free space are missing, 53 voxels
+  // above the table are boxed 7 sweeps later and removed 5 after that, 3 versions. Smoothed, its depths mark
+  // too few such voxels to make a version even then.
+  const std::size_t backlog = DaemonConfig{}.sweep_backlog;
+  EXPECT_EQ(arm_cell_versions_with_a_stall(backlog, 34, 40, 60, kStereoSmoothingRadius), 1);
+  EXPECT_EQ(arm_cell_versions_with_a_stall(1, 34, 40, 60, kStereoSmoothingRadius), 1);
+  EXPECT_EQ(arm_cell_versions_with_a_stall(backlog, 34, 40, 60, 0), 1);
+  EXPECT_GT(arm_cell_versions_with_a_stall(1, 34, 40, 60, 0), 1) << "the stall made no difference";
 }
 
 }  // namespace
