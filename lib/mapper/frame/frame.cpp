@@ -1,6 +1,7 @@
 #include "cellmap/frame/frame.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -33,40 +34,62 @@ void valid_depths(const DepthImage& image, std::vector<std::uint16_t>& raw) {
   }
 }
 
-// One pass of the depth smoothing: each valid depth of `in` becomes the mean of the valid depths within
-// `radius` steps of `stride` (along `count` pixels from it, on its row or column) that differ from it by at
-// most `share` of it, written to `out`. `lines` lines of `count` pixels, `line_stride` apart.
-void smooth_along(const std::vector<std::uint16_t>& in, std::vector<std::uint16_t>& out, int lines,
-                  std::size_t line_stride, int count, std::size_t stride, int radius, double share) {
-  out.resize(in.size());
-  for (int line = 0; line < lines; ++line) {
-    const std::uint16_t* from = &in[static_cast<std::size_t>(line) * line_stride];
-    std::uint16_t* to = &out[static_cast<std::size_t>(line) * line_stride];
-    for (int i = 0; i < count; ++i) {
-      const std::uint32_t d = from[i * stride];
-      if (d == 0) {
-        to[i * stride] = 0;
-        continue;
-      }
-      const std::uint32_t limit = static_cast<std::uint32_t>(share * d);
-      std::uint32_t sum = 0, n = 0;
-      for (int j = std::max(0, i - radius); j <= std::min(count - 1, i + radius); ++j) {
-        const std::uint32_t e = from[j * stride];
-        if (e != 0 && (e > d ? e - d : d - e) <= limit) sum += e, ++n;
-      }
-      to[i * stride] = static_cast<std::uint16_t>((sum + n / 2) / n);
-    }
+// Depth smoothing's sums: for each of `count` pixels, `other`'s depth where it is valid and within `limit` of
+// the pixel's own (`centre`), added to `sum` and counted in `n`. Branch-free, so that it vectorizes.
+void add_neighbours(const std::uint16_t* centre, const std::uint16_t* other, const std::uint32_t* limit,
+                    std::uint32_t* sum, std::uint32_t* n, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t d = centre[i], e = other[i];
+    const std::uint32_t near = (e > d ? e - d : d - e) <= limit[i];
+    const std::uint32_t take = near & (e != 0);
+    sum[i] += take * e;
+    n[i] += take;
   }
 }
 
-// The depth smoothing (PinholeIntrinsics::smoothing_radius): along the rows, then the columns. Written here
-// rather than taken from PCL: its bilateral filters work on an organized cloud with a range kernel fixed in
-// metres, where stereo noise grows with z² and a frame must cost a few milliseconds.
+// The depth smoothing (PinholeIntrinsics::smoothing_radius): each valid depth becomes the mean of the valid
+// depths within the radius along its row that lie within max_depth_jump of it, then the same along its
+// column. Written here rather than taken from PCL: its bilateral filters work on an organized cloud with a
+// range kernel fixed in metres, where stereo noise grows with z² and a frame must cost a few milliseconds.
 void smooth_depths(std::vector<std::uint16_t>& raw, const PinholeIntrinsics& k,
                    std::vector<std::uint16_t>& scratch) {
   const std::size_t w = static_cast<std::size_t>(k.width);
-  smooth_along(raw, scratch, k.height, w, k.width, 1, k.smoothing_radius, k.max_depth_jump);
-  smooth_along(scratch, raw, k.width, 1, k.height, w, k.smoothing_radius, k.max_depth_jump);
+  const int r = k.smoothing_radius;
+  thread_local std::vector<std::uint32_t> limit, sum, n;
+  limit.resize(w), sum.resize(w), n.resize(w);
+  // 1 / n for the counts a window can have (a division per pixel would cost more than the sums); 0 for none,
+  // which only a pixel without a return has (a valid pixel counts itself).
+  std::array<float, 2 * kMaxSmoothingRadius + 2> inverse{};
+  for (std::size_t c = 1; c < inverse.size(); ++c) inverse[c] = 1.0f / static_cast<float>(c);
+  const auto mean_into = [&](std::uint16_t* out) {
+    for (std::size_t u = 0; u < w; ++u)
+      out[u] = static_cast<std::uint16_t>(static_cast<float>(sum[u]) * inverse[n[u]] + 0.5f);
+  };
+  const auto start = [&](const std::uint16_t* centre) {
+    for (std::size_t u = 0; u < w; ++u) limit[u] = static_cast<std::uint32_t>(k.max_depth_jump * centre[u]);
+    std::fill(sum.begin(), sum.end(), 0u);
+    std::fill(n.begin(), n.end(), 0u);
+  };
+  scratch.resize(raw.size());
+  for (int v = 0; v < k.height; ++v) {  // along the rows: raw → scratch
+    const std::uint16_t* row = &raw[static_cast<std::size_t>(v) * w];
+    start(row);
+    for (int o = -r; o <= r; ++o) {
+      const std::size_t from = static_cast<std::size_t>(std::max(0, -o));
+      const std::size_t to = w - static_cast<std::size_t>(std::max(0, o));
+      if (from < to)
+        add_neighbours(row + from, row + from + o, &limit[from], &sum[from], &n[from], to - from);
+    }
+    mean_into(&scratch[static_cast<std::size_t>(v) * w]);
+  }
+  for (int v = 0; v < k.height; ++v) {  // along the columns: scratch → raw
+    const std::uint16_t* row = &scratch[static_cast<std::size_t>(v) * w];
+    start(row);
+    for (int o = std::max(-r, -v); o <= std::min(r, k.height - 1 - v); ++o)
+      add_neighbours(row, row + static_cast<std::ptrdiff_t>(o) * static_cast<std::ptrdiff_t>(w), limit.data(),
+                     sum.data(), n.data(), w);
+    mean_into(&raw[static_cast<std::size_t>(v) * w]);
+  }
 }
 
 // Stands for "no valid depth" in a minimum: a valid pixel is never nearer, and a pixel's own depth is part
