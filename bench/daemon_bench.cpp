@@ -680,6 +680,12 @@ void print_standing(double stamp, const Standing& s) {
                     : (s.place_free ? "its place free" : "its place blocked"));
 }
 
+// The two native cameras the recordings are made for: the Kinect v2 (clearing on no return) and the D435.
+std::vector<Camera> native_cameras(const Options& options) {
+  return {{"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
+          {"realsense", d435_848x480(), 0.0}};
+}
+
 // Plays the recordings through CellPipeline on this thread, frame by frame in stamp order, grouped into
 // sweeps by cellmapd's FrameGrouper: the daemon's versions without its threads, DDS or timing, so a run is
 // the same every time. Prints each version, how the boxes stand before each change of the crate and at the
@@ -687,9 +693,7 @@ void print_standing(double stamp, const Standing& s) {
 int run_offline(const Options& options) {
   const ScratchDir dir;
   const Recording recording(options, dir.path);
-  std::vector<Camera> cameras{
-      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
-      {"realsense", d435_848x480(), 0.0}};
+  std::vector<Camera> cameras = native_cameras(options);
   write_recordings(options, recording, cameras);
   const daemon::DaemonConfig config = daemon_config(options, cameras, dir.path);
   const std::vector<std::unique_ptr<ReplaySource>> replays = open_replays(cameras, dir.path);
@@ -745,9 +749,7 @@ int run_offline(const Options& options) {
 int run(const Options& options) {
   const ScratchDir dir;
   const Recording recording(options, dir.path);
-  std::vector<Camera> cameras{
-      {"kinect", sim::default_intrinsics(sim::SensorModel::kKinectV2), options.no_return_range},
-      {"realsense", d435_848x480(), 0.0}};
+  std::vector<Camera> cameras = native_cameras(options);
   write_recordings(options, recording, cameras);
 
   // Before any thread (the subscriber's reader, the daemon's): they all inherit the blocked signals.
