@@ -82,6 +82,27 @@ TEST(DepthToPointsTest, FlyingPixelFilterDropsWhatLiesBehindADepthEdgeAndKeepsSu
   EXPECT_THROW((void)depth_to_points(image), Error);
 }
 
+// A width × height image, focal length `f`, its principal point at the centre, whose depth at (u, v) is
+// depth(u, v, r) for a pseudo-random r (a linear congruential sequence from `seed`, row by row).
+template <class Depth>
+DepthImage random_image(int width, int height, double f, double max_depth_jump, std::uint32_t seed,
+                        const Depth& depth) {
+  DepthImage image;
+  image.intrinsics.width = width;
+  image.intrinsics.height = height;
+  image.intrinsics.fx = image.intrinsics.fy = f;
+  image.intrinsics.cx = (width - 1) / 2.0;
+  image.intrinsics.cy = (height - 1) / 2.0;
+  image.intrinsics.max_depth_jump = max_depth_jump;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      seed = seed * 1664525u + 1013904223u;
+      image.depth.push_back(depth(u, v, seed >> 8));
+    }
+  }
+  return image;
+}
+
 // The filter's definition, pixel by pixel: dropped when a valid 8-neighbour inside the image is nearer by
 // more than max_depth_jump of the pixel's depth.
 bool behind_an_edge(const DepthImage& image, int u, int v) {
@@ -103,22 +124,10 @@ bool behind_an_edge(const DepthImage& image, int u, int v) {
 // Noisy surfaces at two depths with holes, edges on every side and at the image's borders: the filter
 // drops exactly the pixels its definition drops.
 TEST(DepthToPointsTest, FlyingPixelFilterDropsExactlyWhatItsDefinitionDrops) {
-  DepthImage image;
-  image.intrinsics.width = 37;
-  image.intrinsics.height = 23;
-  image.intrinsics.fx = image.intrinsics.fy = 30.0;
-  image.intrinsics.cx = 18.0;
-  image.intrinsics.cy = 11.0;
-  image.intrinsics.max_depth_jump = 0.02;
-  std::uint32_t state = 7;
-  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
-  for (int v = 0; v < image.intrinsics.height; ++v) {
-    for (int u = 0; u < image.intrinsics.width; ++u) {
-      const bool near = (u / 5 + v / 4) % 2 == 0;
-      const std::uint32_t r = next() >> 8;
-      image.depth.push_back(r % 13 == 0 ? 0 : std::uint16_t((near ? 1000 : 1800) + r % 41));
-    }
-  }
+  const DepthImage image = random_image(37, 23, 30.0, 0.02, 7, [](int u, int v, std::uint32_t r) {
+    const bool near = (u / 5 + v / 4) % 2 == 0;
+    return r % 13 == 0 ? 0 : std::uint16_t((near ? 1000 : 1800) + r % 41);
+  });
   const Cloud organized = depth_to_points(image, true);
   std::size_t dropped = 0;
   for (int v = 0; v < image.intrinsics.height; ++v) {
@@ -155,17 +164,9 @@ TEST(DepthToPointsTest, SmoothingAveragesNeighboursWithinTheJumpOnly) {
 // Two walls (1 m and 2 m) scattered by ±20 mm: smoothing with radius 2 leaves under a third of the scatter on
 // a wall and none of one wall's depths in the other's.
 TEST(DepthToPointsTest, SmoothingShrinksAFlatSurfacesScatterAndKeepsItsEdge) {
-  DepthImage image;
-  image.intrinsics.width = 60;
-  image.intrinsics.height = 40;
-  image.intrinsics.fx = image.intrinsics.fy = 50.0;
-  image.intrinsics.max_depth_jump = 0.05;
-  std::uint32_t state = 11;
-  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
-  for (int v = 0; v < 40; ++v) {
-    for (int u = 0; u < 60; ++u)
-      image.depth.push_back(std::uint16_t((u < 30 ? 1000 : 2000) + (next() >> 8) % 41 - 20));
-  }
+  DepthImage image = random_image(60, 40, 50.0, 0.05, 11, [](int u, int, std::uint32_t r) {
+    return std::uint16_t((u < 30 ? 1000 : 2000) + r % 41 - 20);
+  });
   const auto scatter = [](const Cloud& organized) {
     double sum = 0, sq = 0;
     int n = 0;
