@@ -40,6 +40,7 @@ target_compile_definitions(cellmap_common INTERFACE $<INSTALL_INTERFACE:EIGEN_HA
 set_target_properties(cellmap_client PROPERTIES EXPORT_NAME client)
 set_target_properties(cellmap_pcl PROPERTIES EXPORT_NAME pcl)
 set_target_properties(cellmap_idl PROPERTIES EXPORT_NAME idl)
+set_target_properties(cellmap_ros2_idl PROPERTIES EXPORT_NAME ros2_idl)
 
 # The client component: cellmap_client and every cellmap target it links, directly or through a stage.
 set(CELLMAP_CLIENT_TARGETS "")
@@ -58,7 +59,7 @@ while(pending)
     endif()
   endforeach()
 endwhile()
-set(CELLMAP_MAPPER_TARGETS cellmap cellmap_pcl cellmap_idl ${CELLMAP_STAGES})
+set(CELLMAP_MAPPER_TARGETS cellmap cellmap_pcl cellmap_idl cellmap_ros2_idl ${CELLMAP_STAGES})
 list(REMOVE_ITEM CELLMAP_MAPPER_TARGETS ${CELLMAP_CLIENT_TARGETS})
 
 install(TARGETS ${CELLMAP_CLIENT_TARGETS}
@@ -77,6 +78,8 @@ endforeach()
 # The DDS types for programs that read the topics without the client library (other vendors, ROS 2 tools).
 install(FILES ${PROJECT_SOURCE_DIR}/idl/cellmap.idl ${PROJECT_BINARY_DIR}/idl/cellmap.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cellmap/idl)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/idl/ros2 DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/cellmap/idl
+        FILES_MATCHING PATTERN "*.idl")
 
 install(EXPORT cellmapClientTargets NAMESPACE cellmap:: DESTINATION ${CELLMAP_INSTALL_CMAKEDIR})
 install(EXPORT cellmapTargets NAMESPACE cellmap:: DESTINATION ${CELLMAP_INSTALL_CMAKEDIR})

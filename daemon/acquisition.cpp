@@ -130,8 +130,9 @@ bool played_fastest(const SourceConfig& source) {
 // back-off paces retries.
 class CameraLoop final {
  public:
-  CameraLoop(const SourceConfig& config, const RobotInput* robot, AcquisitionOutput output)
-      : camera_(config, robot), kind_(to_string(config.kind)), output_(output) {}
+  CameraLoop(const SourceConfig& config, std::unique_ptr<DepthSource> source, const RobotInput* robot,
+             AcquisitionOutput output)
+      : camera_(config, std::move(source), robot), kind_(to_string(config.kind)), output_(output) {}
 
   void open() {
     const SourceStatus opened = camera_.open();
@@ -216,11 +217,15 @@ class CameraAcquisition final : public Acquisition {
         robot_model_(config.robot) {
     const bool live = std::any_of(config.sources.begin(), config.sources.end(),
                                   [](const SourceConfig& s) { return !is_replay(s); });
-    if (live)
-      robot_.emplace(config.robot, pose_tolerance_, participant, config.cell, refuse(output.refusals));
+    if (live) {
+      robot_.emplace(config.robot, pose_tolerance_, participant, config.cell, config.ros2.joint_states,
+                     refuse(output.refusals));
+    }
     lossless_ = std::all_of(config.sources.begin(), config.sources.end(), played_fastest);
-    for (const SourceConfig& source : config.sources)
-      loops_.push_back(std::make_unique<CameraLoop>(source, robot_ ? &*robot_ : nullptr, output));
+    for (const SourceConfig& source : config.sources) {
+      loops_.push_back(std::make_unique<CameraLoop>(source, make_source(source, participant, refuse(output.refusals)),
+                                                    robot_ ? &*robot_ : nullptr, output));
+    }
   }
 
   void run(const std::atomic<bool>& stop, std::uint64_t max_sweeps) override {

@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/ros2/sensor_sources.hpp"
 #include "cellmap/sensor/replay_source.hpp"
 #include "cellmap/transport/topics.hpp"
 
@@ -23,11 +24,17 @@ transport::InputLimits skew_limits() {
 
 RobotInput::RobotInput(const std::optional<Robot>& robot, double tolerance,
                        const dds::Participant& participant, const std::string& cell,
-                       transport::OnRefused on_refused)
+                       const std::string& joint_states, transport::OnRefused on_refused)
     : on_refused_(std::move(on_refused)) {
+  if (!joint_states.empty() && !robot)
+    throw Error("ros2.joint_states " + joint_states + " needs a robot model (a `robot` section) to pose");
   if (robot) {
     joints_.emplace(*robot, tolerance, kLiveSamples);
-    joint_reader_.emplace(participant, cell, robot->joint_names(), skew_limits(), on_refused_);
+    if (joint_states.empty()) {
+      joint_reader_.emplace(participant, cell, robot->joint_names(), skew_limits(), on_refused_);
+    } else {
+      joint_state_reader_.emplace(participant, joint_states, cell, robot->joint_names(), kMaxPoseSkew, on_refused_);
+    }
   } else {
     poses_.emplace(tolerance, kLiveSamples);
     pose_reader_.emplace(participant, cell, skew_limits(), on_refused_);
@@ -39,13 +46,15 @@ void RobotInput::pump(std::chrono::milliseconds timeout) {
     ++refused_;
     if (on_refused_) on_refused_(std::string(topic) + ": " + e.what());
   };
-  if (joint_reader_) {
-    for (const transport::RobotJoints& sample : joint_reader_->take(timeout)) {
+  if (joints_) {
+    const char* topic = joint_reader_ ? transport::kRobotJointsTopic : joint_state_reader_->topic().c_str();
+    for (const transport::RobotJoints& sample :
+         joint_reader_ ? joint_reader_->take(timeout) : joint_state_reader_->take(timeout)) {
       try {
         joints_->push(sample.state());
         ++received_;
       } catch (const Error& e) {
-        refuse(transport::kRobotJointsTopic, e);
+        refuse(topic, e);
       }
     }
     return;
@@ -61,11 +70,23 @@ void RobotInput::pump(std::chrono::milliseconds timeout) {
 }
 
 std::uint64_t RobotInput::rejected() const {
+  if (joint_state_reader_) return refused_ + joint_state_reader_->rejected();
   return refused_ + (joint_reader_ ? joint_reader_->rejected() : pose_reader_->rejected());
 }
 
-CameraInput::CameraInput(const SourceConfig& config, const RobotInput* robot)
-    : config_(config), source_(make_depth_source(config.camera)), robot_(robot) {
+std::unique_ptr<DepthSource> make_source(const SourceConfig& config, const dds::Participant& participant,
+                                         transport::OnRefused on_refused) {
+  ros2::TopicInput input = config.ros2;
+  input.max_stamp_skew = kMaxPoseSkew;
+  if (config.kind == SourceKind::kPointCloud2)
+    return ros2::make_point_cloud2_source(participant, config.sensor, input, std::move(on_refused));
+  if (config.kind == SourceKind::kLaserScan)
+    return ros2::make_laser_scan_source(participant, config.sensor, input, std::move(on_refused));
+  return make_depth_source(config.camera);
+}
+
+CameraInput::CameraInput(const SourceConfig& config, std::unique_ptr<DepthSource> source, const RobotInput* robot)
+    : config_(config), source_(std::move(source)), robot_(robot) {
   config_.grouping.validate();
   if (std::holds_alternative<ReplayConfig>(config.camera.source)) {
     recorded_.emplace(config.camera.pose_tolerance, 1'000'000);

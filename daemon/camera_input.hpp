@@ -15,6 +15,7 @@
 #include "cellmap/frame/joint_buffer.hpp"
 #include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sensor/depth_source.hpp"
+#include "cellmap/ros2/joint_state_reader.hpp"
 #include "cellmap/transport/robot_joints.hpp"
 #include "cellmap/transport/robot_state.hpp"
 #include "daemon_config.hpp"
@@ -33,10 +34,12 @@ inline constexpr std::chrono::seconds kMaxPoseSkew{5};
 /// the buffers may be read from any.
 class RobotInput final {
  public:
-  /// @param tolerance  seconds from a frame to each bracketing sample (the cameras' pose_tolerance)
-  /// @throws Error if the reader cannot be created.
+  /// @param tolerance     seconds from a frame to each bracketing sample (the cameras' pose_tolerance)
+  /// @param joint_states  a ROS 2 sensor_msgs/msg/JointState topic to take the robot model's joints from
+  ///                      instead of cellmap/robot_joints; "" = cellmap/robot_joints
+  /// @throws Error if the reader cannot be created, or joint_states is given without a robot model.
   RobotInput(const std::optional<Robot>& robot, double tolerance, const dds::Participant& participant,
-             const std::string& cell, transport::OnRefused on_refused);
+             const std::string& cell, const std::string& joint_states, transport::OnRefused on_refused);
 
   /// Waits up to `timeout` for samples and moves those that arrived into the buffer.
   void pump(std::chrono::milliseconds timeout);
@@ -56,10 +59,17 @@ class RobotInput final {
   std::optional<JointBuffer> joints_;
   std::optional<PoseBuffer> poses_;
   std::optional<transport::RobotJointsReader> joint_reader_;
+  std::optional<ros2::JointStateReader> joint_state_reader_;
   std::optional<transport::RobotStateReader> pose_reader_;
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> refused_{0};  // well-formed on the wire but refused by the buffer
 };
+
+/// The source of `config`: a ROS 2 topic's (pointcloud2, laserscan) on `participant`, its samples refused
+/// to `on_refused`; else the camera's own (make_depth_source). @throws Error as the source's constructor.
+[[nodiscard]] std::unique_ptr<DepthSource> make_source(const SourceConfig& config,
+                                                       const dds::Participant& participant,
+                                                       transport::OnRefused on_refused);
 
 /// One camera: its frames posed in the cell frame (X_CS = X_CS fixed, or X_CE(stamp) · X_ES on the tool)
 /// with the robot at the frame's stamp when the cell has a robot model. A frame whose pose (or robot) is not
@@ -68,9 +78,10 @@ class RobotInput final {
 /// filtered). Not thread-safe: one camera thread owns it.
 class CameraInput final {
  public:
-  /// @param robot  the cell's live robot (must outlive this), or nullptr (replay)
-  /// @throws Error if the camera settings are invalid (the source's constructor).
-  CameraInput(const SourceConfig& config, const RobotInput* robot);
+  /// @param source  the camera's frames (make_source)
+  /// @param robot   the cell's live robot (must outlive this), or nullptr (replay)
+  /// @throws Error if the grouping settings are invalid.
+  CameraInput(const SourceConfig& config, std::unique_ptr<DepthSource> source, const RobotInput* robot);
 
   /// Opens the camera; a missing device is not an error (the status says disconnected and it is retried).
   /// A replay's recorded poses are loaded into its pose buffer.

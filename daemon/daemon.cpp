@@ -63,6 +63,17 @@ class Stopwatch {
   double cpu_;
 };
 
+// The DDS Security setting, refused when ROS 2 topics are in use: ROS 2 nodes do not hold the cell's
+// credentials, and a daemon that talked to them would be silently unprotected.
+const std::optional<security::Setting>& security_of(const DaemonConfig& config) {
+  if (config.security && config.uses_ros2()) {
+    throw Error(
+        "DDS Security is on and the config uses ROS 2 topics (a pointcloud2 or laserscan source, or the ros2 "
+        "section), which the cell's permissions cannot protect: turn one of them off (docs/ros2.md)");
+  }
+  return config.security;
+}
+
 std::vector<std::string> sensor_names(const DaemonConfig& config) {
   std::vector<std::string> names;
   for (const SourceConfig& source : config.sources) names.push_back(source.sensor);
@@ -75,14 +86,16 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
     : config_(std::move(config)),
       options_(std::move(options)),
       store_(config_.state_dir, config_.cell),
-      participant_(static_cast<std::uint32_t>(config_.domain), config_.security),
+      participant_(static_cast<std::uint32_t>(config_.domain), security_of(config_)),
       publisher_(of_cell(participant_, config_.cell), config_.cell, config_.delta_depth),
       layers_(participant_, config_.cell),
+      ros2_outputs_(config_.ros2, participant_),
       pipeline_(recover_pipeline(config_.pipeline, store_.recovered())),
       keeper_(store_,
               [this](const Environment& env, const EnvironmentDelta& delta) {
                 const Stopwatch watch;
                 publisher_.publish(env, delta);
+                ros2_outputs_.publish(env, delta);
                 watch.add_to(publish_cost_);
               }),
       frames_(config_.frame_backlog),
@@ -96,6 +109,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
   use_self_filter();
   spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
                store_.directory().string(), acquisition_->describe(), keeper_.published().version());
+  if (!ros2_outputs_.describe().empty()) spdlog::info("ROS 2 outputs: {}", ros2_outputs_.describe());
 }
 
 void Daemon::use_self_filter() {
@@ -131,6 +145,7 @@ void Daemon::run(const Signals& signals) {
   });
   while (!stop_) {
     const std::optional<int> signal = signals.wait_for(milliseconds(200));
+    ros2_outputs_.serve_new_readers();
     if (!signal) continue;
     if (*signal == SIGHUP) {
       const std::optional<double> period =

@@ -25,6 +25,7 @@
 #include "health.hpp"
 #include "input_refusals.hpp"
 #include "layer_publisher.hpp"
+#include "ros2_outputs.hpp"
 #include "signals.hpp"
 #include "versions.hpp"
 
@@ -103,6 +104,7 @@ class Daemon final {
   dds::Participant participant_;
   transport::EnvironmentPublisher publisher_;
   LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
+  Ros2Outputs ros2_outputs_;  // MoveIt and RViz, when the config enables them
   CellPipeline pipeline_;
   VersionKeeper keeper_;
   FrameQueue frames_;

@@ -1,5 +1,6 @@
 #include "daemon_config.hpp"
 
+#include <algorithm>
 #include <set>
 
 #include "cellmap/common/atomic_file.hpp"
@@ -10,8 +11,8 @@
 namespace cellmap::daemon {
 namespace {
 
-constexpr SourceKind kSourceKinds[] = {SourceKind::kSim, SourceKind::kReplay, SourceKind::kOpenNI2,
-                                       SourceKind::kV4l2};
+constexpr SourceKind kSourceKinds[] = {SourceKind::kSim,  SourceKind::kReplay,      SourceKind::kOpenNI2,
+                                       SourceKind::kV4l2, SourceKind::kPointCloud2, SourceKind::kLaserScan};
 
 std::optional<SourceKind> source_kind(const std::string& text) {
   for (const SourceKind kind : kSourceKinds) {
@@ -69,12 +70,40 @@ void read_camera_mount(YamlMap& section, SourceConfig& c) {
   c.X_CS = mount.X_CS;
 }
 
+// A ROS 2 topic name of the config, checked as ros2::dds_topic checks it.
+std::string read_ros2_topic(YamlMap& section, const char* key, const std::string& fallback) {
+  const std::string topic = section.get<std::string>(key, fallback);
+  try {
+    (void)ros2::dds_topic(topic);
+  } catch (const Error& e) {
+    section.fail(key, e.what());
+  }
+  return topic;
+}
+
+// A `pointcloud2` or `laserscan` section; `chosen`: its kind is the entry's, so topic and frame_id are due.
+ros2::TopicInput read_topic_input(YamlMap settings, bool chosen) {
+  ros2::TopicInput input;
+  const std::string topic = settings.get<std::string>("topic", "");
+  if (chosen || !topic.empty()) input.topic = read_ros2_topic(settings, "topic", topic);
+  input.frame_id = settings.get<std::string>("frame_id", "");
+  if (chosen && input.frame_id.empty())
+    settings.fail("frame_id", "is required: the header.frame_id of the sensor's samples");
+  const std::string reliability = settings.get<std::string>("reliability", "best_effort");
+  if (reliability != "best_effort" && reliability != "reliable")
+    settings.fail("reliability", "must be best_effort or reliable");
+  input.reliability = reliability == "reliable" ? ros2::Reliability::kReliable : ros2::Reliability::kBestEffort;
+  input.frame_timeout = settings.number("frame_timeout", input.frame_timeout, 0.05, 3600.0);
+  settings.expect_all_read();
+  return input;
+}
+
 // One source entry. Every camera kind's settings are read (so a misspelt key is found whichever kind is
 // chosen); the chosen kind's become the camera.
 SourceConfig read_source(YamlMap section, double sweep_period, const std::filesystem::path& base_dir) {
   SourceConfig c;
   const std::optional<SourceKind> kind = source_kind(section.get<std::string>("kind", to_string(c.kind)));
-  if (!kind) section.fail("kind", "must be one of sim, replay, openni2, v4l2");
+  if (!kind) section.fail("kind", "must be one of sim, replay, openni2, v4l2, pointcloud2, laserscan");
   c.kind = *kind;
   const std::string scene = section.get<std::string>("scene", "");
   if (!scene.empty()) c.scene = base_dir / scene;  // an absolute scene path replaces base_dir
@@ -98,6 +127,10 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   const OpenNI2Config openni2 = read_openni2_config(section.child("openni2"), c.sensor);
   const V4l2Config v4l2 = read_v4l2_config(section.child("v4l2"), c.sensor);
   ReplayConfig replay = read_replay_config(section.child("replay"), c.sensor);
+  const ros2::TopicInput cloud = read_topic_input(section.child("pointcloud2"), c.kind == SourceKind::kPointCloud2);
+  const ros2::TopicInput scan = read_topic_input(section.child("laserscan"), c.kind == SourceKind::kLaserScan);
+  if (c.kind == SourceKind::kPointCloud2) c.ros2 = cloud;
+  if (c.kind == SourceKind::kLaserScan) c.ros2 = scan;
   if (c.kind == SourceKind::kOpenNI2) c.camera.source = openni2;
   if (c.kind == SourceKind::kV4l2) c.camera.source = v4l2;
   if (c.kind == SourceKind::kReplay) {
@@ -151,6 +184,27 @@ std::optional<Robot> read_daemon_robot(YamlMap& root, const std::filesystem::pat
   return sim::read_robot(YamlMap(node, "robot", root.source()), base_dir.string());
 }
 
+// An output of the `ros2` section: nullopt unless enabled.
+std::optional<ros2::TopicOutput> read_topic_output(YamlMap section) {
+  const bool enabled = section.get<bool>("enabled", false);
+  ros2::TopicOutput output;
+  output.topic = read_ros2_topic(section, "topic", "");
+  output.frame_id = section.get<std::string>("frame_id", output.frame_id);
+  if (output.frame_id.empty()) section.fail("frame_id", "must not be empty");
+  section.expect_all_read();
+  return enabled ? std::optional(output) : std::nullopt;
+}
+
+Ros2Config read_ros2(YamlMap section) {
+  Ros2Config c;
+  c.joint_states = section.get<std::string>("joint_states", "");
+  if (!c.joint_states.empty()) c.joint_states = read_ros2_topic(section, "joint_states", c.joint_states);
+  c.collision_objects = read_topic_output(section.child("collision_objects"));
+  c.markers = read_topic_output(section.child("markers"));
+  section.expect_all_read();
+  return c;
+}
+
 }  // namespace
 
 const char* to_string(SourceKind kind) {
@@ -163,6 +217,10 @@ const char* to_string(SourceKind kind) {
       return "openni2";
     case SourceKind::kV4l2:
       return "v4l2";
+    case SourceKind::kPointCloud2:
+      return "pointcloud2";
+    case SourceKind::kLaserScan:
+      return "laserscan";
   }
   return "?";
 }
@@ -199,8 +257,14 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   c.robot = read_daemon_robot(root, base_dir);
   c.pipeline = CellPipelineConfig::from_yaml(root);
   c.security = read_security(root.child("security"), base_dir);
+  c.ros2 = read_ros2(root.child("ros2"));
   root.expect_all_read();
   return c;
+}
+
+bool DaemonConfig::uses_ros2() const {
+  const bool ros2_source = std::any_of(sources.begin(), sources.end(), [](const SourceConfig& s) { return s.is_ros2(); });
+  return ros2_source || !ros2.joint_states.empty() || ros2.collision_objects || ros2.markers;
 }
 
 }  // namespace cellmap::daemon

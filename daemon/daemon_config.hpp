@@ -11,6 +11,8 @@
 
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/robot/robot.hpp"
+#include "cellmap/ros2/environment_writers.hpp"
+#include "cellmap/ros2/sensor_sources.hpp"
 #include "cellmap/security/credentials.hpp"
 #include "cellmap/sensor/sensor_config.hpp"
 #include "cellmap/sim/scene.hpp"
@@ -19,9 +21,10 @@
 namespace cellmap::daemon {
 
 /// What one sensor of the cell is (`kind` of an entry of `sources`): a sensor of the simulated cell (the
-/// default: no hardware needed) or a depth camera (a replay directory, an OpenNI2 or a V4L2 device).
-enum class SourceKind { kSim, kReplay, kOpenNI2, kV4l2 };
-/// The config's spelling: sim | replay | openni2 | v4l2.
+/// default: no hardware needed), a depth camera (a replay directory, an OpenNI2 or a V4L2 device) or a
+/// ROS 2 driver's topic (sensor_msgs/msg/PointCloud2 or LaserScan). All but sim are posed as cameras.
+enum class SourceKind { kSim, kReplay, kOpenNI2, kV4l2, kPointCloud2, kLaserScan };
+/// The config's spelling: sim | replay | openni2 | v4l2 | pointcloud2 | laserscan.
 [[nodiscard]] const char* to_string(SourceKind kind);
 
 /// One entry of `sources` (or the single `source` section, read as a list of one). Each entry is laid over
@@ -49,8 +52,23 @@ struct SourceConfig final {
   /// Cameras: period = `sweep_period` (the frame time one sweep spans), max_frames = `sweep_frames`,
   /// pose_wait = `pose_wait`.
   SweepParams grouping;
+  /// pointcloud2 and laserscan: the settings of that kind (`topic` and `frame_id` required, `reliability`,
+  /// `frame_timeout`); stamps are checked against kMaxPoseSkew's 5 s like the robot's samples.
+  ros2::TopicInput ros2;
 
   [[nodiscard]] bool is_camera() const { return kind != SourceKind::kSim; }
+  [[nodiscard]] bool is_ros2() const { return kind == SourceKind::kPointCloud2 || kind == SourceKind::kLaserScan; }
+};
+
+/// The `ros2` section: ROS 2 nodes on the same DDS domain (docs/ros2.md). Everything off by default.
+struct Ros2Config final {
+  /// `joint_states`: a sensor_msgs/msg/JointState topic posing the robot instead of cellmap/robot_joints;
+  /// empty = cellmap/robot_joints.
+  std::string joint_states;
+  /// `collision_objects` (`enabled`, `topic`, `frame_id`): the boxes for MoveIt; nullopt = off.
+  std::optional<ros2::TopicOutput> collision_objects;
+  /// `markers` (`enabled`, `topic`, `frame_id`): the boxes for RViz; nullopt = off.
+  std::optional<ros2::TopicOutput> markers;
 };
 /// The text of config/cellmapd.yaml, embedded at build time: the built-in defaults.
 [[nodiscard]] const char* default_config_yaml();
@@ -84,7 +102,10 @@ struct DaemonConfig final {
   std::optional<Robot> robot;
   /// The sections `occupancy`, `change`, `segment` and `reconcile`: what makes the map and the boxes.
   CellPipelineConfig pipeline;
+  Ros2Config ros2;
 
+  /// True if any ROS 2 topic is read or written (a source of a ROS 2 kind, or the `ros2` section).
+  [[nodiscard]] bool uses_ros2() const;
   /// True if the sources are the simulated cell's sensors.
   [[nodiscard]] bool simulated() const { return !sources.front().is_camera(); }
 

@@ -127,4 +127,17 @@ BoxSet read_box_file(const std::filesystem::path& path) {
   return box_set_from_json(read_file(path), path.string());
 }
 
+std::array<double, 3> box_colour(std::uint64_t id) {
+  // Golden-ratio steps around the hue circle keep neighbouring ids apart; the page uses the same formula.
+  const double hue = std::fmod(static_cast<double>(id % 1000003) * 0.618033988749895, 1.0) * 6.0;
+  const double s = 0.5, v = 0.9;
+  const double c = v * s;
+  const double x = c * (1 - std::abs(std::fmod(hue, 2.0) - 1));
+  const double m = v - c;
+  const int sector = static_cast<int>(hue) % 6;
+  static constexpr int kOrder[6][3] = {{0, 1, 2}, {1, 0, 2}, {2, 0, 1}, {2, 1, 0}, {1, 2, 0}, {0, 2, 1}};
+  const double parts[3] = {c, x, 0.0};
+  return {parts[kOrder[sector][0]] + m, parts[kOrder[sector][1]] + m, parts[kOrder[sector][2]] + m};
+}
+
 }  // namespace cellmap

@@ -435,19 +435,6 @@ std::array<double, 3> obstacle_colour() {
   return {0.62, 0.63, 0.66};
 }
 
-std::array<double, 3> box_colour(std::uint64_t id) {
-  // Golden-ratio steps around the hue circle keep neighbouring ids apart; the page uses the same formula.
-  const double hue = std::fmod(static_cast<double>(id % 1000003) * 0.618033988749895, 1.0) * 6.0;
-  const double s = 0.5, v = 0.9;
-  const double c = v * s;
-  const double x = c * (1 - std::abs(std::fmod(hue, 2.0) - 1));
-  const double m = v - c;
-  const int sector = static_cast<int>(hue) % 6;
-  static constexpr int kOrder[6][3] = {{0, 1, 2}, {1, 0, 2}, {2, 0, 1}, {2, 1, 0}, {1, 2, 0}, {0, 2, 1}};
-  const double parts[3] = {c, x, 0.0};
-  return {parts[kOrder[sector][0]] + m, parts[kOrder[sector][1]] + m, parts[kOrder[sector][2]] + m};
-}
-
 std::array<Panel, 3> layout(const RenderOptions& options) {
   const double top = 44, gap = 12;
   const double w = options.width, h = options.height - top;

@@ -102,4 +102,11 @@ inline constexpr int kBenchDaemon = 230;
 // for a second plant run beside it).
 inline constexpr int kBenchPlant = 219;
 
+// ros2_dds_test: the ROS 2 sources and writers in process.
+inline constexpr int kRos2PointCloud = 65;
+inline constexpr int kRos2LaserScan = 66;
+inline constexpr int kRos2JointStates = 67;
+inline constexpr int kRos2CollisionObjects = 68;
+inline constexpr int kRos2Markers = 69;
+
 }  // namespace cellmap::test::domain

@@ -52,6 +52,11 @@ Qos& Qos::autodispose(bool on) {
   return *this;
 }
 
+Qos& Qos::best_effort() {
+  dds_qset_reliability(qos_, DDS_RELIABILITY_BEST_EFFORT, 0);
+  return *this;
+}
+
 Qos& Qos::partition(const std::string& name) {
   dds_qset_partition1(qos_, name.c_str());
   return *this;

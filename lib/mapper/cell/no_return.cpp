@@ -2,10 +2,37 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+
 namespace cellmap {
 
+namespace {
+
+// A line scanner's beams without a return, each cleared up to `range` or its own end, whichever is nearer.
+std::size_t add_beams(const Frame& frame, float range, Scan& scan) {
+  const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
+  for (const pcl::PointXYZ& end : frame.no_return_S) {
+    const Eigen::Vector3f end_S = end.getVector3fMap();
+    const float length = end_S.norm();
+    if (!(length > 0.0f)) continue;
+    const Eigen::Vector3f end_C = X_CS * (end_S * (std::min(length, range) / length));
+    scan.clear_C.push_back(pcl::PointXYZ(end_C.x(), end_C.y(), end_C.z()));
+  }
+  return frame.no_return_S.size();
+}
+
+}  // namespace
+
 std::size_t add_no_return_rays(const Frame& frame, double range, unsigned phase, Scan& scan) {
-  if (!frame.depth || !(range > 0.0)) return 0;
+  if (!(range > 0.0)) return 0;
+  if (!frame.no_return_S.empty()) {
+    const std::size_t added = add_beams(frame, float(range), scan);
+    scan.clear_C.width = static_cast<std::uint32_t>(scan.clear_C.size());
+    scan.clear_C.height = 1;
+    scan.clear_C.is_dense = true;
+    return added;
+  }
+  if (!frame.depth) return 0;
   const DepthImage& image = *frame.depth;
   const PinholeIntrinsics& in = image.intrinsics;
   const auto width = static_cast<std::size_t>(in.width), height = static_cast<std::size_t>(in.height);

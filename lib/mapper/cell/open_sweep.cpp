@@ -18,6 +18,8 @@ namespace {
 void drop_measurements(Frame& frame) {
   frame.points_S.clear();
   frame.points_S.points.shrink_to_fit();
+  frame.no_return_S.clear();
+  frame.no_return_S.points.shrink_to_fit();
   if (frame.depth) {
     frame.depth->depth.clear();
     frame.depth->depth.shrink_to_fit();

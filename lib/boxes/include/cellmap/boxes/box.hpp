@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -25,6 +26,10 @@ struct Box final {
   [[nodiscard]] double volume() const { return 8.0 * half_extents.prod(); }
   [[nodiscard]] bool is_axis_aligned() const;
 };
+
+/// The colour of a box wherever cellmap shows it (the view, `cellmap render`, RViz markers), RGB 0–1: a hue
+/// from the id, so a box keeps its colour from version to version.
+[[nodiscard]] std::array<double, 3> box_colour(std::uint64_t id);
 
 /// A set of boxes with the version and frame they belong to: the boxes JSON file (docs/boxes-json.md).
 struct BoxSet final {

@@ -45,10 +45,6 @@ struct Face final {
 /// the front left, above (−x, −y, +z of the scene's centre).
 [[nodiscard]] std::vector<Face> project(const std::vector<Box>& boxes, View view, const Panel& panel);
 
-/// The colour of a box on the page and in pictures (RGB, 0–1): a hue from the id, so a box keeps its colour
-/// from version to version.
-[[nodiscard]] std::array<double, 3> box_colour(std::uint64_t id);
-
 struct RenderOptions final {
   int width = 1600;  ///< pixels (SVG: points)
   int height = 1000;

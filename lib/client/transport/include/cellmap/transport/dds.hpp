@@ -38,6 +38,9 @@ class Qos final {
   /// Writers only: when false, deleting the writer (a daemon restart) unregisters its instances without
   /// disposing them, so readers keep the data instead of seeing it removed.
   Qos& autodispose(bool on);
+  /// BEST_EFFORT instead of RELIABLE: a reader then matches writers of either kind; a sample lost on the way
+  /// is not sent again.
+  Qos& best_effort();
   /// Readers and writers: puts the entity in one DDS partition (instead of the default partition ""). A name
   /// with '*' or '?' is a pattern: it matches every partition it fits (Cyclone matches patterns on either
   /// side, never a pattern with a pattern).

@@ -75,6 +75,9 @@ struct Frame final {
   Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();  ///< sensor pose in the cell frame at `stamp`
   std::optional<DepthImage> depth;                         ///< cameras only
   Cloud points_S;  ///< valid points in the sensor frame (from `depth`, or a scanner's scan)
+  /// Line scanners: a point at the far end of each beam that saw nothing within its range, in the sensor
+  /// frame (a camera's such pixels are the 0s of `depth`). SweepFrame::no_return_range clears along them.
+  Cloud no_return_S;
   /// What the sensor could see, set by sources that know it without a depth image (line scanners).
   std::optional<FieldOfView> field_of_view;
 };

@@ -1,0 +1,85 @@
+#include "cellmap/ros2/point_cloud2.hpp"
+
+#include <cmath>
+#include <cstring>
+
+#include "cellmap/common/error.hpp"
+
+namespace cellmap::ros2 {
+namespace {
+
+// Where one coordinate lies in a point and how wide it is.
+struct Coordinate final {
+  std::uint32_t offset = 0;
+  bool is_double = false;
+};
+
+Coordinate find_coordinate(const PointCloud2View& msg, const char* name) {
+  for (const PointField& field : msg.fields) {
+    if (field.name != name) continue;
+    const auto type = static_cast<PointFieldType>(field.datatype);
+    if (type != PointFieldType::kFloat32 && type != PointFieldType::kFloat64) {
+      throw Error(std::string("field ") + name + " has datatype " + std::to_string(field.datatype) +
+                  ", not FLOAT32 (7) or FLOAT64 (8)");
+    }
+    if (field.count == 0) throw Error(std::string("field ") + name + " has count 0");
+    const Coordinate c{field.offset, type == PointFieldType::kFloat64};
+    const std::uint64_t end = std::uint64_t{c.offset} + (c.is_double ? 8 : 4);
+    if (end > msg.point_step) {
+      throw Error(std::string("field ") + name + " at offset " + std::to_string(field.offset) +
+                  " ends past point_step " + std::to_string(msg.point_step));
+    }
+    return c;
+  }
+  throw Error(std::string("no field ") + name);
+}
+
+void check_layout(const PointCloud2View& msg) {
+  if (msg.is_bigendian) throw Error("big-endian clouds are not supported");
+  const std::uint64_t points = std::uint64_t{msg.width} * msg.height;
+  if (points > kMaxCloudPoints) {
+    throw Error(std::to_string(msg.width) + " x " + std::to_string(msg.height) + " points, more than " +
+                std::to_string(kMaxCloudPoints));
+  }
+  if (std::uint64_t{msg.width} * msg.point_step > msg.row_step) {
+    throw Error("row_step " + std::to_string(msg.row_step) + " is shorter than width " +
+                std::to_string(msg.width) + " x point_step " + std::to_string(msg.point_step));
+  }
+  if (std::uint64_t{msg.row_step} * msg.height != msg.data_size) {
+    throw Error("data holds " + std::to_string(msg.data_size) + " bytes, not row_step " +
+                std::to_string(msg.row_step) + " x height " + std::to_string(msg.height));
+  }
+}
+
+template <typename T>
+float read(const std::uint8_t* at) {
+  T value;
+  std::memcpy(&value, at, sizeof(T));
+  return static_cast<float>(value);
+}
+
+float read(const std::uint8_t* point, const Coordinate& c) {
+  return c.is_double ? read<double>(point + c.offset) : read<float>(point + c.offset);
+}
+
+}  // namespace
+
+Cloud to_points(const PointCloud2View& msg) {
+  check_layout(msg);
+  const Coordinate x = find_coordinate(msg, "x"), y = find_coordinate(msg, "y"), z = find_coordinate(msg, "z");
+  Cloud cloud;
+  cloud.reserve(std::size_t{msg.width} * msg.height);
+  for (std::uint32_t row = 0; row < msg.height; ++row) {
+    const std::uint8_t* point = msg.data + std::size_t{row} * msg.row_step;
+    for (std::uint32_t i = 0; i < msg.width; ++i, point += msg.point_step) {
+      const pcl::PointXYZ p(read(point, x), read(point, y), read(point, z));
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud.push_back(p);
+    }
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  return cloud;
+}
+
+}  // namespace cellmap::ros2
