@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "cellmap/ros2/topics.hpp"
+#include "cellmap/ros2/type_hash.hpp"
 #include "moveit_msgs/msg/CollisionObject.h"
 #include "visualization_msgs/msg/MarkerArray.h"
 
@@ -111,12 +112,17 @@ visualization_msgs_msg_dds__Marker_ cube(const std_msgs_msg_dds__Header_& h, con
   return m;
 }
 
+// KEEP_ALL: a version's burst of boxes must reach MoveIt whole.
 dds::Qos collision_object_qos() {
-  return dds::Qos::make(false, 0);  // KEEP_ALL: a version's burst of boxes must reach MoveIt whole
+  dds::Qos qos = dds::Qos::make(false, 0);
+  qos.user_data(type_hash_user_data("moveit_msgs/msg/CollisionObject"));
+  return qos;
 }
 
 dds::Qos marker_qos() {
-  return dds::Qos::make(true, 1);
+  dds::Qos qos = dds::Qos::make(true, 1);
+  qos.user_data(type_hash_user_data("visualization_msgs/msg/MarkerArray"));
+  return qos;
 }
 
 }  // namespace

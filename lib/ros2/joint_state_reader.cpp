@@ -7,6 +7,7 @@
 #include "cellmap/common/wall_clock.hpp"
 #include "cellmap/ros2/joint_state.hpp"
 #include "cellmap/ros2/topics.hpp"
+#include "cellmap/ros2/type_hash.hpp"
 #include "sensor_msgs/msg/JointState.h"
 
 namespace cellmap::ros2 {
@@ -17,7 +18,7 @@ constexpr std::uint32_t kJointReaderDepth = 256;
 
 dds::Qos reader_qos() {
   dds::Qos qos = dds::Qos::make(false, kJointReaderDepth);
-  qos.best_effort();
+  qos.best_effort().user_data(type_hash_user_data("sensor_msgs/msg/JointState"));
   return qos;
 }
 

@@ -10,6 +10,7 @@
 #include "cellmap/common/wall_clock.hpp"
 #include "cellmap/ros2/laser_scan.hpp"
 #include "cellmap/ros2/point_cloud2.hpp"
+#include "cellmap/ros2/type_hash.hpp"
 #include "sensor_msgs/msg/LaserScan.h"
 #include "sensor_msgs/msg/PointCloud2.h"
 #include "quoted.hpp"
@@ -34,7 +35,7 @@ class TopicSource final : public DepthSource {
         on_refused_(std::move(on_refused)),
         to_frame_(std::move(to_frame)),
         topic_(participant, type, dds_topic(input_.topic)),
-        reader_(participant, topic_, reader_qos(input_.reliability)),
+        reader_(participant, topic_, reader_qos(input_.reliability, type_name)),
         waitset_(participant) {
     if (input_.frame_id.empty()) throw Error("camera '" + name_ + "': frame_id must not be empty");
     waitset_.attach(reader_);
@@ -70,9 +71,10 @@ class TopicSource final : public DepthSource {
   }
 
  private:
-  static dds::Qos reader_qos(Reliability reliability) {
+  static dds::Qos reader_qos(Reliability reliability, const char* type_name) {
     dds::Qos qos = dds::Qos::make(false, kFrameReaderDepth);
     if (reliability == Reliability::kBestEffort) qos.best_effort();
+    qos.user_data(type_hash_user_data(type_name));
     return qos;
   }
 

@@ -15,6 +15,7 @@
 #include "cellmap/ros2/joint_state_reader.hpp"
 #include "cellmap/ros2/sensor_sources.hpp"
 #include "cellmap/ros2/topics.hpp"
+#include "cellmap/ros2/type_hash.hpp"
 #include "moveit_msgs/msg/CollisionObject.h"
 #include "sensor_msgs/msg/JointState.h"
 #include "sensor_msgs/msg/LaserScan.h"
@@ -269,6 +270,20 @@ std::vector<SeenObject> take_objects(const dds::Reader& reader, std::size_t coun
   return seen;
 }
 
+// The USER_DATA of the one writer matched with `reader`.
+std::string matched_writer_user_data(const dds::Reader& reader) {
+  dds_instance_handle_t writer = 0;
+  if (dds_get_matched_publications(reader.get(), &writer, 1) != 1) return "no writer matched";
+  dds_builtintopic_endpoint_t* endpoint = dds_get_matched_publication_data(reader.get(), writer);
+  if (endpoint == nullptr) return "no endpoint data";
+  void* data = nullptr;
+  size_t size = 0;
+  std::string text = dds_qget_userdata(endpoint->qos, &data, &size) ? std::string(static_cast<char*>(data), size) : "";
+  dds_free(data);
+  dds_builtintopic_free_endpoint(endpoint);
+  return text;
+}
+
 Box box(std::uint64_t id, Eigen::Vector3d center, Eigen::Vector3d half_extents,
         Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity()) {
   Box b;
@@ -297,6 +312,8 @@ TEST_F(Ros2DdsTest, CollisionObjectsFollowTheVersionsAndAReaderThatJoinsGetsEver
       std::this_thread::sleep_for(10ms);
   };
   joined();  // nothing to send yet
+  // Discovery tells the reader the writer's type hash, as `ros2 topic info -v` shows it.
+  EXPECT_EQ(matched_writer_user_data(first), type_hash_user_data("moveit_msgs/msg/CollisionObject"));
 
   const Environment v0("arm");
   const Eigen::Quaterniond yaw(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));

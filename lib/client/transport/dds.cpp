@@ -67,6 +67,11 @@ Qos& Qos::property(const std::string& name, const std::string& value) {
   return *this;
 }
 
+Qos& Qos::user_data(const std::string& text) {
+  dds_qset_userdata(qos_, text.data(), text.size());
+  return *this;
+}
+
 Entity::~Entity() {
   reset();
 }

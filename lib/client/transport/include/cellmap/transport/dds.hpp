@@ -47,6 +47,8 @@ class Qos final {
   Qos& partition(const std::string& name);
   /// Sets a named property (participants: e.g. DDS Security's "dds.sec.*").
   Qos& property(const std::string& name, const std::string& value);
+  /// Sets USER_DATA to the bytes of `text` (no NUL), which peers see in discovery (ROS 2: "typehash=…;").
+  Qos& user_data(const std::string& text);
   [[nodiscard]] const dds_qos_t* get() const { return qos_; }
 
  private:
