@@ -63,14 +63,9 @@ class Stopwatch {
   double cpu_;
 };
 
-// The DDS Security setting, refused when ROS 2 topics are in use: ROS 2 nodes do not hold the cell's
-// credentials, and a daemon that talked to them would be silently unprotected.
+// The DDS Security setting, once the command line's --security was checked against ROS 2 topics.
 const std::optional<security::Setting>& security_of(const DaemonConfig& config) {
-  if (config.security && config.uses_ros2()) {
-    throw Error(
-        "DDS Security is on and the config uses ROS 2 topics (a pointcloud2 or laserscan source, or the ros2 "
-        "section), which the cell's permissions cannot protect: turn one of them off (docs/ros2.md)");
-  }
+  check_ros2_security(config);
   return config.security;
 }
 

@@ -85,7 +85,8 @@ std::string read_ros2_topic(YamlMap& section, const char* key, const std::string
 ros2::TopicInput read_topic_input(YamlMap settings, bool chosen) {
   ros2::TopicInput input;
   const std::string topic = settings.get<std::string>("topic", "");
-  if (chosen || !topic.empty()) input.topic = read_ros2_topic(settings, "topic", topic);
+  if (chosen && topic.empty()) settings.fail("topic", "is required: the ROS 2 topic of the sensor's samples");
+  if (!topic.empty()) input.topic = read_ros2_topic(settings, "topic", topic);
   input.frame_id = settings.get<std::string>("frame_id", "");
   if (chosen && input.frame_id.empty())
     settings.fail("frame_id", "is required: the header.frame_id of the sensor's samples");
@@ -258,8 +259,19 @@ DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& sou
   c.pipeline = CellPipelineConfig::from_yaml(root);
   c.security = read_security(root.child("security"), base_dir);
   c.ros2 = read_ros2(root.child("ros2"));
+  if (c.simulated() && !c.ros2.joint_states.empty())
+    root.child("ros2").fail("joint_states", "poses cameras; the simulated cell moves its robot itself");
   root.expect_all_read();
+  check_ros2_security(c);
   return c;
+}
+
+void check_ros2_security(const DaemonConfig& config) {
+  if (config.security && config.uses_ros2()) {
+    throw Error(
+        "DDS Security is on and the config uses ROS 2 topics (a pointcloud2 or laserscan source, or the ros2 "
+        "section), which the cell's permissions cannot protect: turn one of them off (docs/ros2.md)");
+  }
 }
 
 bool DaemonConfig::uses_ros2() const {

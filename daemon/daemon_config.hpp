@@ -118,4 +118,9 @@ struct DaemonConfig final {
                                           const std::filesystem::path& base_dir);
 };
 
+/// ROS 2 nodes hold none of the cell's credentials: a daemon that talked to them with DDS Security on would
+/// be silently unprotected on those topics. (DaemonConfig::parse checks it; the command line's --security
+/// needs it checked again.) @throws Error saying so if security is on and uses_ros2().
+void check_ros2_security(const DaemonConfig& config);
+
 }  // namespace cellmap::daemon

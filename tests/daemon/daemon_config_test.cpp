@@ -47,7 +47,7 @@ TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {
   EXPECT_EQ(error_of("change: {margin: -1}\n").rfind("my.yaml: change.margin:", 0), 0u)
       << error_of("change: {margin: -1}\n");
   EXPECT_EQ(error_of("source: {kind: kinect}\n"),
-            "my.yaml: source.kind: must be one of sim, replay, openni2, v4l2");
+            "my.yaml: source.kind: must be one of sim, replay, openni2, v4l2, pointcloud2, laserscan");
   EXPECT_EQ(error_of("log_level: loud\n"),
             "my.yaml: log_level: must be one of trace, debug, info, warn, error");
   EXPECT_EQ(error_of("segment: {neighbours: {kk: 3}}\n").rfind("my.yaml: segment.neighbours.kk", 0), 0u)
@@ -203,6 +203,82 @@ TEST(DaemonConfigTest, RobotSectionIsTheGantryOrAUrdf) {
             "my.yaml: robot.gantry: exactly one of gantry, urdf is required");
   EXPECT_EQ(error_of("self_filter: {padding: 2}\n").rfind("my.yaml: self_filter.padding:", 0), 0u)
       << error_of("self_filter: {padding: 2}\n");
+}
+
+TEST(DaemonConfigTest, Ros2CellIsFedByAPointCloud2TopicAndPublishesToMoveItAndRviz) {
+  const DaemonConfig c = DaemonConfig::load(CELLMAP_SOURCE_DIR "/config/ros2-cell.yaml");
+  ASSERT_EQ(c.sources.size(), 1u);
+  const SourceConfig& camera = c.sources[0];
+  EXPECT_EQ(camera.kind, SourceKind::kPointCloud2);
+  EXPECT_TRUE(camera.is_camera());
+  EXPECT_EQ(camera.ros2.topic, "/camera/depth/points");
+  EXPECT_EQ(camera.ros2.frame_id, "camera");
+  EXPECT_EQ(camera.ros2.reliability, ros2::Reliability::kBestEffort);
+  EXPECT_EQ(camera.mount, sim::Mount::kCell);
+  EXPECT_TRUE(camera.X_CS.isApprox(Eigen::Isometry3d::Identity()));
+  ASSERT_TRUE(c.pipeline.segment.workspace);
+  EXPECT_TRUE(c.pipeline.segment.workspace->contains({2.9, -1.4, 1.4}));
+  EXPECT_FALSE(c.pipeline.segment.workspace->contains({0.2, 0.0, 0.0}));
+  ASSERT_TRUE(c.ros2.collision_objects);
+  EXPECT_EQ(c.ros2.collision_objects->topic, "/collision_object");
+  EXPECT_EQ(c.ros2.collision_objects->frame_id, "world");
+  ASSERT_TRUE(c.ros2.markers);
+  EXPECT_EQ(c.ros2.markers->topic, "/cellmap/markers");
+  EXPECT_TRUE(c.ros2.joint_states.empty());
+  EXPECT_TRUE(c.uses_ros2());
+}
+
+TEST(DaemonConfigTest, Ros2IsOffByDefault) {
+  const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
+  EXPECT_FALSE(c.ros2.collision_objects);
+  EXPECT_FALSE(c.ros2.markers);
+  EXPECT_FALSE(c.uses_ros2());
+}
+
+TEST(DaemonConfigTest, LaserScanSourceOnTheToolWithJointStates) {
+  const DaemonConfig c = DaemonConfig::parse(
+      "robot: {gantry: {lower: [0, 0, 0], upper: [1, 1, 1], tool_at_zero: {position: [0, 0, 2]}}}\n"
+      "sources: [{kind: laserscan, sensor: os32c, mount: tool, pose: {position: [0, 0, -0.1]},\n"
+      "           laserscan: {topic: /scan, frame_id: laser, reliability: reliable, frame_timeout: 0.5}}]\n"
+      "ros2: {joint_states: /joint_states}\n",
+      "my.yaml", "/etc/cellmap");
+  EXPECT_EQ(c.sources[0].kind, SourceKind::kLaserScan);
+  EXPECT_EQ(c.sources[0].ros2.topic, "/scan");
+  EXPECT_EQ(c.sources[0].ros2.reliability, ros2::Reliability::kReliable);
+  EXPECT_DOUBLE_EQ(c.sources[0].ros2.frame_timeout, 0.5);
+  EXPECT_EQ(c.sources[0].mount, sim::Mount::kTool);
+  EXPECT_EQ(c.ros2.joint_states, "/joint_states");
+}
+
+TEST(DaemonConfigTest, Ros2ErrorsNameTheKey) {
+  const std::string cloud = "sources: [{kind: pointcloud2, sensor: cam, mount: cell, pose: {position: [0, 0, 0]}, ";
+  EXPECT_EQ(error_of(cloud + "pointcloud2: {frame_id: camera}}]\n"),
+            "my.yaml: sources[0].pointcloud2.topic: is required: the ROS 2 topic of the sensor's samples");
+  EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: /points}}]\n"),
+            "my.yaml: sources[0].pointcloud2.frame_id: is required: the header.frame_id of the sensor's samples");
+  EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: points, frame_id: camera}}]\n"),
+            "my.yaml: sources[0].pointcloud2.topic: 'points' is not a ROS 2 topic name: it must start with '/'");
+  EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: /p, frame_id: c, reliability: sometimes}}]\n"),
+            "my.yaml: sources[0].pointcloud2.reliability: must be best_effort or reliable");
+  EXPECT_EQ(error_of("ros2: {markers: {enabled: true, topic: /cellmap//markers}}\n"),
+            "my.yaml: ros2.markers.topic: '/cellmap//markers' is not a ROS 2 topic name: it has an empty token "
+            "('//')");
+  EXPECT_EQ(error_of("ros2: {joint_states: /joint_states}\n"),
+            "my.yaml: ros2.joint_states: poses cameras; the simulated cell moves its robot itself");
+  EXPECT_NE(error_of("ros2: {collision_objects: {enabled: true, colour: red}}\n").find("colour"), std::string::npos);
+}
+
+TEST(DaemonConfigTest, DdsSecurityWithRos2TopicsIsRefused) {
+  const std::string expected =
+      "DDS Security is on and the config uses ROS 2 topics (a pointcloud2 or laserscan source, or the ros2 "
+      "section), which the cell's permissions cannot protect: turn one of them off (docs/ros2.md)";
+  EXPECT_EQ(error_of("security: {directory: creds}\nros2: {markers: {enabled: true}}\n"), expected);
+  DaemonConfig c = DaemonConfig::load(CELLMAP_SOURCE_DIR "/config/ros2-cell.yaml");
+  c.security = security::Setting{"creds", security::Role::kDaemon};  // as --security sets it
+  EXPECT_THROW(check_ros2_security(c), Error);
+  c.ros2 = {};
+  c.sources = DaemonConfig::parse("", "empty.yaml", ".").sources;
+  EXPECT_NO_THROW(check_ros2_security(c));
 }
 
 }  // namespace

@@ -170,7 +170,8 @@ void CellPipeline::filter_robot(const Robot& robot) {
 }
 
 OpenSweep CellPipeline::open_sweep() const {
-  return OpenSweep(config_.occupancy, config_.self_filter.enabled ? filter_.get() : nullptr);
+  return OpenSweep(config_.occupancy, config_.self_filter.enabled ? filter_.get() : nullptr,
+                   config_.segment.workspace);
 }
 
 SweepReport CellPipeline::process(FrameSweep sweep) {

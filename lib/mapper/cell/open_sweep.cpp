@@ -26,6 +26,21 @@ void drop_measurements(Frame& frame) {
   }
 }
 
+// Points of `scan` outside `workspace` become clear-only ray ends.
+void clear_only_outside(const Workspace& workspace, Scan& scan) {
+  Cloud inside;
+  inside.reserve(scan.points_C.size());
+  for (const pcl::PointXYZ& p : scan.points_C) {
+    (workspace.contains(p.getVector3fMap().cast<double>()) ? inside : scan.clear_C).push_back(p);
+  }
+  scan.points_C = std::move(inside);
+  for (Cloud* cloud : {&scan.points_C, &scan.clear_C}) {
+    cloud->width = static_cast<std::uint32_t>(cloud->size());
+    cloud->height = 1;
+    cloud->is_dense = true;
+  }
+}
+
 // The start of the line that says why `frame` was left out.
 std::string fault_of(const SweepFrame& frame) {
   return "frame of '" + frame.frame.sensor + "' at " + std::to_string(frame.frame.stamp) + " s: ";
@@ -33,8 +48,8 @@ std::string fault_of(const SweepFrame& frame) {
 
 }  // namespace
 
-OpenSweep::OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter)
-    : occupancy_(occupancy), filter_(filter), open_(fresh()) {
+OpenSweep::OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter, std::optional<Workspace> workspace)
+    : occupancy_(occupancy), filter_(filter), workspace_(std::move(workspace)), open_(fresh()) {
   side_by_side_.reserve(std::size_t(std::max(occupancy_.threads, 1)));
   for (int t = 0; t < std::max(occupancy_.threads, 1); ++t) side_by_side_.emplace_back(occupancy_);
 }
@@ -55,6 +70,7 @@ OpenSweep::Gathered OpenSweep::gather(SweepFrame frame, unsigned phase, Observed
   } else {
     scan = move_to_scan(frame.frame);
   }
+  if (workspace_) clear_only_outside(*workspace_, scan);
   if (frame.no_return_range > 0.0)
     out.no_return_rays = add_no_return_rays(frame.frame, frame.no_return_range, phase, scan);
   filter_clock.add_to(out.t_filter, out.cpu_filter);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cellmap/frame/frame.hpp"
+#include "cellmap/preprocess/workspace.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
 #include "cellmap/robot/robot.hpp"
 #include "cellmap/self_filter/self_filter.hpp"
@@ -64,9 +65,12 @@ struct GatheredSweep final {
 class OpenSweep final {
  public:
   /// Voxels at `occupancy`'s resolution and range; frames that come with the robot's pose are cut by
-  /// `filter` (nullptr: frames pass as they are). `filter` must outlive this.
+  /// `filter` (nullptr: frames pass as they are); points outside `workspace` (the config's
+  /// segment.workspace; none: no crop) only clear the free space up to them, as points beyond max_range do:
+  /// nothing outside what can matter to the robot becomes an obstacle. `filter` must outlive this.
   /// @throws Error if `occupancy` is invalid.
-  explicit OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter = nullptr);
+  explicit OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter = nullptr,
+                     std::optional<Workspace> workspace = std::nullopt);
 
   /// Cuts the robot out of `frame` (when it comes with the robot's pose and a filter is set), converts it to
   /// its scan (its points moved, not copied; clear-only rays for its pixels without a return) and gathers
@@ -100,6 +104,7 @@ class OpenSweep final {
 
   OccupancyConfig occupancy_;
   const SelfFilter* filter_;
+  std::optional<Workspace> workspace_;
   GatheredSweep open_;
   std::vector<ObservedVoxels> side_by_side_;  // one per thread of a batch; merged into open_ at close()
   Eigen::Vector3d origin_sum_C_ = Eigen::Vector3d::Zero();
