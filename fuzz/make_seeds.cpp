@@ -16,8 +16,12 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "cellmap.h"
+#include "sensor_msgs/msg/JointState.h"
+#include "sensor_msgs/msg/LaserScan.h"
+#include "sensor_msgs/msg/PointCloud2.h"
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/environment/version_store.hpp"
@@ -197,6 +201,59 @@ void map_blob_seeds(const fs::path& dir) {
 
 }  // namespace
 
+// ROS 2 sensor samples as a driver sends them: a packed FLOAT32 cloud with a NaN point, an organized FLOAT64
+// one with padding, a scan with inf and NaN ranges, the SCARA arm's joint states with a gripper's joint.
+void ros2_seeds(const fs::path& dir) {
+  char x[] = "x", y[] = "y", z[] = "z", frame[] = "camera", laser[] = "laser", empty[] = "";
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<sensor_msgs_msg_dds__PointField_> packed_fields{{x, 0, 7, 1}, {y, 4, 7, 1}, {z, 8, 7, 1}};
+  std::vector<float> packed_points{0.5f, -1.0f, 2.0f, nan, nan, nan, 1.0f, 2.0f, 3.0f};
+  sensor_msgs_msg_dds__PointCloud2_ packed{};
+  packed.header = {{1'700'000'000, 5}, frame};
+  packed.height = 1;
+  packed.width = 3;
+  packed.fields = {3, 3, packed_fields.data(), false};
+  packed.point_step = 12;
+  packed.row_step = 36;
+  packed.data = {36, 36, reinterpret_cast<std::uint8_t*>(packed_points.data()), false};
+  write(dir / "cloud_packed", serialized(0, sensor_msgs_msg_dds__PointCloud2__desc, &packed, false));
+  write(dir / "cloud_packed_be", serialized(0, sensor_msgs_msg_dds__PointCloud2__desc, &packed, true));
+
+  std::vector<sensor_msgs_msg_dds__PointField_> wide_fields{{z, 0, 8, 1}, {x, 8, 8, 1}, {y, 16, 8, 1}};
+  std::vector<double> wide_points(2 * 2 * 4, 0.25);  // 2 × 2 points of 32 bytes (8 of padding)
+  wide_points[1] = std::numeric_limits<double>::infinity();
+  sensor_msgs_msg_dds__PointCloud2_ organized = packed;
+  organized.height = 2;
+  organized.width = 2;
+  organized.fields = {3, 3, wide_fields.data(), false};
+  organized.point_step = 32;
+  organized.row_step = 64;
+  organized.data = {128, 128, reinterpret_cast<std::uint8_t*>(wide_points.data()), false};
+  write(dir / "cloud_organized", serialized(0, sensor_msgs_msg_dds__PointCloud2__desc, &organized, false));
+
+  std::vector<float> ranges{1.0f, std::numeric_limits<float>::infinity(), nan, 0.01f, 3.5f};
+  sensor_msgs_msg_dds__LaserScan_ scan{};
+  scan.header = {{1'700'000'000, 5}, laser};
+  scan.angle_min = -1.0f;
+  scan.angle_max = 1.0f;
+  scan.angle_increment = 0.5f;
+  scan.range_min = 0.05f;
+  scan.range_max = 4.0f;
+  scan.ranges = {5, 5, ranges.data(), false};
+  write(dir / "scan", serialized(1, sensor_msgs_msg_dds__LaserScan__desc, &scan, false));
+  write(dir / "scan_be", serialized(1, sensor_msgs_msg_dds__LaserScan__desc, &scan, true));
+
+  char shoulder[] = "shoulder", elbow[] = "elbow", lift[] = "lift", finger[] = "finger";
+  std::vector<char*> names{finger, lift, shoulder, elbow};
+  std::vector<double> positions{0.01, 0.1, 0.5, -0.25};
+  sensor_msgs_msg_dds__JointState_ joints{};
+  joints.header = {{1'700'000'000, 5}, empty};
+  joints.name = {4, 4, names.data(), false};
+  joints.position = {4, 4, positions.data(), false};
+  write(dir / "joint_states", serialized(2, sensor_msgs_msg_dds__JointState__desc, &joints, false));
+  write(dir / "joint_states_be", serialized(2, sensor_msgs_msg_dds__JointState__desc, &joints, true));
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "usage: fuzz_make_seeds CORPUS_DIR\n");
@@ -206,6 +263,7 @@ int main(int argc, char** argv) {
   cloud_seeds(corpus / "pcd", corpus / "ply");
   depth_image_seeds(corpus / "depth_image");
   dds_seeds(corpus / "dds_samples");
+  ros2_seeds(corpus / "ros2_samples");
   version_store_seeds(corpus / "version_store", fs::temp_directory_path() / "cellmap_fuzz_make_seeds");
   map_blob_seeds(corpus / "map_blob");
   return 0;

@@ -8,7 +8,7 @@
 #include "cellmap/ros2/joint_state.hpp"
 #include "cellmap/ros2/topics.hpp"
 #include "cellmap/ros2/type_hash.hpp"
-#include "sensor_msgs/msg/JointState.h"
+#include "wire_views.hpp"
 
 namespace cellmap::ros2 {
 namespace {
@@ -20,13 +20,6 @@ dds::Qos reader_qos() {
   dds::Qos qos = dds::Qos::make(false, kJointReaderDepth);
   qos.best_effort().user_data(type_hash_user_data("sensor_msgs/msg/JointState"));
   return qos;
-}
-
-std::vector<std::string> names_of(const sensor_msgs_msg_dds__JointState_& msg) {
-  std::vector<std::string> names;
-  names.reserve(msg.name._length);
-  for (std::uint32_t i = 0; i < msg.name._length; ++i) names.emplace_back(msg.name._buffer[i] ? msg.name._buffer[i] : "");
-  return names;
 }
 
 }  // namespace
@@ -64,8 +57,7 @@ std::vector<transport::RobotJoints> JointStateReader::take(std::chrono::nanoseco
       joints.stamp_ns = std::int64_t{stamp.sec} * 1'000'000'000 + stamp.nanosec;
       if (max_stamp_skew_.count() > 0 && std::abs(joints.stamp_ns - now_ns) > max_stamp_skew_.count())
         throw Error("stamped " + std::to_string(double(joints.stamp_ns - now_ns) * 1e-9) + " s from now");
-      const std::vector<double> positions(msg.position._buffer, msg.position._buffer + msg.position._length);
-      joints.positions = in_robot_order(names_of(msg), positions, joint_names_);
+      joints.positions = in_robot_order(names_of(msg), positions_of(msg), joint_names_);
       joints.names = joint_names_;
       samples.push_back(std::move(joints));
     } catch (const Error& e) {

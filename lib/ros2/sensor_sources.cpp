@@ -11,9 +11,8 @@
 #include "cellmap/ros2/laser_scan.hpp"
 #include "cellmap/ros2/point_cloud2.hpp"
 #include "cellmap/ros2/type_hash.hpp"
-#include "sensor_msgs/msg/LaserScan.h"
-#include "sensor_msgs/msg/PointCloud2.h"
 #include "quoted.hpp"
+#include "wire_views.hpp"
 
 namespace cellmap::ros2 {
 namespace {
@@ -138,16 +137,6 @@ class TopicSource final : public DepthSource {
   double last_frame_ = 0.0;
 };
 
-PointCloud2View view_of(const sensor_msgs_msg_dds__PointCloud2_& msg) {
-  PointCloud2View view{msg.height, msg.width, {}, msg.is_bigendian, msg.point_step, msg.row_step,
-                       msg.data._buffer, msg.data._length};
-  for (std::uint32_t i = 0; i < msg.fields._length; ++i) {
-    const auto& f = msg.fields._buffer[i];
-    view.fields.push_back({f.name ? f.name : "", f.offset, f.datatype, f.count});
-  }
-  return view;
-}
-
 }  // namespace
 
 std::unique_ptr<DepthSource> make_point_cloud2_source(const dds::Participant& participant, std::string name,
@@ -165,9 +154,7 @@ std::unique_ptr<DepthSource> make_laser_scan_source(const dds::Participant& part
   return std::make_unique<TopicSource<Message>>(
       participant, &sensor_msgs_msg_dds__LaserScan__desc, "sensor_msgs/msg/LaserScan", std::move(name),
       std::move(input), std::move(on_refused), [](const Message& msg, Frame& frame) {
-        const LaserScanView view{msg.angle_min, msg.angle_max,    msg.angle_increment, msg.range_min,
-                                 msg.range_max, msg.ranges._buffer, msg.ranges._length};
-        ScanPoints scan = to_points(view);
+        ScanPoints scan = to_points(view_of(msg));
         frame.points_S = std::move(scan.points_S);
         frame.no_return_S = std::move(scan.no_return_S);
         frame.field_of_view = std::move(scan.fan);
