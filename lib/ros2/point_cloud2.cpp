@@ -37,7 +37,8 @@ Coordinate find_coordinate(const PointCloud2View& msg, const char* name) {
 void check_layout(const PointCloud2View& msg) {
   if (msg.is_bigendian) throw Error("big-endian clouds are not supported");
   const std::uint64_t points = std::uint64_t{msg.width} * msg.height;
-  if (points > kMaxCloudPoints) {
+  // Each bounded on its own too: a huge height times a width of 0 would pass and loop over empty rows.
+  if (points > kMaxCloudPoints || msg.width > kMaxCloudPoints || msg.height > kMaxCloudPoints) {
     throw Error(std::to_string(msg.width) + " x " + std::to_string(msg.height) + " points, more than " +
                 std::to_string(kMaxCloudPoints));
   }
