@@ -8,6 +8,13 @@
 
 namespace cellmap::test::domain {
 
+// ros2 peer: ros2_peer_test, the Fast DDS stand-in for a ROS 2 node (tests/ros2/peer) against plain Cyclone.
+inline constexpr int kPeerPublishes = 60;
+inline constexpr int kPeerSubscribes = 61;
+inline constexpr int kPeerLateMarkers = 62;
+inline constexpr int kPeerBigCloud = 63;
+inline constexpr int kPeerBestEffort = 64;
+
 // transport_test: in-process publisher and subscribers.
 inline constexpr int kEveryVersion = 110;
 inline constexpr int kLateJoiner = 111;

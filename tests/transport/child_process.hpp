@@ -1,33 +1,47 @@
 #pragma once
-// A child process for end-to-end tests: started with execv, its stdout read line by line with a timeout.
+// A child process for end-to-end tests: started with execv, its stdout read line by line with a timeout;
+// optionally its stdin written by the test.
 
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace cellmap::test {
 
 class ChildProcess {
  public:
-  explicit ChildProcess(std::vector<std::string> argv) {
+  /// What the child reads: the test's stdin, or what the test writes with write_input().
+  enum class Input { inherit, from_test };
+
+  explicit ChildProcess(std::vector<std::string> argv, Input input = Input::inherit) {
     int fds[2];
     if (::pipe(fds) != 0) throw std::runtime_error("pipe failed");
+    // A socket rather than a pipe for stdin: writing to a child that died then fails with EPIPE (send with
+    // MSG_NOSIGNAL) instead of killing the test with SIGPIPE.
+    int in[2] = {-1, -1};
+    if (input == Input::from_test && ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, in) != 0) {
+      throw std::runtime_error("socketpair failed");
+    }
     pid_ = ::fork();
     if (pid_ < 0) throw std::runtime_error("fork failed");
     if (pid_ == 0) {
       ::dup2(fds[1], STDOUT_FILENO);
       ::close(fds[0]);
       ::close(fds[1]);
+      if (in[1] >= 0) ::dup2(in[1], STDIN_FILENO);  // dup2 clears CLOEXEC on the copy
       std::vector<char*> args;
       for (std::string& a : argv) args.push_back(a.data());
       args.push_back(nullptr);
@@ -36,8 +50,11 @@ class ChildProcess {
     }
     ::close(fds[1]);
     out_ = fds[0];
+    if (in[1] >= 0) ::close(in[1]);
+    in_ = in[0];
   }
   ~ChildProcess() {
+    close_input();
     if (pid_ > 0) {
       ::kill(pid_, SIGKILL);
       wait();
@@ -78,6 +95,23 @@ class ChildProcess {
     }
   }
 
+  /// Writes all of `data` to the child's stdin (Input::from_test); blocks while the child does not read.
+  /// @throws std::runtime_error if the child's stdin is closed or the child is gone.
+  void write_input(std::string_view data) {
+    while (!data.empty()) {
+      const ssize_t n = in_ < 0 ? -1 : ::send(in_, data.data(), data.size(), MSG_NOSIGNAL);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw std::runtime_error("cannot write to the child's stdin");
+      data.remove_prefix(static_cast<std::size_t>(n));
+    }
+  }
+
+  /// Ends the child's stdin: it reads end of file.
+  void close_input() {
+    if (in_ >= 0) ::close(in_);
+    in_ = -1;
+  }
+
   void signal(int sig) const {
     if (pid_ > 0) ::kill(pid_, sig);
   }
@@ -101,6 +135,7 @@ class ChildProcess {
  private:
   pid_t pid_ = -1;
   int out_ = -1;
+  int in_ = -1;
   std::string buffer_;
 };
 
