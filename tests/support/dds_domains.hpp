@@ -116,4 +116,9 @@ inline constexpr int kRos2JointStates = 67;
 inline constexpr int kRos2CollisionObjects = 68;
 inline constexpr int kRos2Markers = 69;
 
+// ros2_e2e_test: cellmapd with a ROS 2 node of another vendor (tests/ros2/peer).
+inline constexpr int kRos2Cell = 71;
+inline constexpr int kRos2ArmJointStates = 72;
+inline constexpr int kRos2GantryLaserScan = 73;
+
 }  // namespace cellmap::test::domain
