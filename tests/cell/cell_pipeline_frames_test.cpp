@@ -122,6 +122,30 @@ TEST(CellPipelineFramesTest, NoReturnRaysEndAtTheirRangeAndFramesWithoutAnImageA
   EXPECT_EQ(pipeline.process(scanner).no_return_rays, 0u);
 }
 
+// A line scanner's beams that saw nothing within range (Frame::no_return_S, at its range_max) clear up to
+// no_return_range or their end, whichever is nearer; with no_return_range 0, nothing.
+TEST(CellPipelineFramesTest, ScannerBeamsWithoutAReturnClearUpToTheNearerOfTheirEndAndTheRange) {
+  const auto scan = [](double no_return_range) {
+    SweepFrame f;
+    f.frame.sensor = "lidar";
+    f.frame.X_CS.translation() = Eigen::Vector3d(0.01, 0.01, 0.01);
+    f.frame.no_return_S.push_back(pcl::PointXYZ(2.0f, 0.0f, 0.0f));  // range_max 2 m along +x
+    f.frame.no_return_S.push_back(pcl::PointXYZ(0.0f, 4.0f, 0.0f));  // range_max 4 m along +y
+    f.no_return_range = no_return_range;
+    FrameSweep sweep;
+    sweep.frames.push_back(std::move(f));
+    return sweep;
+  };
+  CellPipeline off(config());
+  EXPECT_EQ(off.process(scan(0.0)).no_return_rays, 0u);
+  CellPipeline pipeline(config());
+  EXPECT_EQ(pipeline.process(scan(3.0)).no_return_rays, 2u);
+  EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(1.9, 0.01, 0.01)), VoxelState::free);
+  EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(2.1, 0.01, 0.01)), VoxelState::unknown);  // its own end
+  EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(0.01, 2.9, 0.01)), VoxelState::free);
+  EXPECT_EQ(pipeline.map().state(Eigen::Vector3d(0.01, 3.1, 0.01)), VoxelState::unknown);  // no_return_range
+}
+
 // A panel appears in two halves three sweeps apart (the left half confirmed when the right one gets its first
 // hit): with gather_sweeps 0 each half is a version (the right half touches the left, whose voxels are new,
 // so it is a change of its own); with 3, one version holds both.

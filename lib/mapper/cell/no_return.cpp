@@ -11,14 +11,16 @@ namespace {
 // A line scanner's beams without a return, each cleared up to `range` or its own end, whichever is nearer.
 std::size_t add_beams(const Frame& frame, float range, Scan& scan) {
   const Eigen::Isometry3f X_CS = frame.X_CS.cast<float>();
+  std::size_t added = 0;
   for (const pcl::PointXYZ& end : frame.no_return_S) {
     const Eigen::Vector3f end_S = end.getVector3fMap();
     const float length = end_S.norm();
     if (!(length > 0.0f)) continue;
     const Eigen::Vector3f end_C = X_CS * (end_S * (std::min(length, range) / length));
     scan.clear_C.push_back(pcl::PointXYZ(end_C.x(), end_C.y(), end_C.z()));
+    ++added;
   }
-  return frame.no_return_S.size();
+  return added;
 }
 
 }  // namespace
