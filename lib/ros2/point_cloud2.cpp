@@ -1,5 +1,7 @@
 #include "cellmap/ros2/point_cloud2.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -63,19 +65,77 @@ float read(const std::uint8_t* point, const Coordinate& c) {
   return c.is_double ? read<double>(point + c.offset) : read<float>(point + c.offset);
 }
 
+// Points are gathered a block at a time, without a branch on each point's validity, and appended with one
+// copy: a push_back per point (its capacity check and PCL's width and height updates) cost more than reading
+// the point (`cellmap bench ros2`). 512 points are 8 KiB, within L1.
+constexpr std::uint32_t kBlock = 512;
+// A block is appended once fewer slots than this are left, so that the loop over a row runs long stretches.
+constexpr std::uint32_t kMinStretch = 64;
+
+// Appends to `cloud` the points of `msg` whose x, y and z, read as floats by `read_xyz(point, p)`, are all
+// finite, in row order.
+template <typename ReadXyz>
+void append_finite(const PointCloud2View& msg, const ReadXyz& read_xyz, Cloud& cloud) {
+  // Each point's 4th float stays 1, as pcl::PointXYZ(x, y, z) sets it.
+  std::array<pcl::PointXYZ, kBlock> block;
+  std::uint32_t filled = 0;
+  const auto flush = [&] {
+    cloud.points.insert(cloud.points.end(), block.begin(), block.begin() + filled);
+    filled = 0;
+  };
+  for (std::uint32_t row = 0; row < msg.height; ++row) {
+    const std::uint8_t* point = msg.data + std::size_t{row} * msg.row_step;
+    for (std::uint32_t left = msg.width; left > 0;) {
+      const std::uint32_t stretch = std::min(left, kBlock - filled);
+      for (std::uint32_t i = 0; i < stretch; ++i, point += msg.point_step) {
+        pcl::PointXYZ& p = block[filled];
+        read_xyz(point, p);
+        filled += static_cast<std::uint32_t>(std::isfinite(p.x) & std::isfinite(p.y) & std::isfinite(p.z));
+      }
+      left -= stretch;
+      if (kBlock - filled < kMinStretch) flush();
+    }
+  }
+  flush();
+}
+
 }  // namespace
 
 Cloud to_points(const PointCloud2View& msg) {
   check_layout(msg);
-  const Coordinate x = find_coordinate(msg, "x"), y = find_coordinate(msg, "y"), z = find_coordinate(msg, "z");
+  const Coordinate x = find_coordinate(msg, "x"), y = find_coordinate(msg, "y"),
+                   z = find_coordinate(msg, "z");
   Cloud cloud;
   cloud.reserve(std::size_t{msg.width} * msg.height);
-  for (std::uint32_t row = 0; row < msg.height; ++row) {
-    const std::uint8_t* point = msg.data + std::size_t{row} * msg.row_step;
-    for (std::uint32_t i = 0; i < msg.width; ++i, point += msg.point_step) {
-      const pcl::PointXYZ p(read(point, x), read(point, y), read(point, z));
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud.push_back(p);
-    }
+  // Each layout of the coordinates its own loop: all FLOAT32 (depth cameras and most lidars), all FLOAT64, or
+  // mixed, which reads each coordinate by its datatype.
+  if (!x.is_double && !y.is_double && !z.is_double) {
+    append_finite(
+        msg,
+        [xo = x.offset, yo = y.offset, zo = z.offset](const std::uint8_t* point, pcl::PointXYZ& p) {
+          p.x = read<float>(point + xo);
+          p.y = read<float>(point + yo);
+          p.z = read<float>(point + zo);
+        },
+        cloud);
+  } else if (x.is_double && y.is_double && z.is_double) {
+    append_finite(
+        msg,
+        [xo = x.offset, yo = y.offset, zo = z.offset](const std::uint8_t* point, pcl::PointXYZ& p) {
+          p.x = read<double>(point + xo);
+          p.y = read<double>(point + yo);
+          p.z = read<double>(point + zo);
+        },
+        cloud);
+  } else {
+    append_finite(
+        msg,
+        [&](const std::uint8_t* point, pcl::PointXYZ& p) {
+          p.x = read(point, x);
+          p.y = read(point, y);
+          p.z = read(point, z);
+        },
+        cloud);
   }
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -37,7 +39,8 @@ struct OwnedCloud {
   }
 };
 
-// x, y, z as packed FLOAT32, 12 bytes a point, one row: what depth_image_proc's point_cloud_xyz sends.
+// x, y, z as packed FLOAT32, 12 bytes a point, one row (sensor_msgs' setPointCloud2Fields with x, y, z;
+// depth_image_proc's point_cloud_xyz pads them to 16 bytes).
 OwnedCloud packed(const std::vector<std::array<float, 3>>& points) {
   OwnedCloud c;
   c.header.height = 1;
@@ -115,6 +118,58 @@ TEST(PointCloud2Test, OrganizedRowsWithPaddingAndInvalidPoints) {
   expect_point(cloud[1], 4, 5, 6);
   expect_point(cloud[2], 9, 10, 11);
   expect_point(cloud[3], 12, 13, 14);
+}
+
+// Mixed datatypes: x and z FLOAT32, y FLOAT64 (each coordinate read by its own datatype).
+TEST(PointCloud2Test, MixedFloat32AndFloat64FieldsAreRead) {
+  OwnedCloud c;
+  c.header.height = 1;
+  c.header.width = 2;
+  c.header.fields = {{"x", 0, kFloat32, 1}, {"y", 8, kFloat64, 1}, {"z", 4, kFloat32, 1}};
+  c.header.point_step = 16;
+  c.header.row_step = 32;
+  c.data.assign(32, 0);
+  c.put<float>(0, 1.5f);
+  c.put<double>(8, -0.25);
+  c.put<float>(4, 2.0f);
+  c.put<float>(16, kNaN);
+  const Cloud cloud = to_points(c.view());
+  ASSERT_EQ(cloud.size(), 1u);
+  expect_point(cloud[0], 1.5f, -0.25f, 2.0f);
+}
+
+// A cloud of many rows longer than the points converted at a time, with padded rows and invalid points in
+// runs and alone: the same points, in the same order, as reading each point on its own.
+TEST(PointCloud2Test, LargeOrganizedCloudKeepsEveryValidPointInOrder) {
+  OwnedCloud c;
+  c.header.height = 37;
+  c.header.width = 1013;
+  c.header.fields = {
+      {"x", 0, kFloat32, 1}, {"y", 4, kFloat32, 1}, {"z", 8, kFloat32, 1}, {"rgb", 16, kFloat32, 1}};
+  c.header.point_step = 32;
+  c.header.row_step = 1013 * 32 + 8;
+  c.data.assign(std::size_t{c.header.row_step} * c.header.height, 0);
+  std::vector<std::array<float, 3>> expected;
+  for (std::uint32_t row = 0; row < c.header.height; ++row) {
+    for (std::uint32_t i = 0; i < c.header.width; ++i) {
+      const std::uint32_t n = row * c.header.width + i;
+      std::array<float, 3> p{0.001f * n, -0.5f * row, 1.0f + 0.25f * i};
+      if ((n / 700) % 3 == 1) p[2] = kNaN;  // runs of invalid points, some across rows
+      if (n % 97 == 0) p[0] = kInf;         // and single ones
+      if (n % 89 == 0) p[1] = -kInf;
+      for (std::size_t k = 0; k < 3; ++k) c.put(std::size_t{row} * c.header.row_step + 32 * i + 4 * k, p[k]);
+      if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) expected.push_back(p);
+    }
+  }
+  const Cloud cloud = to_points(c.view());
+  ASSERT_EQ(cloud.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    expect_point(cloud[i], expected[i][0], expected[i][1], expected[i][2]);
+    EXPECT_EQ(cloud[i].data[3], 1.0f);  // as pcl::PointXYZ(x, y, z) makes it
+  }
+  EXPECT_EQ(cloud.width, expected.size());
+  EXPECT_EQ(cloud.height, 1u);
+  EXPECT_TRUE(cloud.is_dense);
 }
 
 TEST(PointCloud2Test, EmptyCloudGivesNoPoints) {

@@ -1,8 +1,9 @@
 #pragma once
 // Every DDS domain id the tests use, in one table. ctest runs tests side by side (-j 2) and DDS tests on
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
-// A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp) and 144
-// (bench/daemon_bench.cpp), the browser test 220-221 (tests/view/view_browser_test.py), scripts/soak 179.
+// A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), 144
+// (bench/daemon_bench.cpp) and 145 (bench/ros2_bench.cpp), the browser test 220-221
+// (tests/view/view_browser_test.py), scripts/soak 179.
 // Credentials tests name domains 7, 197 and 233 without joining them. Ids above 232 cannot be joined:
 // Cyclone's ports for domain d start at 7400 + 250 · d, beyond 65535 there.
 
@@ -108,6 +109,10 @@ inline constexpr int kBenchDaemon = 230;
 // plant_bench_test: `cellmap bench plant` with two cells (218 is also the benchmark's default; 219 is kept
 // for a second plant run beside it).
 inline constexpr int kBenchPlant = 219;
+
+// ros2_bench_test: `cellmap bench ros2` for a second per input variant (its writers mostly in a child
+// process).
+inline constexpr int kBenchRos2 = 70;
 
 // ros2_dds_test: the ROS 2 sources and writers in process.
 inline constexpr int kRos2PointCloud = 65;

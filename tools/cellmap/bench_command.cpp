@@ -1,5 +1,5 @@
-// `cellmap bench fusion|segment|collision|dds|daemon|plant`: runs the benchmark program built beside this
-// tool.
+// `cellmap bench fusion|segment|collision|dds|daemon|plant|ros2`: runs the benchmark program built beside
+// this tool.
 #include <unistd.h>
 
 #include <cerrno>
@@ -29,9 +29,9 @@ void add_bench_command(CLI::App& app) {
   auto* sub = app.add_subcommand("bench", "Run a benchmark; prints 'ratio <name>: <N>x' against its anchor");
   auto name = std::make_shared<std::string>();
   auto extra = std::make_shared<std::vector<std::string>>();
-  sub->add_option("name", *name, "fusion | segment | collision | dds | daemon | plant")
+  sub->add_option("name", *name, "fusion | segment | collision | dds | daemon | plant | ros2")
       ->required()
-      ->check(CLI::IsMember({"fusion", "segment", "collision", "dds", "daemon", "plant"}));
+      ->check(CLI::IsMember({"fusion", "segment", "collision", "dds", "daemon", "plant", "ros2"}));
   sub->add_option("benchmark_flags", *extra, "extra Google Benchmark flags, e.g. --benchmark_filter=REGEX");
   sub->allow_extras(false);
   sub->callback([name, extra] {
