@@ -73,9 +73,9 @@ constexpr std::uint32_t kBlock = 512;
 constexpr std::uint32_t kMinStretch = 64;
 
 // Appends to `cloud` the points of `msg` whose x, y and z, read as floats by `read_xyz(point, p)`, are all
-// finite, in row order.
+// finite and lie at least sqrt(min_range2) from the origin, in row order.
 template <typename ReadXyz>
-void append_finite(const PointCloud2View& msg, const ReadXyz& read_xyz, Cloud& cloud) {
+void append_valid(const PointCloud2View& msg, float min_range2, const ReadXyz& read_xyz, Cloud& cloud) {
   // Each point's 4th float stays 1, as pcl::PointXYZ(x, y, z) sets it.
   std::array<pcl::PointXYZ, kBlock> block;
   std::uint32_t filled = 0;
@@ -90,7 +90,8 @@ void append_finite(const PointCloud2View& msg, const ReadXyz& read_xyz, Cloud& c
       for (std::uint32_t i = 0; i < stretch; ++i, point += msg.point_step) {
         pcl::PointXYZ& p = block[filled];
         read_xyz(point, p);
-        filled += static_cast<std::uint32_t>(std::isfinite(p.x) & std::isfinite(p.y) & std::isfinite(p.z));
+        const bool finite = std::isfinite(p.x) & std::isfinite(p.y) & std::isfinite(p.z);
+        filled += static_cast<std::uint32_t>(finite & (p.x * p.x + p.y * p.y + p.z * p.z >= min_range2));
       }
       left -= stretch;
       if (kBlock - filled < kMinStretch) flush();
@@ -101,8 +102,9 @@ void append_finite(const PointCloud2View& msg, const ReadXyz& read_xyz, Cloud& c
 
 }  // namespace
 
-Cloud to_points(const PointCloud2View& msg) {
+Cloud to_points(const PointCloud2View& msg, float min_range) {
   check_layout(msg);
+  const float min_range2 = min_range * min_range;
   const Coordinate x = find_coordinate(msg, "x"), y = find_coordinate(msg, "y"),
                    z = find_coordinate(msg, "z");
   Cloud cloud;
@@ -110,8 +112,8 @@ Cloud to_points(const PointCloud2View& msg) {
   // Each layout of the coordinates its own loop: all FLOAT32 (depth cameras and most lidars), all FLOAT64, or
   // mixed, which reads each coordinate by its datatype.
   if (!x.is_double && !y.is_double && !z.is_double) {
-    append_finite(
-        msg,
+    append_valid(
+        msg, min_range2,
         [xo = x.offset, yo = y.offset, zo = z.offset](const std::uint8_t* point, pcl::PointXYZ& p) {
           p.x = read<float>(point + xo);
           p.y = read<float>(point + yo);
@@ -119,8 +121,8 @@ Cloud to_points(const PointCloud2View& msg) {
         },
         cloud);
   } else if (x.is_double && y.is_double && z.is_double) {
-    append_finite(
-        msg,
+    append_valid(
+        msg, min_range2,
         [xo = x.offset, yo = y.offset, zo = z.offset](const std::uint8_t* point, pcl::PointXYZ& p) {
           p.x = read<double>(point + xo);
           p.y = read<double>(point + yo);
@@ -128,8 +130,8 @@ Cloud to_points(const PointCloud2View& msg) {
         },
         cloud);
   } else {
-    append_finite(
-        msg,
+    append_valid(
+        msg, min_range2,
         [&](const std::uint8_t* point, pcl::PointXYZ& p) {
           p.x = read(point, x);
           p.y = read(point, y);

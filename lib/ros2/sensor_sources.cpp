@@ -142,10 +142,12 @@ class TopicSource final : public DepthSource {
 std::unique_ptr<DepthSource> make_point_cloud2_source(const dds::Participant& participant, std::string name,
                                                       TopicInput input, transport::OnRefused on_refused) {
   using Message = sensor_msgs_msg_dds__PointCloud2_;
+  const auto min_range = float(input.min_range);
   return std::make_unique<TopicSource<Message>>(
       participant, &sensor_msgs_msg_dds__PointCloud2__desc, "sensor_msgs/msg/PointCloud2", std::move(name),
-      std::move(input), std::move(on_refused),
-      [](const Message& msg, Frame& frame) { frame.points_S = to_points(view_of(msg)); });
+      std::move(input), std::move(on_refused), [min_range](const Message& msg, Frame& frame) {
+        frame.points_S = to_points(view_of(msg), min_range);
+      });
 }
 
 std::unique_ptr<DepthSource> make_laser_scan_source(const dds::Participant& participant, std::string name,

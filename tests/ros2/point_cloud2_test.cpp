@@ -172,6 +172,16 @@ TEST(PointCloud2Test, LargeOrganizedCloudKeepsEveryValidPointInOrder) {
   EXPECT_TRUE(cloud.is_dense);
 }
 
+// realsense-ros's ordered clouds keep a pixel without depth as (0, 0, 0): not a point at the camera.
+TEST(PointCloud2Test, PointsNearerThanMinRangeAreLeftOut) {
+  const OwnedCloud c = packed({{0, 0, 0}, {0.03f, 0, 0}, {0, 0.04f, 0.04f}, {1, 2, 3}});
+  EXPECT_EQ(to_points(c.view()).size(), 4u);
+  const Cloud cloud = to_points(c.view(), 0.05f);
+  ASSERT_EQ(cloud.size(), 2u);
+  expect_point(cloud[0], 0, 0.04f, 0.04f);  // 5.7 cm away
+  expect_point(cloud[1], 1, 2, 3);
+}
+
 TEST(PointCloud2Test, EmptyCloudGivesNoPoints) {
   EXPECT_TRUE(to_points(packed({}).view()).empty());
 }

@@ -22,6 +22,9 @@ struct TopicInput final {
   Reliability reliability = Reliability::kBestEffort;
   /// Seconds without a sample after which the source reports itself disconnected.
   double frame_timeout = 2.0;
+  /// PointCloud2: points nearer than this to the frame's origin, metres, are no return (drivers that keep a
+  /// pixel without depth as (0, 0, 0), e.g. an ordered RealSense cloud). LaserScan uses the scan's range_min.
+  double min_range = 0.05;
   /// Samples stamped farther than this from now (CLOCK_REALTIME) are refused; zero: not checked.
   std::chrono::nanoseconds max_stamp_skew = std::chrono::seconds(5);
 };
