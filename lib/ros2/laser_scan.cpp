@@ -46,12 +46,6 @@ FieldOfView fan_of(const LaserScanView& scan) {
   return fan;
 }
 
-void finish(Cloud& cloud) {
-  cloud.width = static_cast<std::uint32_t>(cloud.size());
-  cloud.height = 1;
-  cloud.is_dense = true;
-}
-
 }  // namespace
 
 ScanPoints to_points(const LaserScanView& scan) {
@@ -66,8 +60,8 @@ ScanPoints to_points(const LaserScanView& scan) {
     const Eigen::Vector3d p = beam(angle) * (returned ? double(range) : double(scan.range_max));
     (returned ? out.points_S : out.no_return_S).push_back(pcl::PointXYZ(float(p.x()), float(p.y()), 0.0f));
   }
-  finish(out.points_S);
-  finish(out.no_return_S);
+  set_unorganized(out.points_S);
+  set_unorganized(out.no_return_S);
   return out;
 }
 

@@ -139,9 +139,7 @@ Cloud to_points(const PointCloud2View& msg, float min_range) {
         },
         cloud);
   }
-  cloud.width = static_cast<std::uint32_t>(cloud.size());
-  cloud.height = 1;
-  cloud.is_dense = true;
+  set_unorganized(cloud);
   return cloud;
 }
 

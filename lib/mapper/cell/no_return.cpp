@@ -29,9 +29,7 @@ std::size_t add_no_return_rays(const Frame& frame, double range, unsigned phase,
   if (!(range > 0.0)) return 0;
   if (!frame.no_return_S.empty()) {
     const std::size_t added = add_beams(frame, float(range), scan);
-    scan.clear_C.width = static_cast<std::uint32_t>(scan.clear_C.size());
-    scan.clear_C.height = 1;
-    scan.clear_C.is_dense = true;
+    set_unorganized(scan.clear_C);
     return added;
   }
   if (!frame.depth) return 0;
@@ -50,9 +48,7 @@ std::size_t add_no_return_rays(const Frame& frame, double range, unsigned phase,
       scan.clear_C.push_back(pcl::PointXYZ(end_C.x(), end_C.y(), end_C.z()));
     }
   }
-  scan.clear_C.width = static_cast<std::uint32_t>(scan.clear_C.size());
-  scan.clear_C.height = 1;
-  scan.clear_C.is_dense = true;
+  set_unorganized(scan.clear_C);
   return scan.clear_C.size() - before;
 }
 

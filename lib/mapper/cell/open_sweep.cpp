@@ -34,11 +34,8 @@ void clear_only_outside(const Workspace& workspace, Scan& scan) {
     (workspace.contains(p.getVector3fMap().cast<double>()) ? inside : scan.clear_C).push_back(p);
   }
   scan.points_C = std::move(inside);
-  for (Cloud* cloud : {&scan.points_C, &scan.clear_C}) {
-    cloud->width = static_cast<std::uint32_t>(cloud->size());
-    cloud->height = 1;
-    cloud->is_dense = true;
-  }
+  set_unorganized(scan.points_C);
+  set_unorganized(scan.clear_C);
 }
 
 // The start of the line that says why `frame` was left out.

@@ -169,9 +169,7 @@ Cloud depth_to_points(const DepthImage& image, bool organized) {
     cloud.height = static_cast<std::uint32_t>(k.height);
     cloud.is_dense = false;
   } else {
-    cloud.width = static_cast<std::uint32_t>(cloud.size());
-    cloud.height = 1;
-    cloud.is_dense = true;
+    set_unorganized(cloud);
   }
   return cloud;
 }

@@ -92,11 +92,8 @@ void split_points(const Frame& frame, RobotDepth&& robot_depth, SelfFilterResult
       kept.push_back(pcl::PointXYZ(p_C.x(), p_C.y(), p_C.z()));
     }
   }
-  for (Cloud* cloud : {&kept, &clear}) {
-    cloud->width = static_cast<std::uint32_t>(cloud->size());
-    cloud->height = 1;
-    cloud->is_dense = true;
-  }
+  set_unorganized(kept);
+  set_unorganized(clear);
   result.kept = kept.size();
   result.removed = clear.size();
 }

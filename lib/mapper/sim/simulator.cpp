@@ -283,9 +283,7 @@ SimFrame Simulator::render_scanner(const SensorSpec& spec, const Eigen::Isometry
     points.push_back(
         pcl::PointXYZ(static_cast<float>(p_S.x()), static_cast<float>(p_S.y()), static_cast<float>(p_S.z())));
   }
-  points.width = static_cast<std::uint32_t>(points.size());
-  points.height = 1;
-  points.is_dense = true;
+  set_unorganized(points);
   return out;
 }
 

@@ -34,12 +34,6 @@ void to_cell(const Eigen::Matrix3f& R_CS, const Eigen::Vector3f& t_CS, const pcl
   p_C.z = R_CS(2, 0) * x + R_CS(2, 1) * y + R_CS(2, 2) * z + t_CS.z();
 }
 
-void set_unorganized(Cloud& cloud) {
-  cloud.width = static_cast<std::uint32_t>(cloud.size());
-  cloud.height = 1;
-  cloud.is_dense = true;
-}
-
 }  // namespace
 
 Scan to_scan(const Frame& frame) {
