@@ -223,7 +223,8 @@ class CameraAcquisition final : public Acquisition {
     }
     lossless_ = std::all_of(config.sources.begin(), config.sources.end(), played_fastest);
     for (const SourceConfig& source : config.sources) {
-      loops_.push_back(std::make_unique<CameraLoop>(source, make_source(source, participant, refuse(output.refusals)),
+      loops_.push_back(std::make_unique<CameraLoop>(source,
+                                                    make_source(source, participant, refuse(output.refusals)),
                                                     robot_ ? &*robot_ : nullptr, output));
     }
   }

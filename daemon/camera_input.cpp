@@ -33,7 +33,8 @@ RobotInput::RobotInput(const std::optional<Robot>& robot, double tolerance,
     if (joint_states.empty()) {
       joint_reader_.emplace(participant, cell, robot->joint_names(), skew_limits(), on_refused_);
     } else {
-      joint_state_reader_.emplace(participant, joint_states, cell, robot->joint_names(), kMaxPoseSkew, on_refused_);
+      joint_state_reader_.emplace(participant, joint_states, cell, robot->joint_names(), kMaxPoseSkew,
+                                  on_refused_);
     }
   } else {
     poses_.emplace(tolerance, kLiveSamples);
@@ -85,7 +86,8 @@ std::unique_ptr<DepthSource> make_source(const SourceConfig& config, const dds::
   return make_depth_source(config.camera);
 }
 
-CameraInput::CameraInput(const SourceConfig& config, std::unique_ptr<DepthSource> source, const RobotInput* robot)
+CameraInput::CameraInput(const SourceConfig& config, std::unique_ptr<DepthSource> source,
+                         const RobotInput* robot)
     : config_(config), source_(std::move(source)), robot_(robot) {
   config_.grouping.validate();
   if (std::holds_alternative<ReplayConfig>(config.camera.source)) {

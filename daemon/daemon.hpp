@@ -103,7 +103,7 @@ class Daemon final {
   VersionStore store_;
   dds::Participant participant_;
   transport::EnvironmentPublisher publisher_;
-  LayerPublisher layers_;  // the optional layers, written only while a viewer reads them
+  LayerPublisher layers_;     // the optional layers, written only while a viewer reads them
   Ros2Outputs ros2_outputs_;  // MoveIt and RViz, when the config enables them
   CellPipeline pipeline_;
   VersionKeeper keeper_;

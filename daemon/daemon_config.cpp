@@ -93,7 +93,8 @@ ros2::TopicInput read_topic_input(YamlMap settings, bool chosen) {
   const std::string reliability = settings.get<std::string>("reliability", "best_effort");
   if (reliability != "best_effort" && reliability != "reliable")
     settings.fail("reliability", "must be best_effort or reliable");
-  input.reliability = reliability == "reliable" ? ros2::Reliability::kReliable : ros2::Reliability::kBestEffort;
+  input.reliability =
+      reliability == "reliable" ? ros2::Reliability::kReliable : ros2::Reliability::kBestEffort;
   input.frame_timeout = settings.number("frame_timeout", input.frame_timeout, 0.05, 3600.0);
   if (settings.has("min_range")) input.min_range = settings.number("min_range", input.min_range, 0.0, 100.0);
   settings.expect_all_read();
@@ -129,8 +130,10 @@ SourceConfig read_source(YamlMap section, double sweep_period, const std::filesy
   const OpenNI2Config openni2 = read_openni2_config(section.child("openni2"), c.sensor);
   const V4l2Config v4l2 = read_v4l2_config(section.child("v4l2"), c.sensor);
   ReplayConfig replay = read_replay_config(section.child("replay"), c.sensor);
-  const ros2::TopicInput cloud = read_topic_input(section.child("pointcloud2"), c.kind == SourceKind::kPointCloud2);
-  const ros2::TopicInput scan = read_topic_input(section.child("laserscan"), c.kind == SourceKind::kLaserScan);
+  const ros2::TopicInput cloud =
+      read_topic_input(section.child("pointcloud2"), c.kind == SourceKind::kPointCloud2);
+  const ros2::TopicInput scan =
+      read_topic_input(section.child("laserscan"), c.kind == SourceKind::kLaserScan);
   if (c.kind == SourceKind::kPointCloud2) c.ros2 = cloud;
   if (c.kind == SourceKind::kLaserScan) c.ros2 = scan;
   if (c.kind == SourceKind::kOpenNI2) c.camera.source = openni2;
@@ -276,7 +279,8 @@ void check_ros2_security(const DaemonConfig& config) {
 }
 
 bool DaemonConfig::uses_ros2() const {
-  const bool ros2_source = std::any_of(sources.begin(), sources.end(), [](const SourceConfig& s) { return s.is_ros2(); });
+  const bool ros2_source =
+      std::any_of(sources.begin(), sources.end(), [](const SourceConfig& s) { return s.is_ros2(); });
   return ros2_source || !ros2.joint_states.empty() || ros2.collision_objects || ros2.markers;
 }
 

@@ -57,7 +57,9 @@ struct SourceConfig final {
   ros2::TopicInput ros2;
 
   [[nodiscard]] bool is_camera() const { return kind != SourceKind::kSim; }
-  [[nodiscard]] bool is_ros2() const { return kind == SourceKind::kPointCloud2 || kind == SourceKind::kLaserScan; }
+  [[nodiscard]] bool is_ros2() const {
+    return kind == SourceKind::kPointCloud2 || kind == SourceKind::kLaserScan;
+  }
 };
 
 /// The `ros2` section: ROS 2 nodes on the same DDS domain (docs/ros2.md). Everything off by default.

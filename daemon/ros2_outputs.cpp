@@ -40,7 +40,8 @@ void Ros2Outputs::publish(const Environment& env, const EnvironmentDelta& delta)
 void Ros2Outputs::serve_new_readers() {
   try {
     if (collision_objects_ && collision_objects_->resend_if_new_readers())
-      spdlog::info("ROS 2: a MoveIt reader joined; sent it the environment ({} readers)", collision_objects_->readers());
+      spdlog::info("ROS 2: a MoveIt reader joined; sent it the environment ({} readers)",
+                   collision_objects_->readers());
   } catch (const Error& e) {
     report("collision objects", e);
   }

@@ -1,7 +1,8 @@
 #pragma once
 // A DDS sample as the receive path decodes it, for the harnesses of DDS inputs: Cyclone's checks of a
 // received payload (encapsulation kind, dds_stream_normalize against the type's ops), then dds_stream_read
-// into the generated struct, as a take() does. XCDR1 only: see dds_samples_fuzz.cpp for why XCDR2 is left out.
+// into the generated struct, as a take() does. XCDR1 only: see dds_samples_fuzz.cpp for why XCDR2 is left
+// out.
 
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_cdrstream.h>

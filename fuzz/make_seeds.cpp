@@ -19,14 +19,14 @@
 #include <vector>
 
 #include "cellmap.h"
-#include "sensor_msgs/msg/JointState.h"
-#include "sensor_msgs/msg/LaserScan.h"
-#include "sensor_msgs/msg/PointCloud2.h"
 #include "cellmap/cell/cell_pipeline.hpp"
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/environment/version_store.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 #include "daemon_config.hpp"
+#include "sensor_msgs/msg/JointState.h"
+#include "sensor_msgs/msg/LaserScan.h"
+#include "sensor_msgs/msg/PointCloud2.h"
 #include "wire.hpp"
 
 namespace {

@@ -32,7 +32,8 @@ void points_of(const sensor_msgs_msg_dds__LaserScan_& msg) {
 // The SCARA arm of config/scenes/ (four joints), as a daemon with ros2.joint_states reads joints for it.
 void push_joints(const sensor_msgs_msg_dds__JointState_& msg) {
   static const Robot robot = UrdfModel::load(CELLMAP_SOURCE_DIR "/config/scenes/scara.urdf").chain("flange");
-  const std::vector<double> q = ros2::in_robot_order(ros2::names_of(msg), ros2::positions_of(msg), robot.joint_names());
+  const std::vector<double> q =
+      ros2::in_robot_order(ros2::names_of(msg), ros2::positions_of(msg), robot.joint_names());
   JointBuffer buffer(robot, 0.01, 16);
   buffer.push({1.0, Eigen::Map<const Eigen::VectorXd>(q.data(), Eigen::Index(q.size())), std::nullopt});
 }

@@ -53,8 +53,8 @@ geometry_msgs_msg_dds__Pose_ identity_pose() {
 // One CollisionObject with its own storage for what its sequences point to.
 class CollisionObjectSample final {
  public:
-  CollisionObjectSample(const std::string& cell, const Box& box, std::int64_t stamp_ns, const std::string& frame_id,
-                        std::uint8_t operation)
+  CollisionObjectSample(const std::string& cell, const Box& box, std::int64_t stamp_ns,
+                        const std::string& frame_id, std::uint8_t operation)
       : id_(collision_object_id(cell, box.id)),
         sizes_{2 * box.half_extents.x(), 2 * box.half_extents.y(), 2 * box.half_extents.z()},
         primitive_poses_{identity_pose()} {
@@ -100,7 +100,8 @@ visualization_msgs_msg_dds__Marker_ blank_marker(const std_msgs_msg_dds__Header_
   return m;
 }
 
-visualization_msgs_msg_dds__Marker_ cube(const std_msgs_msg_dds__Header_& h, const std::string& ns, const Box& box) {
+visualization_msgs_msg_dds__Marker_ cube(const std_msgs_msg_dds__Header_& h, const std::string& ns,
+                                         const Box& box) {
   visualization_msgs_msg_dds__Marker_ m = blank_marker(h, ns);
   m.id = static_cast<std::int32_t>(box.id & 0x7fffffffu);
   m.type = visualization_msgs_msg_dds__Marker_Constants_CUBE_;
@@ -140,13 +141,16 @@ void CollisionObjectWriter::write(const Environment& after, const EnvironmentDel
   const std::lock_guard<std::mutex> lock(mutex_);
   current_ = after;
   for (const Box& box : delta.added)
-    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id, moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id,
+                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
   for (const Box& box : delta.modified)
-    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id, moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id,
+                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
   for (const std::uint64_t id : delta.removed) {
     Box gone;
     gone.id = id;
-    write_object(writer_, after.cell(), gone, after.stamp_ns(), output_.frame_id, moveit_msgs_msg_dds__CollisionObject_Constants_REMOVE_);
+    write_object(writer_, after.cell(), gone, after.stamp_ns(), output_.frame_id,
+                 moveit_msgs_msg_dds__CollisionObject_Constants_REMOVE_);
   }
 }
 
@@ -156,7 +160,8 @@ bool CollisionObjectWriter::resend_if_new_readers() {
   if (ever == readers_seen_) return false;
   readers_seen_ = ever;
   for (const Box& box : current_.boxes())
-    write_object(writer_, current_.cell(), box, current_.stamp_ns(), output_.frame_id, moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+    write_object(writer_, current_.cell(), box, current_.stamp_ns(), output_.frame_id,
+                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
   return true;
 }
 

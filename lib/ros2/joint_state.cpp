@@ -8,10 +8,12 @@
 
 namespace cellmap::ros2 {
 
-std::vector<double> in_robot_order(const std::vector<std::string>& names, const std::vector<double>& positions,
+std::vector<double> in_robot_order(const std::vector<std::string>& names,
+                                   const std::vector<double>& positions,
                                    const std::vector<std::string>& robot_joints) {
   if (names.size() != positions.size()) {
-    throw Error(std::to_string(names.size()) + " names but " + std::to_string(positions.size()) + " positions");
+    throw Error(std::to_string(names.size()) + " names but " + std::to_string(positions.size()) +
+                " positions");
   }
   std::unordered_map<std::string, std::size_t> index;
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -25,8 +25,8 @@ dds::Qos reader_qos() {
 }  // namespace
 
 JointStateReader::JointStateReader(const dds::Participant& participant, std::string topic, std::string cell,
-                                   std::vector<std::string> joint_names, std::chrono::nanoseconds max_stamp_skew,
-                                   transport::OnRefused on_refused)
+                                   std::vector<std::string> joint_names,
+                                   std::chrono::nanoseconds max_stamp_skew, transport::OnRefused on_refused)
     : topic_name_(std::move(topic)),
       cell_(std::move(cell)),
       joint_names_(std::move(joint_names)),

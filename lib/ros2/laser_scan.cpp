@@ -13,7 +13,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMaxFanGap = 30.0 * kPi / 180.0;
 
 void check(const LaserScanView& scan) {
-  for (const float value : {scan.angle_min, scan.angle_max, scan.angle_increment, scan.range_min, scan.range_max}) {
+  for (const float value :
+       {scan.angle_min, scan.angle_max, scan.angle_increment, scan.range_min, scan.range_max}) {
     if (!std::isfinite(value)) throw Error("angles and range limits must be finite");
   }
   if (scan.angle_increment == 0.0f) throw Error("angle_increment is 0");
@@ -21,8 +22,10 @@ void check(const LaserScanView& scan) {
     throw Error("range_min " + std::to_string(scan.range_min) + " must be >= 0 and below range_max " +
                 std::to_string(scan.range_max));
   }
-  if (scan.range_max > kMaxScanRange) throw Error("range_max " + std::to_string(scan.range_max) + " m is absurd");
-  if (scan.count > kMaxScanBeams) throw Error(std::to_string(scan.count) + " beams, more than " + std::to_string(kMaxScanBeams));
+  if (scan.range_max > kMaxScanRange)
+    throw Error("range_max " + std::to_string(scan.range_max) + " m is absurd");
+  if (scan.count > kMaxScanBeams)
+    throw Error(std::to_string(scan.count) + " beams, more than " + std::to_string(kMaxScanBeams));
   // Drivers round the last angle differently: allow a beam either way, never a scan that would wrap.
   const double spanned = (double(scan.angle_max) - scan.angle_min) / scan.angle_increment + 1.0;
   if (scan.count == 0 || std::abs(spanned - double(scan.count)) > 1.0 + 1e-6 ||

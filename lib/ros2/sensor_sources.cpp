@@ -95,7 +95,8 @@ class TopicSource final : public DepthSource {
 
   Frame to_frame(const Message& msg) const {
     const auto& stamp = msg.header.stamp;
-    if (stamp.nanosec >= 1'000'000'000u) throw Error("header.stamp.nanosec " + std::to_string(stamp.nanosec) + " is not below 1e9");
+    if (stamp.nanosec >= 1'000'000'000u)
+      throw Error("header.stamp.nanosec " + std::to_string(stamp.nanosec) + " is not below 1e9");
     const std::int64_t stamp_ns = std::int64_t{stamp.sec} * 1'000'000'000 + stamp.nanosec;
     const std::string frame_id = msg.header.frame_id ? msg.header.frame_id : "";
     if (frame_id != input_.frame_id)
@@ -114,11 +115,12 @@ class TopicSource final : public DepthSource {
     if (!frames_.empty()) {
       status_.state = SourceState::kConnected;
       status_.reason.clear();
-    } else if (status_.state == SourceState::kConnected && steady_seconds() - last_frame_ > input_.frame_timeout) {
+    } else if (status_.state == SourceState::kConnected &&
+               steady_seconds() - last_frame_ > input_.frame_timeout) {
       status_.state = SourceState::kDisconnected;
       status_.reason = "no " + std::string(type_name_) + " on " + input_.topic + " for " +
-                       std::to_string(input_.frame_timeout) + " s (" + std::to_string(reader_.matched_writers()) +
-                       " publishers matched)";
+                       std::to_string(input_.frame_timeout) + " s (" +
+                       std::to_string(reader_.matched_writers()) + " publishers matched)";
     } else if (status_.state == SourceState::kDisconnected) {
       status_.reason = status_.frames == 0 ? waiting_reason() : status_.reason;
     }
@@ -145,9 +147,8 @@ std::unique_ptr<DepthSource> make_point_cloud2_source(const dds::Participant& pa
   const auto min_range = float(input.min_range);
   return std::make_unique<TopicSource<Message>>(
       participant, &sensor_msgs_msg_dds__PointCloud2__desc, "sensor_msgs/msg/PointCloud2", std::move(name),
-      std::move(input), std::move(on_refused), [min_range](const Message& msg, Frame& frame) {
-        frame.points_S = to_points(view_of(msg), min_range);
-      });
+      std::move(input), std::move(on_refused),
+      [min_range](const Message& msg, Frame& frame) { frame.points_S = to_points(view_of(msg), min_range); });
 }
 
 std::unique_ptr<DepthSource> make_laser_scan_source(const dds::Participant& participant, std::string name,

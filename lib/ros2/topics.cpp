@@ -15,8 +15,10 @@ std::string fault_of(const std::string& name) {
   for (std::size_t i = 1; i < name.size(); ++i) {
     const char c = name[i];
     if (c == '/' && name[i - 1] == '/') return "it has an empty token ('//')";
-    if (c != '/' && c != '_' && !std::isalnum(static_cast<unsigned char>(c))) return "only letters, digits, '_' and '/' are allowed";
-    if (std::isdigit(static_cast<unsigned char>(c)) && name[i - 1] == '/') return "a token must not start with a digit";
+    if (c != '/' && c != '_' && !std::isalnum(static_cast<unsigned char>(c)))
+      return "only letters, digits, '_' and '/' are allowed";
+    if (std::isdigit(static_cast<unsigned char>(c)) && name[i - 1] == '/')
+      return "a token must not start with a digit";
   }
   return "";
 }

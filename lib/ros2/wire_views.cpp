@@ -3,7 +3,7 @@
 namespace cellmap::ros2 {
 
 PointCloud2View view_of(const sensor_msgs_msg_dds__PointCloud2_& msg) {
-  PointCloud2View view{msg.height, msg.width, {}, msg.is_bigendian, msg.point_step, msg.row_step,
+  PointCloud2View view{msg.height,       msg.width,       {}, msg.is_bigendian, msg.point_step, msg.row_step,
                        msg.data._buffer, msg.data._length};
   view.fields.reserve(msg.fields._length);
   for (std::uint32_t i = 0; i < msg.fields._length; ++i) {
@@ -14,7 +14,7 @@ PointCloud2View view_of(const sensor_msgs_msg_dds__PointCloud2_& msg) {
 }
 
 LaserScanView view_of(const sensor_msgs_msg_dds__LaserScan_& msg) {
-  return {msg.angle_min, msg.angle_max,    msg.angle_increment, msg.range_min,
+  return {msg.angle_min, msg.angle_max,      msg.angle_increment, msg.range_min,
           msg.range_max, msg.ranges._buffer, msg.ranges._length};
 }
 

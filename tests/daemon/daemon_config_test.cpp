@@ -251,21 +251,26 @@ TEST(DaemonConfigTest, LaserScanSourceOnTheToolWithJointStates) {
 }
 
 TEST(DaemonConfigTest, Ros2ErrorsNameTheKey) {
-  const std::string cloud = "sources: [{kind: pointcloud2, sensor: cam, mount: cell, pose: {position: [0, 0, 0]}, ";
+  const std::string cloud =
+      "sources: [{kind: pointcloud2, sensor: cam, mount: cell, pose: {position: [0, 0, 0]}, ";
   EXPECT_EQ(error_of(cloud + "pointcloud2: {frame_id: camera}}]\n"),
             "my.yaml: sources[0].pointcloud2.topic: is required: the ROS 2 topic of the sensor's samples");
-  EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: /points}}]\n"),
-            "my.yaml: sources[0].pointcloud2.frame_id: is required: the header.frame_id of the sensor's samples");
-  EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: points, frame_id: camera}}]\n"),
-            "my.yaml: sources[0].pointcloud2.topic: 'points' is not a ROS 2 topic name: it must start with '/'");
+  EXPECT_EQ(
+      error_of(cloud + "pointcloud2: {topic: /points}}]\n"),
+      "my.yaml: sources[0].pointcloud2.frame_id: is required: the header.frame_id of the sensor's samples");
+  EXPECT_EQ(
+      error_of(cloud + "pointcloud2: {topic: points, frame_id: camera}}]\n"),
+      "my.yaml: sources[0].pointcloud2.topic: 'points' is not a ROS 2 topic name: it must start with '/'");
   EXPECT_EQ(error_of(cloud + "pointcloud2: {topic: /p, frame_id: c, reliability: sometimes}}]\n"),
             "my.yaml: sources[0].pointcloud2.reliability: must be best_effort or reliable");
-  EXPECT_EQ(error_of("ros2: {markers: {enabled: true, topic: /cellmap//markers}}\n"),
-            "my.yaml: ros2.markers.topic: '/cellmap//markers' is not a ROS 2 topic name: it has an empty token "
-            "('//')");
+  EXPECT_EQ(
+      error_of("ros2: {markers: {enabled: true, topic: /cellmap//markers}}\n"),
+      "my.yaml: ros2.markers.topic: '/cellmap//markers' is not a ROS 2 topic name: it has an empty token "
+      "('//')");
   EXPECT_EQ(error_of("ros2: {joint_states: /joint_states}\n"),
             "my.yaml: ros2.joint_states: poses cameras; the simulated cell moves its robot itself");
-  EXPECT_NE(error_of("ros2: {collision_objects: {enabled: true, colour: red}}\n").find("colour"), std::string::npos);
+  EXPECT_NE(error_of("ros2: {collision_objects: {enabled: true, colour: red}}\n").find("colour"),
+            std::string::npos);
 }
 
 TEST(DaemonConfigTest, DdsSecurityWithRos2TopicsIsRefused) {

@@ -30,7 +30,8 @@ TEST(JointStateTest, NamesInAnyOrderWithOtherJointsIgnored) {
 TEST(JointStateTest, IncompleteOrBrokenSamplesAreRefused) {
   EXPECT_EQ(refusal({"joint_1", "joint_2"}, {1.0, 2.0}), "no position for joint 'joint_3'");
   EXPECT_EQ(refusal({"joint_1", "joint_2", "joint_3"}, {1.0, 2.0}), "3 names but 2 positions");
-  EXPECT_EQ(refusal({"joint_1", "joint_1", "joint_2", "joint_3"}, {1, 1, 2, 3}), "joint 'joint_1' given twice");
+  EXPECT_EQ(refusal({"joint_1", "joint_1", "joint_2", "joint_3"}, {1, 1, 2, 3}),
+            "joint 'joint_1' given twice");
   EXPECT_EQ(refusal({"joint_1", "joint_2", "joint_3"}, {1.0, std::numeric_limits<double>::quiet_NaN(), 3.0}),
             "joint 'joint_2' position is not finite");
   EXPECT_EQ(refusal({"joint_1", "joint_2", "joint_3\n"}, {1, 2, 3}), "no position for joint 'joint_3'");

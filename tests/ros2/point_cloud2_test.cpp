@@ -84,7 +84,8 @@ TEST(PointCloud2Test, Float64FieldsAtAnyOffsetsAreRead) {
   OwnedCloud c;
   c.header.height = 1;
   c.header.width = 2;
-  c.header.fields = {{"intensity", 0, kFloat32, 1}, {"z", 8, kFloat64, 1}, {"x", 16, kFloat64, 1}, {"y", 24, kFloat64, 1}};
+  c.header.fields = {
+      {"intensity", 0, kFloat32, 1}, {"z", 8, kFloat64, 1}, {"x", 16, kFloat64, 1}, {"y", 24, kFloat64, 1}};
   c.header.point_step = 40;
   c.header.row_step = 80;
   c.data.assign(80, 0xAB);
@@ -108,7 +109,8 @@ TEST(PointCloud2Test, OrganizedRowsWithPaddingAndInvalidPoints) {
   c.header.width = 3;
   c.header.row_step = 3 * 12 + 4;
   c.data.assign(2 * c.header.row_step, 0);
-  const float rows[2][3][3] = {{{1, 2, 3}, {kNaN, kNaN, kNaN}, {4, 5, 6}}, {{7, 8, kInf}, {9, 10, 11}, {12, 13, 14}}};
+  const float rows[2][3][3] = {{{1, 2, 3}, {kNaN, kNaN, kNaN}, {4, 5, 6}},
+                               {{7, 8, kInf}, {9, 10, 11}, {12, 13, 14}}};
   for (int r = 0; r < 2; ++r)
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) c.put(std::size_t(r) * c.header.row_step + 12 * i + 4 * k, rows[r][i][k]);

@@ -1,8 +1,8 @@
-// cellmapd on config/ros2-cell.yaml fed only by a ROS 2 node of another DDS vendor (Fast DDS: tests/ros2/peer),
-// all real processes on loopback: the node publishes the depth camera's PointCloud2 (rendered by cellmap's
-// simulator, exact depths) and reads what MoveIt's planning scene monitor and RViz would, while a planner of
-// cellmap's own follows the versions. A box appears in front of the camera and leaves again: each change is
-// one version, and MoveIt's topic gets exactly the matching ADD and REMOVE.
+// cellmapd on config/ros2-cell.yaml fed only by a ROS 2 node of another DDS vendor (Fast DDS:
+// tests/ros2/peer), all real processes on loopback: the node publishes the depth camera's PointCloud2
+// (rendered by cellmap's simulator, exact depths) and reads what MoveIt's planning scene monitor and RViz
+// would, while a planner of cellmap's own follows the versions. A box appears in front of the camera and
+// leaves again: each change is one version, and MoveIt's topic gets exactly the matching ADD and REMOVE.
 #include <gtest/gtest.h>
 
 #include <atomic>

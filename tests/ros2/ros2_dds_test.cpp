@@ -91,7 +91,8 @@ std::optional<Frame> next_frame(DepthSource& source, std::chrono::seconds patien
 // Waits until `refusals` holds `count` lines, driving `source` meanwhile.
 void drive_until_refused(DepthSource& source, Refusals& refusals, std::size_t count) {
   const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
-  while (refusals.all().size() < count && std::chrono::steady_clock::now() < deadline) (void)source.next(50ms);
+  while (refusals.all().size() < count && std::chrono::steady_clock::now() < deadline)
+    (void)source.next(50ms);
 }
 
 TEST_F(Ros2DdsTest, PointCloud2SourceGivesFramesAndRefusesOtherFramesAndOldStamps) {
@@ -133,7 +134,8 @@ TEST_F(Ros2DdsTest, PointCloud2SourceGivesFramesAndRefusesOtherFramesAndOldStamp
   drive_until_refused(*source, refusals, 3);
   const std::vector<std::string> lines = refusals.all();
   ASSERT_EQ(lines.size(), 3u);
-  EXPECT_EQ(lines[0], "/camera/depth/points (sensor_msgs/msg/PointCloud2): in frame 'camera_link', not 'camera'");
+  EXPECT_EQ(lines[0],
+            "/camera/depth/points (sensor_msgs/msg/PointCloud2): in frame 'camera_link', not 'camera'");
   EXPECT_THAT(lines[1], HasSubstr("s from now"));
   EXPECT_THAT(lines[2], HasSubstr("big-endian clouds are not supported"));
   EXPECT_EQ(source->status().frames, 1u);
@@ -278,7 +280,8 @@ std::string matched_writer_user_data(const dds::Reader& reader) {
   if (endpoint == nullptr) return "no endpoint data";
   void* data = nullptr;
   size_t size = 0;
-  std::string text = dds_qget_userdata(endpoint->qos, &data, &size) ? std::string(static_cast<char*>(data), size) : "";
+  std::string text =
+      dds_qget_userdata(endpoint->qos, &data, &size) ? std::string(static_cast<char*>(data), size) : "";
   dds_free(data);
   dds_builtintopic_free_endpoint(endpoint);
   return text;
@@ -358,7 +361,8 @@ TEST_F(Ros2DdsTest, AnRvizThatStartsLaterGetsTheLastMarkerArray) {
   dds::Participant rviz(test::domain::kRos2Markers);
   MarkerWriter writer(daemon, {"/cellmap/markers", "world"});
   writer.write(Environment("arm", 1, 5, {box(7, {1, 1, 1}, {0.1, 0.1, 0.1})}));
-  const Environment v2("arm", 2, 6, {box(7, {1, 1, 1}, {0.1, 0.1, 0.1}), box(9, {2, 0, 0.5}, {0.3, 0.2, 0.1})});
+  const Environment v2("arm", 2, 6,
+                       {box(7, {1, 1, 1}, {0.1, 0.1, 0.1}), box(9, {2, 0, 0.5}, {0.3, 0.2, 0.1})});
   writer.write(v2);
 
   const dds::Topic topic(rviz, &visualization_msgs_msg_dds__MarkerArray__desc, "rt/cellmap/markers");

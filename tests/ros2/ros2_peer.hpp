@@ -32,7 +32,8 @@ class Ros2Peer {
         reader_([this] { read_lines(); }) {
     const auto ready = [this] {
       const std::vector<nlohmann::json> all = events();
-      return std::any_of(all.begin(), all.end(), [](const nlohmann::json& e) { return e.value("event", "") == "ready"; });
+      return std::any_of(all.begin(), all.end(),
+                         [](const nlohmann::json& e) { return e.value("event", "") == "ready"; });
     };
     if (!wait_until(ready)) ADD_FAILURE() << "the ROS 2 peer did not start";
   }
@@ -48,7 +49,8 @@ class Ros2Peer {
   /// "bytes=N", which this adds).
   void command(const std::string& line, const std::string& bytes = "") {
     const std::lock_guard<std::mutex> lock(write_mutex_);
-    process_.write_input(line + (bytes.empty() ? "" : " bytes=" + std::to_string(bytes.size())) + "\n" + bytes);
+    process_.write_input(line + (bytes.empty() ? "" : " bytes=" + std::to_string(bytes.size())) + "\n" +
+                         bytes);
   }
 
   /// A reader of `topic` with MoveIt's QoS for collision objects (RELIABLE, VOLATILE, KEEP_LAST 1024) or
@@ -61,25 +63,28 @@ class Ros2Peer {
   /// An organized cloud of `width` × `height` points (NaN where a pixel has no return) as an RGB-D driver
   /// sends it: x, y, z FLOAT32 at 0, 4, 8, a FLOAT32 rgb at 16, point_step 32 (PCL's PointXYZRGB layout).
   void publish_cloud(const std::string& topic, const std::string& frame, std::uint32_t width,
-                     std::uint32_t height, const std::vector<Eigen::Vector3f>& points, std::int64_t stamp_ns = 0) {
+                     std::uint32_t height, const std::vector<Eigen::Vector3f>& points,
+                     std::int64_t stamp_ns = 0) {
     std::string data(std::size_t(width) * height * 32, '\0');
     for (std::size_t i = 0; i < points.size() && i < std::size_t(width) * height; ++i)
       std::memcpy(data.data() + 32 * i, points[i].data(), 12);
-    command("pub-cloud topic=" + topic + " frame=" + frame + stamp(stamp_ns) + " height=" + std::to_string(height) +
-                " width=" + std::to_string(width) + " point_step=32 row_step=" + std::to_string(32 * width) +
+    command("pub-cloud topic=" + topic + " frame=" + frame + stamp(stamp_ns) +
+                " height=" + std::to_string(height) + " width=" + std::to_string(width) +
+                " point_step=32 row_step=" + std::to_string(32 * width) +
                 " bigendian=0 dense=0 fields=x:0:7:1,y:4:7:1,z:8:7:1,rgb:16:7:1 reliability=best_effort",
             data);
   }
 
-  void publish_scan(const std::string& topic, const std::string& frame, float angle_min, float angle_increment,
-                    float range_min, float range_max, const std::vector<float>& ranges, std::int64_t stamp_ns) {
+  void publish_scan(const std::string& topic, const std::string& frame, float angle_min,
+                    float angle_increment, float range_min, float range_max, const std::vector<float>& ranges,
+                    std::int64_t stamp_ns) {
     std::string data(ranges.size() * 4, '\0');
     std::memcpy(data.data(), ranges.data(), data.size());
     const float angle_max = angle_min + angle_increment * float(ranges.size() - 1);
-    command("pub-scan topic=" + topic + " frame=" + frame + stamp(stamp_ns) + " angle_min=" + number(angle_min) +
-                " angle_max=" + number(angle_max) + " angle_increment=" + number(angle_increment) +
-                " time_increment=0 scan_time=0 range_min=" + number(range_min) + " range_max=" + number(range_max) +
-                " reliability=best_effort",
+    command("pub-scan topic=" + topic + " frame=" + frame + stamp(stamp_ns) +
+                " angle_min=" + number(angle_min) + " angle_max=" + number(angle_max) + " angle_increment=" +
+                number(angle_increment) + " time_increment=0 scan_time=0 range_min=" + number(range_min) +
+                " range_max=" + number(range_max) + " reliability=best_effort",
             data);
   }
 
@@ -103,7 +108,8 @@ class Ros2Peer {
     std::vector<nlohmann::json> out;
     const std::vector<nlohmann::json> all = events();
     for (std::size_t i = from; i < all.size(); ++i) {
-      if (all[i].value("event", "") == "received" && all[i].value("topic", "") == topic) out.push_back(all[i]["msg"]);
+      if (all[i].value("event", "") == "received" && all[i].value("topic", "") == topic)
+        out.push_back(all[i]["msg"]);
     }
     return out;
   }
@@ -120,8 +126,9 @@ class Ros2Peer {
       if (done()) return true;
       if (std::chrono::steady_clock::now() >= deadline) return false;
       std::unique_lock<std::mutex> lock(mutex_);
-      changed_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(100)),
-                          [&] { return events_.size() != seen; });
+      changed_.wait_until(
+          lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(100)),
+          [&] { return events_.size() != seen; });
     }
   }
 

@@ -1,8 +1,8 @@
 // cellmapd fed by ROS 2 sensor drivers on a moving robot, all through a ROS 2 node of another DDS vendor
 // (Fast DDS: tests/ros2/peer): the arm cell's fixed camera with the arm's joints only on /joint_states
-// (ros2_control's joint_state_broadcaster), and the default cell's gantry sweeping a 2D lidar whose scans come
-// as sensor_msgs/msg/LaserScan, as the paper's OS32C did. The scenes are rendered by cellmap's simulator and
-// played in real time, stamped on the wall clock as drivers stamp them.
+// (ros2_control's joint_state_broadcaster), and the default cell's gantry sweeping a 2D lidar whose scans
+// come as sensor_msgs/msg/LaserScan, as the paper's OS32C did. The scenes are rendered by cellmap's simulator
+// and played in real time, stamped on the wall clock as drivers stamp them.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -26,9 +26,9 @@ struct RunningDaemon {
       : participant(static_cast<std::uint32_t>(domain)), planner(participant, cell), status(participant) {
     const std::filesystem::path config = dir.path() / "cellmapd.yaml";
     std::ofstream(config) << config_yaml;
-    daemon = std::make_unique<test::ChildProcess>(std::vector<std::string>{
-        CELLMAPD, "--config", config.string(), "--domain", std::to_string(domain), "--state-dir",
-        (dir.path() / "state").string()});
+    daemon = std::make_unique<test::ChildProcess>(
+        std::vector<std::string>{CELLMAPD, "--config", config.string(), "--domain", std::to_string(domain),
+                                 "--state-dir", (dir.path() / "state").string()});
   }
   test::TempDir dir;
   dds::Participant participant;
@@ -77,9 +77,9 @@ TEST(Ros2RobotE2eTest, ArmCellWithItsJointsOnlyOnJointStatesMakesOneVersion) {
        << "robot: {urdf: {file: " CELLMAP_SOURCE_DIR "/config/robots/cellmap_arm/urdf/cellmap_arm.urdf, "
        << "tool_link: tool0, base: {position: [1.5, -0.45, 0.5], rotation: [0.7071067811865476, 0, 0, "
           "0.7071067811865476]}}}\n"
-       << "sources: [{kind: pointcloud2, sensor: post, mount: cell, pose: {position: [" << X_CS.translation().x()
-       << ", " << X_CS.translation().y() << ", " << X_CS.translation().z() << "], rotation: [" << q_CS.w() << ", "
-       << q_CS.x() << ", " << q_CS.y() << ", " << q_CS.z() << "]}, "
+       << "sources: [{kind: pointcloud2, sensor: post, mount: cell, pose: {position: ["
+       << X_CS.translation().x() << ", " << X_CS.translation().y() << ", " << X_CS.translation().z()
+       << "], rotation: [" << q_CS.w() << ", " << q_CS.x() << ", " << q_CS.y() << ", " << q_CS.z() << "]}, "
        << "pointcloud2: {topic: /post/depth/points, frame_id: post_depth_optical_frame}}]\n"
        << "ros2: {joint_states: /joint_states}\n";
   const int domain = test::domain::kRos2ArmJointStates;
@@ -106,8 +106,8 @@ TEST(Ros2RobotE2eTest, ArmCellWithItsJointsOnlyOnJointStatesMakesOneVersion) {
         }
         for (const sim::SimFrame& frame : window.frames) {
           const std::vector<Eigen::Vector3f> points = as_floats(frame.frame.points_S);
-          peer.publish_cloud("/post/depth/points", "post_depth_optical_frame", std::uint32_t(points.size()), 1,
-                             points, stamp_of(start_ns, frame.frame.stamp));
+          peer.publish_cloud("/post/depth/points", "post_depth_optical_frame", std::uint32_t(points.size()),
+                             1, points, stamp_of(start_ns, frame.frame.stamp));
         }
         for (const transport::CellStatus& s : cell.status.take(0ms)) {
           if (s.cell == "arm") processed = std::max(processed, s.sweeps);
@@ -153,9 +153,10 @@ TEST(Ros2RobotE2eTest, GantrySweepingALaserScanBuildsBoxesHoldingEveryObstacleTh
   yaml << "cell: gantry-scan\nsweep_period: 1.51\nstatus_period: 0.5\nchange: {settle_sweeps: 3}\n"
        << "robot: {gantry: {lower: [0.0, 0.0, -0.6], upper: [3.0, 2.0, 0.0], "
        << "tool_at_zero: {position: [0.0, 0.0, 2.4], rotation: [0, 1, 0, 0]}}}\n"
-       << "sources: [{kind: laserscan, sensor: os32c, mount: tool, pose: {position: [" << spec.X_ES.translation().x()
-       << ", " << spec.X_ES.translation().y() << ", " << spec.X_ES.translation().z() << "], rotation: ["
-       << q_ES.w() << ", " << q_ES.x() << ", " << q_ES.y() << ", " << q_ES.z() << "]}, "
+       << "sources: [{kind: laserscan, sensor: os32c, mount: tool, pose: {position: ["
+       << spec.X_ES.translation().x() << ", " << spec.X_ES.translation().y() << ", "
+       << spec.X_ES.translation().z() << "], rotation: [" << q_ES.w() << ", " << q_ES.x() << ", " << q_ES.y()
+       << ", " << q_ES.z() << "]}, "
        << "laserscan: {topic: /scan, frame_id: laser}}]\n"
        << "ros2: {joint_states: /joint_states}\n";
   const int domain = test::domain::kRos2GantryLaserScan;
@@ -177,13 +178,15 @@ TEST(Ros2RobotE2eTest, GantrySweepingALaserScanBuildsBoxesHoldingEveryObstacleTh
         const Eigen::VectorXd& q = plan.stops[stop % plan.stops.size()];
         const std::vector<double> joints(q.data(), q.data() + q.size());
         const std::int64_t stamp = stamp_of(start_ns, t);
-        const sim::SimFrame frame = simulator.render(scanner, q, t, stop / plan.stops.size(), stop % plan.stops.size());
+        const sim::SimFrame frame =
+            simulator.render(scanner, q, t, stop / plan.stops.size(), stop % plan.stops.size());
         std::vector<float> ranges;
-        for (const double r : frame.exact) ranges.push_back(r > 0.0 ? float(r) : std::numeric_limits<float>::infinity());
+        for (const double r : frame.exact)
+          ranges.push_back(r > 0.0 ? float(r) : std::numeric_limits<float>::infinity());
         // The controller's samples bracket the scan's stamp (the gantry stands at the stop meanwhile).
         peer.publish_joints("/joint_states", {"x", "y", "z"}, joints, stamp - 2'000'000);
-        peer.publish_scan("/scan", "laser", float(-spec.scanner.fov / 2), increment, float(spec.scanner.min_range),
-                          float(spec.scanner.max_range), ranges, stamp);
+        peer.publish_scan("/scan", "laser", float(-spec.scanner.fov / 2), increment,
+                          float(spec.scanner.min_range), float(spec.scanner.max_range), ranges, stamp);
         peer.publish_joints("/joint_states", {"x", "y", "z"}, joints, stamp + 2'000'000);
         ++stop;
         for (const transport::CellStatus& s : cell.status.take(0ms)) {
@@ -205,10 +208,11 @@ TEST(Ros2RobotE2eTest, GantrySweepingALaserScanBuildsBoxesHoldingEveryObstacleTh
     ASSERT_EQ(seen.count(obstacle), 1u) << obstacle << " is not in the scanner's view";
     std::size_t held = 0;
     for (const Eigen::Vector3d& p : seen.at(obstacle)) {
-      held += std::any_of(env.boxes().begin(), env.boxes().end(), [&](const Box& b) { return b.contains(p, 0.021); });
+      held += std::any_of(env.boxes().begin(), env.boxes().end(),
+                          [&](const Box& b) { return b.contains(p, 0.021); });
     }
-    EXPECT_EQ(held, seen.at(obstacle).size()) << obstacle << ": " << held << " of " << seen.at(obstacle).size()
-                                              << " seen points in a box";
+    EXPECT_EQ(held, seen.at(obstacle).size())
+        << obstacle << ": " << held << " of " << seen.at(obstacle).size() << " seen points in a box";
   }
   std::cout << "default cell, gantry with a LaserScan over ROS 2: version " << env.version() << ", "
             << env.boxes().size() << " boxes\n";

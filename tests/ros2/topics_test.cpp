@@ -18,7 +18,8 @@ TEST(Ros2TopicsTest, NamesRosWouldRefuseAreRefused) {
   for (const char* bad : {"", "camera", "/", "/a//b", "/a/", "/1a", "/a/2b", "/a b", "/a-b", "rt/a"}) {
     EXPECT_THROW((void)dds_topic(bad), Error) << bad;
   }
-  EXPECT_THAT([] { (void)dds_topic("/a//b"); }, ::testing::ThrowsMessage<Error>(::testing::HasSubstr("'/a//b' is not a ROS 2 topic name")));
+  EXPECT_THAT([] { (void)dds_topic("/a//b"); },
+              ::testing::ThrowsMessage<Error>(::testing::HasSubstr("'/a//b' is not a ROS 2 topic name")));
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ std::string fault_of(const SweepFrame& frame) {
 
 }  // namespace
 
-OpenSweep::OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter, std::optional<Workspace> workspace)
+OpenSweep::OpenSweep(const OccupancyConfig& occupancy, const SelfFilter* filter,
+                     std::optional<Workspace> workspace)
     : occupancy_(occupancy), filter_(filter), workspace_(std::move(workspace)), open_(fresh()) {
   side_by_side_.reserve(std::size_t(std::max(occupancy_.threads, 1)));
   for (int t = 0; t < std::max(occupancy_.threads, 1); ++t) side_by_side_.emplace_back(occupancy_);

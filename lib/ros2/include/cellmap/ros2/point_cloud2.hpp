@@ -47,9 +47,9 @@ struct PointCloud2View final {
 inline constexpr std::uint64_t kMaxCloudPoints = 16'000'000;
 
 /// The points of `msg` in its own frame, row by row: every point whose x, y and z are all finite (NaN and
-/// inf mark invalid points, whatever is_dense says) and that lies at least `min_range` metres from the frame's
-/// origin (some drivers keep a pixel without depth as (0, 0, 0)). x, y and z are FLOAT32 or FLOAT64 fields at any offsets
-/// within point_step; other fields are ignored. Pure function; thread-safe.
+/// inf mark invalid points, whatever is_dense says) and that lies at least `min_range` metres from the
+/// frame's origin (some drivers keep a pixel without depth as (0, 0, 0)). x, y and z are FLOAT32 or FLOAT64
+/// fields at any offsets within point_step; other fields are ignored. Pure function; thread-safe.
 /// @throws Error with one line saying what is wrong: a big-endian cloud, no x, y or z field, one of another
 /// datatype or with count 0, a field past point_step, a row shorter than width × point_step, data whose
 /// size is not row_step × height, or more than kMaxCloudPoints points.

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "cellmap/sensor/depth_source.hpp"
 #include "cellmap/ros2/topics.hpp"
+#include "cellmap/sensor/depth_source.hpp"
 #include "cellmap/transport/dds.hpp"
 #include "cellmap/transport/input_limits.hpp"
 
@@ -37,15 +37,15 @@ struct TopicInput final {
 /// source. Not thread-safe (one camera thread drives it, as every DepthSource).
 /// @throws Error if the topic name is not a ROS 2 one, frame_id is empty or the reader cannot be created.
 [[nodiscard]] std::unique_ptr<DepthSource> make_point_cloud2_source(const dds::Participant& participant,
-                                                                   std::string name, TopicInput input,
-                                                                   transport::OnRefused on_refused);
+                                                                    std::string name, TopicInput input,
+                                                                    transport::OnRefused on_refused);
 
 /// As make_point_cloud2_source, for sensor_msgs/msg/LaserScan: each scan one frame with its returns as
 /// points_S, the far ends of its beams without a return as Frame::no_return_S and its fan as the field of
 /// view. The scan is taken as one instant (header.stamp): at a gantry's speeds (< 1 m/s) a 40 ms scan
 /// moves the scanner under 4 cm, about two voxels.
 [[nodiscard]] std::unique_ptr<DepthSource> make_laser_scan_source(const dds::Participant& participant,
-                                                                 std::string name, TopicInput input,
-                                                                 transport::OnRefused on_refused);
+                                                                  std::string name, TopicInput input,
+                                                                  transport::OnRefused on_refused);
 
 }  // namespace cellmap::ros2

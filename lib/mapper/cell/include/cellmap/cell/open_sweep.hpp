@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "cellmap/frame/frame.hpp"
-#include "cellmap/preprocess/workspace.hpp"
 #include "cellmap/occupancy/occupancy_map.hpp"
+#include "cellmap/preprocess/workspace.hpp"
 #include "cellmap/robot/robot.hpp"
 #include "cellmap/self_filter/self_filter.hpp"
 
