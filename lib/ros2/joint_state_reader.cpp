@@ -40,7 +40,11 @@ JointStateReader::JointStateReader(const dds::Participant& participant, std::str
 }
 
 JointStateReader::~JointStateReader() {
-  waitset_.detach(reader_);
+  try {
+    waitset_.detach(reader_);
+  } catch (const Error&) {
+    // Deleting the reader detaches it anyway.
+  }
 }
 
 std::vector<transport::RobotJoints> JointStateReader::take(std::chrono::nanoseconds timeout) {

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <deque>
 #include <functional>
+#include <sstream>
 #include <utility>
 
 #include "cellmap/common/error.hpp"
@@ -39,7 +40,13 @@ class TopicSource final : public DepthSource {
     if (input_.frame_id.empty()) throw Error("camera '" + name_ + "': frame_id must not be empty");
     waitset_.attach(reader_);
   }
-  ~TopicSource() override { waitset_.detach(reader_); }
+  ~TopicSource() override {
+    try {
+      waitset_.detach(reader_);
+    } catch (const Error&) {
+      // Deleting the reader detaches it anyway.
+    }
+  }
 
   [[nodiscard]] const std::string& name() const override { return name_; }
 
@@ -118,9 +125,10 @@ class TopicSource final : public DepthSource {
     } else if (status_.state == SourceState::kConnected &&
                steady_seconds() - last_frame_ > input_.frame_timeout) {
       status_.state = SourceState::kDisconnected;
-      status_.reason = "no " + std::string(type_name_) + " on " + input_.topic + " for " +
-                       std::to_string(input_.frame_timeout) + " s (" +
-                       std::to_string(reader_.matched_writers()) + " publishers matched)";
+      std::ostringstream reason;
+      reason << "no " << type_name_ << " on " << input_.topic << " for " << input_.frame_timeout << " s ("
+             << reader_.matched_writers() << " publishers matched)";
+      status_.reason = reason.str();
     } else if (status_.state == SourceState::kDisconnected) {
       status_.reason = status_.frames == 0 ? waiting_reason() : status_.reason;
     }

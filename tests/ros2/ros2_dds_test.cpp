@@ -160,7 +160,8 @@ TEST_F(Ros2DdsTest, PointCloud2SourceSaysWhenItsPublisherFellSilent) {
   while (source->status().state == SourceState::kConnected && std::chrono::steady_clock::now() < deadline)
     (void)source->next(50ms);
   EXPECT_EQ(source->status().state, SourceState::kDisconnected);
-  EXPECT_THAT(source->status().reason, HasSubstr("no sensor_msgs/msg/PointCloud2 on /lidar/points for 0.2"));
+  EXPECT_THAT(source->status().reason,
+              HasSubstr("no sensor_msgs/msg/PointCloud2 on /lidar/points for 0.2 s (1 publishers matched)"));
 }
 
 TEST_F(Ros2DdsTest, LaserScanSourceGivesReturnsBeamsWithoutReturnAndTheFan) {
