@@ -96,7 +96,7 @@ ros2::TopicInput read_topic_input(YamlMap settings, bool chosen) {
   input.reliability =
       reliability == "reliable" ? ros2::Reliability::kReliable : ros2::Reliability::kBestEffort;
   input.frame_timeout = settings.number("frame_timeout", input.frame_timeout, 0.05, 3600.0);
-  if (settings.has("min_range")) input.min_range = settings.number("min_range", input.min_range, 0.0, 100.0);
+  input.min_range = settings.number("min_range", input.min_range, 0.0, 100.0);
   settings.expect_all_read();
   return input;
 }
