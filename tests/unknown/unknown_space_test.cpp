@@ -63,8 +63,8 @@ TEST(UnknownSpaceTest, AnObservedWorkspaceHasNoBox) {
 TEST(UnknownSpaceTest, APocketIsBoxedExactlyAndOneTooSmallForALimbIsIgnored) {
   VoxelStateGrid grid = free_grid({20, 20, 20});
   grid.fill({3, 4, 5}, {7, 9, 8}, VoxelState::unknown);  // 4 × 5 × 3 voxels: 20 × 25 × 15 cm
-  grid.set(15, 15, 15, VoxelState::unknown);            // one voxel: 5 cm
-  const UnknownCover cover = cover_unknown(grid);       // min_size 10 cm = 2 voxels
+  grid.set(15, 15, 15, VoxelState::unknown);             // one voxel: 5 cm
+  const UnknownCover cover = cover_unknown(grid);        // min_size 10 cm = 2 voxels
   ASSERT_EQ(cover.boxes.size(), 1U);
   expect_box_spans(cover.boxes[0], region_of({3, 4, 5}, {7, 9, 8}));
   EXPECT_NEAR(cover.unknown_volume, 61 * kVoxelVolume, 1e-12);
@@ -74,7 +74,7 @@ TEST(UnknownSpaceTest, APocketIsBoxedExactlyAndOneTooSmallForALimbIsIgnored) {
 
 TEST(UnknownSpaceTest, ThinShellsAndRayGapsAreIgnoredButAZeroSizeKeepsThem) {
   VoxelStateGrid grid = free_grid({20, 20, 20});
-  grid.fill({0, 0, 10}, {20, 20, 11}, VoxelState::unknown);  // a sheet one voxel thick
+  grid.fill({0, 0, 10}, {20, 20, 11}, VoxelState::unknown);                // a sheet one voxel thick
   for (int x = 0; x < 20; x += 2) grid.set(x, 3, 3, VoxelState::unknown);  // gaps between rays
   EXPECT_TRUE(cover_unknown(grid).boxes.empty());
   EXPECT_NEAR(cover_unknown(grid).ignored_volume, 410 * kVoxelVolume, 1e-12);
@@ -138,7 +138,8 @@ TEST(UnknownSpaceTest, EveryPocketVoxelIsCoveredInRandomScenes) {
         }
       }
     }
-    EXPECT_NEAR(cover.boxed_volume - cover.blocked_free_volume, cover.unknown_volume, 1e-9) << "seed " << seed;
+    EXPECT_NEAR(cover.boxed_volume - cover.blocked_free_volume, cover.unknown_volume, 1e-9)
+        << "seed " << seed;
   }
 }
 
@@ -147,7 +148,7 @@ TEST(UnknownSpaceTest, TheGridOfAFusedMapHoldsTheMapsStatesAndTheShadowIsBoxed) 
   OccupancyConfig config;
   config.resolution = kVoxel;
   OccupancyMap map(config);
-  const std::vector<testing::AlignedBox> scene = {{{-3, -3, -0.1}, {3, 3, 0.0}},   // floor
+  const std::vector<testing::AlignedBox> scene = {{{-3, -3, -0.1}, {3, 3, 0.0}},         // floor
                                                   {{0.4, -0.2, 0.0}, {0.7, 0.2, 0.8}}};  // crate
   Eigen::Isometry3d X_CS = Eigen::Isometry3d::Identity();
   X_CS.translate(Eigen::Vector3d(-0.5, 0.0, 2.0));

@@ -80,7 +80,8 @@ std::size_t mask_index(const Eigen::Vector3i& size, int x, int y, int z) {
 // The unknown voxels that some all-unknown cube of `edge` voxels holds: the pockets worth covering.
 VoxelMask pockets(const VoxelStateGrid& grid, int edge) {
   const Eigen::Vector3i& size = grid.size();
-  const VoxelCounts unknown(size, [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
+  const VoxelCounts unknown(size,
+                            [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
   const long long full = static_cast<long long>(edge) * edge * edge;
   const Eigen::Vector3i cube = Eigen::Vector3i::Constant(edge);
   // A cube fits with its low corner at v.
@@ -93,7 +94,8 @@ VoxelMask pockets(const VoxelStateGrid& grid, int edge) {
     for (int y = 0; y < size.y(); ++y) {
       for (int x = 0; x < size.x(); ++x) {
         const Eigen::Vector3i v(x, y, z);
-        mask[mask_index(size, x, y, z)] = fits.in({v - cube + Eigen::Vector3i::Ones(), v + Eigen::Vector3i::Ones()}) > 0;
+        mask[mask_index(size, x, y, z)] =
+            fits.in({v - cube + Eigen::Vector3i::Ones(), v + Eigen::Vector3i::Ones()}) > 0;
       }
     }
   }
@@ -142,8 +144,8 @@ IndexBox grown_from(const Eigen::Vector3i& seed, const Eigen::Vector3i& size, co
   return box;
 }
 
-std::vector<IndexBox> grow_boxes(const VoxelMask& pocket, const Eigen::Vector3i& size, const CoverCounts& counts,
-                                 double max_free_share) {
+std::vector<IndexBox> grow_boxes(const VoxelMask& pocket, const Eigen::Vector3i& size,
+                                 const CoverCounts& counts, double max_free_share) {
   VoxelMask covered(pocket.size(), 0);
   std::vector<IndexBox> boxes;
   for (int z = 0; z < size.z(); ++z) {
@@ -166,7 +168,7 @@ std::vector<IndexBox> grow_boxes(const VoxelMask& pocket, const Eigen::Vector3i&
 
 // Seen free voxels that joining a and b adds to what the two already block.
 long long free_added(const IndexBox& a, const IndexBox& b, const VoxelCounts& free) {
-  return free.in(a.joined(b)) - free.in(a) - free.in(b) + free.in(a.overlap(b));
+  return free.in(a.joined(b)) - free.in(a)-free.in(b) + free.in(a.overlap(b));
 }
 
 void drop_boxes_held_by_others(std::vector<IndexBox>& boxes) {
@@ -196,7 +198,8 @@ void join_boxes(std::vector<IndexBox>& boxes, const VoxelCounts& free, const Unk
       }
     }
     const IndexBox joined = boxes[best_i].joined(boxes[best_j]);
-    const bool cheap = static_cast<double>(best_cost) <= config.max_free_share * static_cast<double>(joined.voxels());
+    const bool cheap =
+        static_cast<double>(best_cost) <= config.max_free_share * static_cast<double>(joined.voxels());
     if (!cheap && static_cast<int>(boxes.size()) <= config.max_boxes) break;
     boxes[best_i] = joined;
     boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(best_j));
@@ -250,7 +253,8 @@ void UnknownConfig::validate() const {
   }
 }
 
-VoxelStateGrid::VoxelStateGrid(const Eigen::Vector3i& size, double resolution, const Eigen::Vector3d& origin_C)
+VoxelStateGrid::VoxelStateGrid(const Eigen::Vector3i& size, double resolution,
+                               const Eigen::Vector3d& origin_C)
     : size_(size), resolution_(resolution), origin_(origin_C) {
   if ((size.array() < 1).any()) throw Error("voxel grid: every size must be at least 1");
   if (!(resolution > 0.0) || !std::isfinite(resolution)) throw Error("voxel grid: resolution must be > 0");
@@ -309,18 +313,20 @@ UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& conf
   std::vector<IndexBox> boxes = grow_boxes(pocket, size, counts, config.max_free_share);
   join_boxes(boxes, counts.free, config);
   std::sort(boxes.begin(), boxes.end(), [](const IndexBox& a, const IndexBox& b) {
-    return std::make_tuple(a.low.z(), a.low.y(), a.low.x()) < std::make_tuple(b.low.z(), b.low.y(), b.low.x());
+    return std::make_tuple(a.low.z(), a.low.y(), a.low.x()) <
+           std::make_tuple(b.low.z(), b.low.y(), b.low.x());
   });
 
   const double voxel_volume = std::pow(grid.resolution(), 3);
   const IndexBox whole{Eigen::Vector3i::Zero(), size};
-  const VoxelCounts unknown(size, [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
+  const VoxelCounts unknown(size,
+                            [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
   UnknownCover cover;
   for (const IndexBox& box : boxes) cover.boxes.push_back(to_box(box, grid, counts.pocket));
   const auto [boxed, blocked_free] = boxed_voxels(boxes, grid);
   cover.grid_volume = static_cast<double>(whole.voxels()) * voxel_volume;
   cover.unknown_volume = static_cast<double>(unknown.in(whole)) * voxel_volume;
-  cover.ignored_volume = static_cast<double>(unknown.in(whole) - counts.pocket.in(whole)) * voxel_volume;
+  cover.ignored_volume = static_cast<double>(unknown.in(whole)-counts.pocket.in(whole)) * voxel_volume;
   cover.blocked_free_volume = static_cast<double>(blocked_free) * voxel_volume;
   cover.boxed_volume = static_cast<double>(boxed) * voxel_volume;
   return cover;
