@@ -455,7 +455,7 @@ TEST(CellPipelineTest, MapStateKeepsTheFlipsWaitingForConfirmation) {
 
 // Sensor noise (Kinect model: depth noise and flying pixels at edges) on a static cell: after the first
 // version no other may appear. 300 sweeps of the coarse cell (~1 min in Release; the 1 000 on the
-// default cell were run by hand, see README).
+// default cell were run by hand, see docs/tuning.md).
 TEST(CellPipelineNoiseTest, StaticNoisyCellMakesNoVersionAfterTheFirst) {
   Cell cell(coarse_cell());
   settle(cell);

@@ -48,7 +48,7 @@ TEST(SensorComparisonTest, StereoBlocksTheMostFreeSpaceAndTheLineScannerTheLeast
   const auto coverage = [&](const std::string& m) { return rows.at(m).at(3); };
   EXPECT_GT(blocked("realsense_d435"), blocked("kinect_v2"));
   EXPECT_GT(blocked("kinect_v2"), blocked("os32c"));
-  // Measured (README): every seen surface point inside a box (100.0 %), 11 / 19 / 11 boxes; cellmapd's first
+  // Measured (docs/paper-experiments.md): every seen surface point inside a box (100.0 %), 11 / 19 / 11 boxes; cellmapd's first
   // version of the same cell is 11 boxes, the batch path stays within twice that.
   const auto boxes = [&](const std::string& m) { return rows.at(m).at(2); };
   for (const auto& [model, values] : rows) {

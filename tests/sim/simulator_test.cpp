@@ -35,7 +35,7 @@ double nearest_surface(const Scene& scene, const Eigen::Vector3d& p_C) {
   return best;
 }
 
-// σ(z) as the README's sensor table documents it, written out here rather than taken from the model under
+// σ(z) as docs/simulator.md's sensor table documents it, written out here rather than taken from the model under
 // test: kinect_v2 1 mm + 0.5 mm·z², realsense_d435 z²·0.08 px/(fx·50 mm), os32c 2 mm.
 double documented_sigma(SensorModel model, const PinholeIntrinsics& k, double z) {
   switch (model) {
