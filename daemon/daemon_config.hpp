@@ -131,7 +131,7 @@ struct DaemonConfig final {
                                          std::vector<std::string>& problems);
 };
 
-/// A config that does not load: every problem found, in the file's order. what() is them all, joined by
+/// A config that does not load: every problem found, in the order found. what() is them all, joined by
 /// "; " (one line).
 class ConfigErrors final : public Error {
  public:

@@ -16,7 +16,7 @@ test::CommandRun cellmap(const std::string& args) {
 }
 
 TEST(CellmapCliTest, AnUnknownSubcommandIsAnErrorWhateverTheFlags) {
-  for (const std::string& args : {"nosuch", "nosuch --help", "--help nosuch", "nosuch --version"}) {
+  for (const char* args : {"nosuch", "nosuch --help", "--help nosuch", "nosuch --version"}) {
     SCOPED_TRACE(args);
     const test::CommandRun run = cellmap(args);
     EXPECT_EQ(run.status, 2);

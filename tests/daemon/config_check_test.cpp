@@ -77,12 +77,14 @@ TEST(ConfigCheckTest, ABadValueInOneSourceLeavesTheOthersChecked) {
   std::filesystem::create_directory(dir.path() / "replay");
   const std::filesystem::path config = write_config(dir,
                                                     "sources:\n"
-                                                    "  - {kind: replay, sensor: post, mount: cell, replay: {directory: replay}}\n"
+                                                    "  - {kind: replay, sensor: post, mount: cell, pose: {}, replay: {directory: replay}}\n"
                                                     "  - {kind: replay, sensor: wrist, mount: tol}\n"
-                                                    "  - {kind: replay, sensor: side, mount: cell, replay: {directory: gone}}\n");
+                                                    "  - {kind: replay, sensor: side, mount: cell, pose: {}, replay: {directory: gone}}\n");
   const CommandRun run = check("--config '" + config.string() + "'", dir);
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find(config.string() + ": sources[1].mount: "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(config.string() + ": sources[1].mount: must be tool, cell or a pose, got 'tol'\n"),
+            std::string::npos)
+      << run.output;
   EXPECT_NE(run.output.find(config.string() + ": sources[2].replay.directory: " + (dir.path() / "gone").string() +
                             ": no such replay directory"),
             std::string::npos)
