@@ -45,10 +45,11 @@ TEST(CellmapCliTest, StatusWithNoDaemonOnTheDomainFailsWithOneLine) {
   const test::CommandRun run = cellmap("status --domain " + domain + " --wait 0.5");
   EXPECT_EQ(run.status, 1);
   EXPECT_EQ(run.output, "cellmap: status: no cellmapd answered on domain " + domain + " within 0.5 s\n");
-  const test::CommandRun one_cell = cellmap("status --domain " + domain + " --cell press-3 --wait 0.5 --json");
+  const test::CommandRun one_cell =
+      cellmap("status --domain " + domain + " --cell press-3 --wait 0.5 --json");
   EXPECT_EQ(one_cell.status, 1);
-  EXPECT_EQ(one_cell.output,
-            "cellmap: status: no cellmapd of cell 'press-3' answered on domain " + domain + " within 0.5 s\n");
+  EXPECT_EQ(one_cell.output, "cellmap: status: no cellmapd of cell 'press-3' answered on domain " + domain +
+                                 " within 0.5 s\n");
 }
 
 }  // namespace

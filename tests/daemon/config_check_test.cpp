@@ -16,8 +16,9 @@ using test::CommandRun;
 
 // `cellmapd --check ARGS` with a private state directory; stderr too unless `with_stderr` is false.
 CommandRun check(const std::string& args, const test::TempDir& dir, bool with_stderr = true) {
-  return test::run_command(std::string(CELLMAPD) + " --check --state-dir '" + (dir.path() / "state").string() +
-                           "' " + args + (with_stderr ? " 2>&1" : " 2>/dev/null"));
+  return test::run_command(std::string(CELLMAPD) + " --check --state-dir '" +
+                           (dir.path() / "state").string() + "' " + args +
+                           (with_stderr ? " 2>&1" : " 2>/dev/null"));
 }
 
 std::filesystem::path write_config(const test::TempDir& dir, const std::string& yaml) {
@@ -54,12 +55,13 @@ TEST(ConfigCheckTest, BuiltInDefaultsPass) {
 
 TEST(ConfigCheckTest, EachProblemIsReportedWithItsKey) {
   const test::TempDir dir;
-  const std::filesystem::path config = write_config(dir,
-                                                    "log_level: loud\n"
-                                                    "cel: typo\n"
-                                                    "source: {scene: missing/scene.yaml}\n"
-                                                    "robot: {urdf: {file: /nonexistent/arm.urdf, tool_link: tool0}}\n"
-                                                    "security: {directory: no-credentials}\n");
+  const std::filesystem::path config =
+      write_config(dir,
+                   "log_level: loud\n"
+                   "cel: typo\n"
+                   "source: {scene: missing/scene.yaml}\n"
+                   "robot: {urdf: {file: /nonexistent/arm.urdf, tool_link: tool0}}\n"
+                   "security: {directory: no-credentials}\n");
   const CommandRun run = check("--config '" + config.string() + "'", dir);
   EXPECT_EQ(run.status, 1) << run.output;
   const std::string name = config.string() + ": ";
@@ -75,18 +77,20 @@ TEST(ConfigCheckTest, EachProblemIsReportedWithItsKey) {
 TEST(ConfigCheckTest, ABadValueInOneSourceLeavesTheOthersChecked) {
   const test::TempDir dir;
   std::filesystem::create_directory(dir.path() / "replay");
-  const std::filesystem::path config = write_config(dir,
-                                                    "sources:\n"
-                                                    "  - {kind: replay, sensor: post, mount: cell, pose: {}, replay: {directory: replay}}\n"
-                                                    "  - {kind: replay, sensor: wrist, mount: tol}\n"
-                                                    "  - {kind: replay, sensor: side, mount: cell, pose: {}, replay: {directory: gone}}\n");
+  const std::filesystem::path config =
+      write_config(dir,
+                   "sources:\n"
+                   "  - {kind: replay, sensor: post, mount: cell, pose: {}, replay: {directory: replay}}\n"
+                   "  - {kind: replay, sensor: wrist, mount: tol}\n"
+                   "  - {kind: replay, sensor: side, mount: cell, pose: {}, replay: {directory: gone}}\n");
   const CommandRun run = check("--config '" + config.string() + "'", dir);
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find(config.string() + ": sources[1].mount: must be tool, cell or a pose, got 'tol'\n"),
-            std::string::npos)
+  EXPECT_NE(
+      run.output.find(config.string() + ": sources[1].mount: must be tool, cell or a pose, got 'tol'\n"),
+      std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find(config.string() + ": sources[2].replay.directory: " + (dir.path() / "gone").string() +
-                            ": no such replay directory"),
+  EXPECT_NE(run.output.find(config.string() + ": sources[2].replay.directory: " +
+                            (dir.path() / "gone").string() + ": no such replay directory"),
             std::string::npos)
       << run.output;
   EXPECT_NE(run.output.find("2 problems"), std::string::npos) << run.output;
@@ -96,14 +100,17 @@ TEST(ConfigCheckTest, CredentialsAreCheckedForTheConfigsCell) {
   const test::TempDir dir;
   const test::TestCredentials credentials("press-3", 0);
   const std::filesystem::path config = write_config(dir, "cell: press-3\n");
-  const std::string flags = "--config '" + config.string() + "' --security '" + credentials.directory().string() + "'";
+  const std::string flags =
+      "--config '" + config.string() + "' --security '" + credentials.directory().string() + "'";
   EXPECT_EQ(check(flags, dir).output, config.string() + ": ok\n");
 
   write_config(dir, "cell: press-4\n");
   const CommandRun other_cell = check(flags, dir);
   EXPECT_EQ(other_cell.status, 1);
-  EXPECT_NE(other_cell.output.find(config.string() + ": --security: "), std::string::npos) << other_cell.output;
-  EXPECT_NE(other_cell.output.find("issued for cell 'press-3', not the config's cell 'press-4'"), std::string::npos)
+  EXPECT_NE(other_cell.output.find(config.string() + ": --security: "), std::string::npos)
+      << other_cell.output;
+  EXPECT_NE(other_cell.output.find("issued for cell 'press-3', not the config's cell 'press-4'"),
+            std::string::npos)
       << other_cell.output;
 
   write_config(dir, "cell: press-3\n");

@@ -22,9 +22,12 @@ TEST(StatusCommandE2eTest, ShowsTheDaemonsStateVersionAndSensors) {
   const int domain = test::domain::kStatusCommand;
   const test::TempDir dir;
   const std::filesystem::path config = dir.path() / "cellmapd.yaml";
-  std::ofstream(config) << "cell: " << kCell
-                        << "\nsweep_period: 0.2\nstatus_period: 0.5\n"
-                           "sources: [{sensor: kinect, noise: false}, {sensor: realsense, noise: false}]\n";
+  std::ofstream(config)
+      << "cell: " << kCell
+      << "\nsweep_period: 0.2\nstatus_period: 0.5\n"
+         "sources: [{sensor: kinect, noise: false}, {sensor: realsense, noise: false}]\n"
+         // The first version after 3 sweeps, not 15: the test is about the report, not the map.
+         "change: {settle_sweeps: 3}\n";
   test::ChildProcess daemon({CELLMAPD, "--config", config.string(), "--domain", std::to_string(domain),
                              "--state-dir", (dir.path() / "state").string()});
   const dds::Participant observer(static_cast<std::uint32_t>(domain));
