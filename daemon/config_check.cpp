@@ -7,6 +7,7 @@
 
 #include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
+#include "cellmap/environment/version_store.hpp"
 #include "cellmap/security/credentials.hpp"
 #include "cellmap/sensor/sensor_config.hpp"
 #include "cellmap/sim/scene.hpp"
@@ -49,14 +50,19 @@ bool writable_directory(const std::filesystem::path& dir) {
   return std::filesystem::is_directory(dir, ec) && ::access(dir.c_str(), W_OK | X_OK) == 0;
 }
 
-// The daemon creates its state directory when missing (VersionStore), so a missing one is fine if it can be.
-void check_state_dir(const std::filesystem::path& dir, const std::string& key, Findings& findings) {
+// The daemon creates its state directory when missing (VersionStore), so a missing one is fine if it can be;
+// one that holds another cell's versions is refused at start.
+void check_state_dir(const std::filesystem::path& dir, const std::string& cell, const std::string& key,
+                     Findings& findings) {
   std::error_code ec;
   if (std::filesystem::exists(dir, ec)) {
     if (!std::filesystem::is_directory(dir, ec)) {
       findings.add(key, dir.string() + ": not a directory");
     } else if (!writable_directory(dir)) {
       findings.add(key, dir.string() + ": not writable");
+    } else if (const std::optional<std::string> stored = VersionStore::stored_cell(dir);
+               stored && *stored != cell) {
+      findings.add(key, dir.string() + ": holds the versions of cell '" + *stored + "', not '" + cell + "'");
     }
     return;
   }
@@ -119,7 +125,7 @@ std::vector<std::string> check_config(const std::filesystem::path& file, const s
   for (const SourceConfig& source : config.sources) {
     if (source.is_camera() && !source.is_ros2()) check_camera(source, findings);
   }
-  check_state_dir(config.state_dir, overrides.state_dir ? "--state-dir" : "state_dir", findings);
+  check_state_dir(config.state_dir, config.cell, overrides.state_dir ? "--state-dir" : "state_dir", findings);
   if (config.security) check_credentials(config, overrides.security ? "--security" : "security", findings);
   return std::move(findings.lines());
 }

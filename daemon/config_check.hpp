@@ -13,7 +13,8 @@ namespace cellmap::daemon {
 /// past each problem to find the next: the config's keys (DaemonConfig::read, with `overrides` laid over
 /// it), the robot's URDF and meshes (read with the `robot` section), the simulated scene with its sensors
 /// and robot (the daemon's own SimulatedCell), each camera's settings and replay directory, the state
-/// directory and the DDS Security credentials (security::check, issued for the config's cell).
+/// directory (there or creatable, not another cell's) and the DDS Security credentials (security::check,
+/// issued for the config's cell).
 /// `file` empty: the built-in defaults, named `name` in messages.
 /// @return every problem, one line each ("<config>: <key>: <reason>"); empty if the daemon would start.
 [[nodiscard]] std::vector<std::string> check_config(const std::filesystem::path& file,

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <set>
 
+#include "cellmap/environment/version_store.hpp"
 #include "support/test_credentials.hpp"
 #include "support/test_support.hpp"
 
@@ -94,6 +95,21 @@ TEST(ConfigCheckTest, ABadValueInOneSourceLeavesTheOthersChecked) {
             std::string::npos)
       << run.output;
   EXPECT_NE(run.output.find("2 problems"), std::string::npos) << run.output;
+}
+
+TEST(ConfigCheckTest, AStateDirectoryOfAnotherCellIsAProblem) {
+  const test::TempDir dir;
+  const std::filesystem::path state = dir.path() / "state";
+  VersionStore(state, "press-3").save(Environment("press-3", 1, 0, {}));
+  const std::filesystem::path config = write_config(dir, "cell: press-4\n");
+  const CommandRun run = check("--config '" + config.string() + "'", dir);
+  EXPECT_EQ(run.status, 1);
+  EXPECT_NE(run.output.find(config.string() + ": --state-dir: " + state.string() +
+                            ": holds the versions of cell 'press-3', not 'press-4'\n"),
+            std::string::npos)
+      << run.output;
+  write_config(dir, "cell: press-3\n");
+  EXPECT_EQ(check("--config '" + config.string() + "'", dir).output, config.string() + ": ok\n");
 }
 
 TEST(ConfigCheckTest, CredentialsAreCheckedForTheConfigsCell) {
