@@ -21,6 +21,32 @@ std::optional<SourceKind> source_kind(const std::string& text) {
   return std::nullopt;
 }
 
+// Reads on past a part of the config that fails, keeping its problem, so that every problem is reported.
+class Problems {
+ public:
+  explicit Problems(std::vector<std::string>& found) : found_(found) {}
+  /// Runs `read_part`; false (its problem kept) if it threw.
+  template <typename ReadPart>
+  bool read(ReadPart&& read_part) {
+    try {
+      read_part();
+      return true;
+    } catch (const Error& e) {
+      found_.push_back(e.what());
+      return false;
+    }
+  }
+
+ private:
+  std::vector<std::string>& found_;
+};
+
+std::string joined(const std::vector<std::string>& lines, const std::string& separator) {
+  std::string text;
+  for (const std::string& line : lines) text += (text.empty() ? "" : separator) + line;
+  return text;
+}
+
 // The `security` section: off while `directory` is empty.
 std::optional<security::Setting> read_security(YamlMap section, const std::filesystem::path& base_dir) {
   const std::string directory = section.get<std::string>("directory", "");
@@ -103,8 +129,10 @@ ros2::TopicInput read_topic_input(YamlMap settings, bool chosen) {
 
 // One source entry. Every camera kind's settings are read (so a misspelt key is found whichever kind is
 // chosen); the chosen kind's become the camera.
-SourceConfig read_source(YamlMap section, double sweep_period, const std::filesystem::path& base_dir) {
+SourceConfig read_source(YamlMap section, const std::string& key, double sweep_period,
+                         const std::filesystem::path& base_dir) {
   SourceConfig c;
+  c.key = key;
   const std::optional<SourceKind> kind = source_kind(section.get<std::string>("kind", to_string(c.kind)));
   if (!kind) section.fail("kind", "must be one of sim, replay, openni2, v4l2, pointcloud2, laserscan");
   c.kind = *kind;
@@ -159,26 +187,37 @@ void check_sources(const std::vector<SourceConfig>& sources, YamlMap& root, cons
   }
 }
 
-// `sources` (each entry laid over the built-in `source` section) or the single `source` section.
+// `sources` (each entry laid over the built-in `source` section) or the single `source` section. An entry
+// that fails is left out.
 std::vector<SourceConfig> read_sources(YamlMap& root, const YamlMap& user, const YamlMap& defaults,
-                                       double sweep_period, const std::filesystem::path& base_dir) {
+                                       double sweep_period, const std::filesystem::path& base_dir,
+                                       Problems& problems) {
   std::vector<SourceConfig> sources;
   const YAML::Node list = root.node("sources");
   if (!list) {
-    sources.push_back(read_source(root.child("source"), sweep_period, base_dir));
+    problems.read(
+        [&] { sources.push_back(read_source(root.child("source"), "source", sweep_period, base_dir)); });
     return sources;
   }
-  if (user.has("source"))
-    root.fail("source", "give either source (one sensor) or sources (a list), not both");
   (void)root.node("source");  // the built-in section: the entries' defaults
-  if (!list.IsSequence() || list.size() == 0) root.fail("sources", "must be a non-empty list of sensors");
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string path = "sources[" + std::to_string(i) + "]";
-    if (!list[i].IsMap()) root.fail(path, "must be a map (kind, sensor, mount, ...)");
-    const YAML::Node entry = overlay_on(defaults.node()["source"], list[i], path, root.source());
-    sources.push_back(read_source(YamlMap(entry, path, root.source()), sweep_period, base_dir));
+  problems.read([&] {
+    if (user.has("source"))
+      root.fail("source", "give either source (one sensor) or sources (a list), not both");
+  });
+  if (!list.IsSequence() || list.size() == 0) {
+    problems.read([&] { root.fail("sources", "must be a non-empty list of sensors"); });
+    return sources;
   }
-  check_sources(sources, root, "sources");
+  bool every_entry_read = true;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    every_entry_read &= problems.read([&] {
+      const std::string path = "sources[" + std::to_string(i) + "]";
+      if (!list[i].IsMap()) root.fail(path, "must be a map (kind, sensor, mount, ...)");
+      const YAML::Node entry = overlay_on(defaults.node()["source"], list[i], path, root.source());
+      sources.push_back(read_source(YamlMap(entry, path, root.source()), path, sweep_period, base_dir));
+    });
+  }
+  if (every_entry_read) problems.read([&] { check_sources(sources, root, "sources"); });
   return sources;
 }
 
@@ -236,38 +275,74 @@ DaemonConfig DaemonConfig::load(const std::filesystem::path& file) {
 
 DaemonConfig DaemonConfig::parse(const std::string& yaml, const std::string& source,
                                  const std::filesystem::path& base_dir) {
-  const YamlMap defaults = YamlMap::parse(default_config_yaml(), "built-in config/cellmapd.yaml");
-  const YamlMap user = YamlMap::parse(yaml, source);
-  YamlMap root(overlay_on(defaults.node(), user.node(), "", source), "", source);
-  DaemonConfig c;
-  c.cell = root.get<std::string>("cell", c.cell);
-  if (c.cell.empty()) root.fail("cell", "must not be empty");
-  if (c.cell.find_first_of("*?\\") != std::string::npos)
-    root.fail("cell", "must not hold '*', '?' or '\\' (its DDS partition would be a pattern)");
-  c.domain = static_cast<int>(root.integer("domain", c.domain, 0, 232));
-  c.state_dir = root.get<std::string>("state_dir", c.state_dir.string());
-  c.sweep_period = root.number("sweep_period", c.sweep_period, 0.0, 3600.0);
-  c.status_period = root.number("status_period", c.status_period, 0.05, 3600.0);
-  c.frame_backlog =
-      static_cast<std::size_t>(root.integer("frame_backlog", static_cast<long>(c.frame_backlog), 1, 10000));
-  c.sweep_backlog =
-      static_cast<std::size_t>(root.integer("sweep_backlog", static_cast<long>(c.sweep_backlog), 1, 1000));
-  c.delta_depth = static_cast<std::uint32_t>(root.integer("delta_depth", c.delta_depth, 1, 10000));
-  c.log_level = root.get<std::string>("log_level", c.log_level);
-  static const std::set<std::string> levels{"trace", "debug", "info", "warn", "error"};
-  if (levels.count(c.log_level) == 0)
-    root.fail("log_level", "must be one of trace, debug, info, warn, error");
-
-  c.sources = read_sources(root, user, defaults, c.sweep_period, base_dir);
-  c.robot = read_daemon_robot(root, base_dir);
-  c.pipeline = CellPipelineConfig::from_yaml(root);
-  c.security = read_security(root.child("security"), base_dir);
-  c.ros2 = read_ros2(root.child("ros2"));
-  if (c.simulated() && !c.ros2.joint_states.empty())
-    root.child("ros2").fail("joint_states", "poses cameras; the simulated cell moves its robot itself");
-  root.expect_all_read();
-  check_ros2_security(c);
+  std::vector<std::string> problems;
+  DaemonConfig c = read(yaml, source, base_dir, problems);
+  if (!problems.empty()) throw ConfigErrors(std::move(problems));
   return c;
+}
+
+DaemonConfig DaemonConfig::read(const std::string& yaml, const std::string& source,
+                                const std::filesystem::path& base_dir, std::vector<std::string>& found) {
+  Problems problems(found);
+  DaemonConfig c;
+  const YamlMap defaults = YamlMap::parse(default_config_yaml(), "built-in config/cellmapd.yaml");
+  std::optional<YamlMap> user;
+  std::optional<YamlMap> read_root;
+  problems.read([&] {
+    user = YamlMap::parse(yaml, source);
+    read_root.emplace(overlay_on(defaults.node(), user->node(), "", source), "", source);
+  });
+  if (!read_root) return c;
+  YamlMap& root = *read_root;
+  problems.read([&] {
+    c.cell = root.get<std::string>("cell", c.cell);
+    if (c.cell.empty()) root.fail("cell", "must not be empty");
+    if (c.cell.find_first_of("*?\\") != std::string::npos)
+      root.fail("cell", "must not hold '*', '?' or '\\' (its DDS partition would be a pattern)");
+  });
+  problems.read([&] { c.domain = static_cast<int>(root.integer("domain", c.domain, 0, 232)); });
+  problems.read([&] { c.state_dir = root.get<std::string>("state_dir", c.state_dir.string()); });
+  problems.read([&] { c.sweep_period = root.number("sweep_period", c.sweep_period, 0.0, 3600.0); });
+  problems.read([&] { c.status_period = root.number("status_period", c.status_period, 0.05, 3600.0); });
+  problems.read([&] {
+    c.frame_backlog =
+        static_cast<std::size_t>(root.integer("frame_backlog", static_cast<long>(c.frame_backlog), 1, 10000));
+  });
+  problems.read([&] {
+    c.sweep_backlog =
+        static_cast<std::size_t>(root.integer("sweep_backlog", static_cast<long>(c.sweep_backlog), 1, 1000));
+  });
+  problems.read([&] {
+    c.delta_depth = static_cast<std::uint32_t>(root.integer("delta_depth", c.delta_depth, 1, 10000));
+  });
+  problems.read([&] {
+    c.log_level = root.get<std::string>("log_level", c.log_level);
+    static const std::set<std::string> levels{"trace", "debug", "info", "warn", "error"};
+    if (levels.count(c.log_level) == 0)
+      root.fail("log_level", "must be one of trace, debug, info, warn, error");
+  });
+
+  c.sources = read_sources(root, *user, defaults, c.sweep_period, base_dir, problems);
+  problems.read([&] { c.robot = read_daemon_robot(root, base_dir); });
+  problems.read([&] { c.pipeline = CellPipelineConfig::from_yaml(root); });
+  problems.read([&] { c.security = read_security(root.child("security"), base_dir); });
+  problems.read([&] { c.ros2 = read_ros2(root.child("ros2")); });
+  problems.read([&] {
+    if (!c.sources.empty() && c.simulated() && !c.ros2.joint_states.empty())
+      root.child("ros2").fail("joint_states", "poses cameras; the simulated cell moves its robot itself");
+  });
+  for (const std::string& key : root.unread_keys()) problems.read([&] { root.fail(key, "unknown key"); });
+  problems.read([&] { check_ros2_security(c); });
+  return c;
+}
+
+ConfigErrors::ConfigErrors(std::vector<std::string> problems)
+    : Error(joined(problems, "; ")), problems_(std::move(problems)) {}
+
+void ConfigOverrides::apply_to(DaemonConfig& config) const {
+  if (domain) config.domain = *domain;
+  if (state_dir) config.state_dir = *state_dir;
+  if (security) config.security = *security;
 }
 
 void check_ros2_security(const DaemonConfig& config) {

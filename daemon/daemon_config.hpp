@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cellmap/cell/cell_pipeline.hpp"
+#include "cellmap/common/error.hpp"
 #include "cellmap/robot/robot.hpp"
 #include "cellmap/ros2/environment_writers.hpp"
 #include "cellmap/ros2/sensor_sources.hpp"
@@ -30,6 +31,8 @@ enum class SourceKind { kSim, kReplay, kOpenNI2, kV4l2, kPointCloud2, kLaserScan
 /// One entry of `sources` (or the single `source` section, read as a list of one). Each entry is laid over
 /// the built-in `source` section, so it names only what it changes.
 struct SourceConfig final {
+  /// Where the entry is in the config (`source`, `sources[1]`): messages about it name its keys from there.
+  std::string key = "source";
   SourceKind kind = SourceKind::kSim;  ///< `kind`
   /// `scene` (sim): scene YAML (relative paths are relative to the config file); empty = the embedded
   /// default cell (config/cell.yaml). Every sim entry names the same scene.
@@ -116,8 +119,37 @@ struct DaemonConfig final {
   /// @throws Error naming the file and key for unknown keys, wrong types and out-of-range values.
   [[nodiscard]] static DaemonConfig load(const std::filesystem::path& file);
   /// As load(), on YAML text; `source` names it in messages and `base_dir` resolves relative paths.
+  /// @throws ConfigErrors (an Error) with every problem read() finds.
   [[nodiscard]] static DaemonConfig parse(const std::string& yaml, const std::string& source,
                                           const std::filesystem::path& base_dir);
+  /// As parse(), but reads on past a problem so that all of them are found (`cellmapd --check`): each
+  /// top-level key, each section and each entry of `sources` is read on its own; one that fails keeps its
+  /// default (a failed entry of `sources` is left out, so `sources` may be empty) and its problem, one line
+  /// "<source>: <key>: <reason>", is appended to `problems`. A file that is not YAML is one problem.
+  [[nodiscard]] static DaemonConfig read(const std::string& yaml, const std::string& source,
+                                         const std::filesystem::path& base_dir,
+                                         std::vector<std::string>& problems);
+};
+
+/// A config that does not load: every problem found, in the order found. what() is them all, joined by
+/// "; " (one line).
+class ConfigErrors final : public Error {
+ public:
+  explicit ConfigErrors(std::vector<std::string> problems);
+  [[nodiscard]] const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::vector<std::string> problems_;
+};
+
+/// What cellmapd's command line sets over the config's keys: `--domain`, `--state-dir`, `--security` with
+/// `--role`. Unset ones leave the config's value.
+struct ConfigOverrides final {
+  std::optional<int> domain;
+  std::optional<std::filesystem::path> state_dir;
+  std::optional<security::Setting> security;
+
+  void apply_to(DaemonConfig& config) const;
 };
 
 /// ROS 2 nodes hold none of the cell's credentials: a daemon that talked to them with DDS Security on would

@@ -160,6 +160,25 @@ VersionStore::VersionStore(fs::path state_dir, std::string cell)
   remove_superseded(listing);
 }
 
+std::optional<std::string> VersionStore::stored_cell(const fs::path& state_dir) {
+  std::vector<std::uint64_t> snapshots;
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(state_dir, ec)) {
+    const std::optional<StateName> parsed = parse_name(entry.path().filename().string());
+    if (parsed && parsed->prefix == kSnapshotPrefix && parsed->suffix == ".json")
+      snapshots.push_back(parsed->number);
+  }
+  std::sort(snapshots.rbegin(), snapshots.rend());
+  for (const std::uint64_t version : snapshots) {
+    try {
+      return load_snapshot(state_dir, version).environment.cell();
+    } catch (const Error&) {
+      // A corrupt snapshot says nothing about the cell; the store skips it too.
+    }
+  }
+  return std::nullopt;
+}
+
 VersionStore::Listing VersionStore::list_directory() {
   Listing listing;
   std::error_code ec;

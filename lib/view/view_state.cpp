@@ -28,19 +28,26 @@ json boxes_json(const std::vector<Box>& boxes, std::uint64_t changed_in) {
   return out;
 }
 
-json status_json(const transport::CellStatus& status, bool daemon) {
+json status_object(const transport::CellStatus& status) {
   json sensors = json::array();
   for (const transport::SensorStatus& sensor : status.sensors)
     sensors.push_back({{"name", sensor.name}, {"state", sensor.state}});
   return {{"cell", status.cell},
-          {"daemon", daemon},
           {"state", status.state},
+          {"reason", status.reason},
           {"sensors", sensors},
           {"last_sweep_ns", status.last_sweep_ns},
           {"sweeps", status.sweeps},
           {"dropped_frames", status.dropped_frames},
+          {"refused_inputs", status.refused_inputs},
           {"boxes", status.boxes},
           {"version", status.version}};
+}
+
+json status_json(const transport::CellStatus& status, bool daemon) {
+  json object = status_object(status);
+  object["daemon"] = daemon;
+  return object;
 }
 
 json voxels_json(const transport::VoxelLayer& layer) {
@@ -157,6 +164,10 @@ struct LayerJson {
 };
 
 }  // namespace
+
+std::string status_json(const transport::CellStatus& status) {
+  return status_object(status).dump();
+}
 
 const char* layer_name(transport::Layer layer) {
   switch (layer) {

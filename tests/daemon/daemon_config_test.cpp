@@ -54,6 +54,37 @@ TEST(DaemonConfigTest, ErrorsNameTheFileAndKey) {
       << error_of("segment: {neighbours: {kk: 3}}\n");
 }
 
+TEST(DaemonConfigTest, ReadGoesOnPastEachProblemAndParseThrowsThemAll) {
+  const std::string yaml =
+      "log_level: loud\n"
+      "cel: x\n"
+      "sources:\n"
+      "  - {kind: sim, sensor: kinect}\n"
+      "  - {kind: sim, sensor: realsense, mount: tool}\n"
+      "change: {margin: -1}\n"
+      "segment: {k: 20}\n"  // read although the section before it failed: not an unknown key
+      "self_filter: {enabled: false}\n";
+  std::vector<std::string> problems;
+  const DaemonConfig c = DaemonConfig::read(yaml, "my.yaml", "/etc/cellmap", problems);
+  ASSERT_EQ(problems.size(), 4u) << ::testing::PrintToString(problems);
+  EXPECT_EQ(problems[0], "my.yaml: log_level: must be one of trace, debug, info, warn, error");
+  EXPECT_EQ(problems[1], "my.yaml: sources[1].mount: a simulated sensor is mounted by its scene");
+  EXPECT_EQ(problems[2].rfind("my.yaml: change.margin: ", 0), 0u) << problems[2];
+  EXPECT_EQ(problems[3], "my.yaml: cel: unknown key");
+  ASSERT_EQ(c.sources.size(), 1u);  // the entry that read
+  EXPECT_EQ(c.sources[0].sensor, "kinect");
+  EXPECT_EQ(c.sources[0].key, "sources[0]");
+
+  try {
+    (void)DaemonConfig::parse(yaml, "my.yaml", "/etc/cellmap");
+    FAIL() << "accepted";
+  } catch (const ConfigErrors& e) {
+    EXPECT_EQ(e.problems(), problems);
+    EXPECT_EQ(std::string(e.what()),
+              problems[0] + "; " + problems[1] + "; " + problems[2] + "; " + problems[3]);
+  }
+}
+
 // Found by fuzzing: a complex key (`? gap: 0.04`) in a section merged over the defaults made the overlay
 // throw yaml-cpp's conversion error, which would have ended cellmapd with an uncaught exception.
 TEST(DaemonConfigTest, FuzzFindingsAreRefusedWithOneLine) {

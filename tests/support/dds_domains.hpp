@@ -54,6 +54,10 @@ inline constexpr int kResume = 203;
 inline constexpr int kMailbox = 205;
 inline constexpr int kGatherRestart = 214;
 
+// status_command_e2e_test: `cellmap status` against cellmapd (cellmap_cli_test's daemon-less run uses
+// kNobodyListening).
+inline constexpr int kStatusCommand = 206;
+
 // planner_e2e_test.
 inline constexpr int kPlanner = 170;
 inline constexpr int kKill = 171;

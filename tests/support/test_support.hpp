@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the tests.
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 
@@ -58,6 +59,23 @@ class TempDir {
 /// passes.
 inline int exit_code(int wait_status) {
   return WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+}
+
+/// What a program printed and how it ended.
+struct CommandRun {
+  std::string output;
+  int status = -1;  ///< exit code, -1 when a signal ended it
+};
+
+/// Runs `command` through /bin/sh and reads its stdout (add `2>&1` to read its stderr too).
+inline CommandRun run_command(const std::string& command) {
+  CommandRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  while (::fgets(buffer, sizeof buffer, pipe) != nullptr) run.output += buffer;
+  run.status = exit_code(::pclose(pipe));
+  return run;
 }
 
 /// The message of the cellmap::Error that `f` throws, or "" if it throws none.

@@ -124,10 +124,12 @@ TEST(ViewStateTest, StatusThenDaemonGoneKeepsTheLastReport) {
                           {"cell", "cell-a"},
                           {"daemon", true},
                           {"state", "running"},
+                          {"reason", ""},
                           {"sensors", json::array({{{"name", "kinect"}, {"state", "streaming"}}})},
                           {"last_sweep_ns", 123},
                           {"sweeps", 42},
                           {"dropped_frames", 3},
+                          {"refused_inputs", 0},
                           {"boxes", 44},
                           {"version", 9}}));
   EXPECT_TRUE(state.daemon("cell-a"));

@@ -14,6 +14,7 @@ void add_sensors_command(CLI::App& app);
 void add_echo_command(CLI::App& app);
 void add_inject_command(CLI::App& app);
 void add_robot_pose_command(CLI::App& app);
+void add_status_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_security_command(CLI::App& app);

@@ -16,20 +16,25 @@ ReconcileParams read_reconcile(YamlMap section) {
 }  // namespace
 
 CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
+  // Every section is taken from the root before any is read: a reader that goes on past a bad section
+  // (cellmapd --check) then does not report the sections after it as unknown keys.
+  YamlMap occupancy = root.child("occupancy");
+  YamlMap change = root.child("change");
+  YamlMap segment = root.child("segment");
+  YamlMap reconcile = root.child("reconcile");
+  YamlMap self_filter = root.child("self_filter");
   CellPipelineConfig c;
-  c.occupancy = OccupancyConfig::from_yaml(root.child("occupancy"));
+  c.occupancy = OccupancyConfig::from_yaml(occupancy);
   // settle_sweeps and gather_sweeps sit in the `change` section (where operators look for them) but are the
   // pipeline's policies: read them here, the rest of the section by the change detector's reader.
-  YamlMap change = root.child("change");
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   c.gather_sweeps = static_cast<int>(change.integer("gather_sweeps", c.gather_sweeps, 0, 1000));
   c.change = ChangeConfig::from_yaml(change);
-  c.segment = SegmentConfig::from_yaml(root.child("segment"));
+  c.segment = SegmentConfig::from_yaml(segment);
   // cover_every_version is the pipeline's policy too, read the same way.
-  YamlMap reconcile = root.child("reconcile");
   c.cover_every_version = reconcile.get<bool>("cover_every_version", c.cover_every_version);
   c.reconcile = read_reconcile(reconcile);
-  c.self_filter = SelfFilterConfig::from_yaml(root.child("self_filter"));
+  c.self_filter = SelfFilterConfig::from_yaml(self_filter);
   return c;
 }
 

@@ -113,10 +113,17 @@ YAML::Node YamlMap::node(const std::string& key) {
 }
 
 void YamlMap::expect_all_read() const {
+  const std::vector<std::string> unread = unread_keys();
+  if (!unread.empty()) fail(unread.front(), "unknown key");
+}
+
+std::vector<std::string> YamlMap::unread_keys() const {
+  std::vector<std::string> unread;
   for (const auto& entry : node_) {
-    const std::string key = entry.first.as<std::string>();
-    if (read_.count(key) == 0) fail(key, "unknown key");
+    std::string key = entry.first.as<std::string>();
+    if (read_.count(key) == 0) unread.push_back(std::move(key));
   }
+  return unread;
 }
 
 void YamlMap::fail(const std::string& key, const std::string& reason) const {

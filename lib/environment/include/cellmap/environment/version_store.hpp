@@ -54,6 +54,11 @@ class VersionStore final {
   /// @throws Error if the directory cannot be created or listed, or holds a snapshot of another cell.
   VersionStore(std::filesystem::path state_dir, std::string cell);
 
+  /// The cell whose versions `state_dir` holds: the one the newest snapshot that reads back names. Read
+  /// without changing anything (a check before a start, `cellmapd --check`); nullopt if the directory holds
+  /// no snapshot that reads back, or does not exist. The constructor refuses another cell's directory.
+  [[nodiscard]] static std::optional<std::string> stored_cell(const std::filesystem::path& state_dir);
+
   /// What was loaded when the store opened.
   [[nodiscard]] const RecoveredState& recovered() const { return recovered_; }
 

@@ -21,8 +21,8 @@
 // BOX = {"id", "center", "half_extents", "rotation" [w,x,y,z], "points", "changed_in"} where changed_in is
 //   the version that added or last modified the box, null if that was before the viewer joined
 // ENTRY = {"from_version", "to_version", "stamp_ns", "received_ns", "added", "modified", "removed"} (counts)
-// STATUS = {"cell", "daemon" (false once it is gone), "state", "sensors":[{"name","state"}...],
-//   "last_sweep_ns", "sweeps", "dropped_frames", "boxes", "version"}
+// STATUS = {"cell", "daemon" (false once it is gone), "state", "reason", "sensors":[{"name","state"}...],
+//   "last_sweep_ns", "sweeps", "dropped_frames", "refused_inputs", "boxes", "version"}
 // Page → server: {"type":"layers", "voxels":bool, "regions":bool, "sensors":bool, "robot":bool} (which layers
 // this page shows; a missing key is false) and
 // {"type":"resync"} (the page missed a version: it gets a "state" again).
@@ -40,6 +40,11 @@
 #include "cellmap/transport/messages.hpp"
 
 namespace cellmap::view {
+
+/// One status report as a JSON object (the fields of cellmap/status, docs/dds.md): {"cell", "state",
+/// "reason", "sensors":[{"name","state"}...], "last_sweep_ns", "sweeps", "dropped_frames", "refused_inputs",
+/// "boxes", "version"}. The page's STATUS is this with "daemon"; `cellmap status --json` lists them.
+[[nodiscard]] std::string status_json(const transport::CellStatus& status);
 
 /// A layer's name in the page protocol: its message type and its key in a "layers" request.
 [[nodiscard]] const char* layer_name(transport::Layer layer);

@@ -84,6 +84,9 @@ class YamlMap {
 
   /// @throws Error naming the first key of this map that was never read ("unknown key").
   void expect_all_read() const;
+  /// The keys of this map that were never read, in the file's order (what expect_all_read() refuses), for a
+  /// reader that reports every unknown key rather than the first.
+  [[nodiscard]] std::vector<std::string> unread_keys() const;
 
   /// @throws Error "<source>: <path>.<key>: <reason>".
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const;
