@@ -1,0 +1,459 @@
+#!/usr/bin/env python3
+"""What the documentation says that can be checked mechanically, against the programs themselves:
+
+1. commands: every `cellmap ...` and `cellmapd ...` in a code span or code block of README.md and docs/**/*.md
+   names subcommands, flags and choices that the programs' --help lists (`cellmap <sub> --help` for each
+   subcommand); a flag named on its own (`--role`) must be a flag of one of them;
+2. config keys: every key the tables of docs/config.md list (the first column of a table whose header starts
+   with "key") is one the readers read, and every key they read is listed. What the readers read comes from
+   the readers (config_keys, tests/docs/config_keys.cpp, records the keys they read or ask about while they
+   read the built-in defaults and every shipped file), not from a second list;
+3. shipped files: every YAML file in config/ and config/scenes/ is accepted by its reader.
+
+Prints one line per finding, "file:line: what is wrong", and exits 1 if there is any.
+
+How docs/config.md is read (so that a rewrite keeps it checkable): a `## ` heading naming `cellmapd.yaml`,
+`segment.yaml` or "scene" says whose keys the tables below it list. A table's keys are relative to the
+sections named (in backticks) in the paragraph right above it, else in the nearest heading above it; a key
+that already starts with that section is taken as written. A key cell may list several keys (`width`,
+`height`) and siblings (`robot.gantry.lower`, `.upper`). A key whose value is a map or a list documents the
+keys inside it too (`intrinsics`, `{fx, fy, cx, cy}` in its row).
+
+--self-test instead shows that each kind of finding is reported, on made-up docs and help texts.
+"""
+import argparse
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+# --- Markdown: where the docs name commands and keys -------------------------------------------------------
+
+FENCE = re.compile(r'^\s*(```|~~~)')
+SPAN = re.compile(r'`([^`]+)`')
+
+
+def markdown_files(source_dir):
+    """README.md and every docs/**/*.md, as (path relative to source_dir, lines)."""
+    paths = [source_dir / 'README.md'] + sorted((source_dir / 'docs').rglob('*.md'))
+    return [(path.relative_to(source_dir), path.read_text(encoding='utf-8').splitlines())
+            for path in paths if path.is_file()]
+
+
+def code_texts(lines):
+    """(line number, text) of every code span (a span broken over lines is joined) and every line of a fenced
+    code block (a line ending in a backslash continues on the next)."""
+    in_block = False
+    paragraph = []  # (line number, text) of the prose lines since the last blank line
+    pending = None  # a code block line continued with a backslash
+
+    def spans_of(paragraph_lines):
+        text = ''
+        starts = []  # (offset, line number)
+        for number, line in paragraph_lines:
+            starts.append((len(text), number))
+            text += line + ' '
+        for match in SPAN.finditer(text):
+            number = max(n for offset, n in starts if offset <= match.start())
+            yield number, match.group(1)
+
+    for number, line in enumerate(lines, start=1):
+        if FENCE.match(line):
+            yield from spans_of(paragraph)
+            paragraph = []
+            in_block = not in_block
+            continue
+        if in_block:
+            if pending:
+                pending = (pending[0], pending[1] + ' ' + line.strip())
+            else:
+                pending = (number, line)
+            if not line.rstrip().endswith('\\'):
+                yield pending[0], pending[1].replace('\\', ' ')
+                pending = None
+        elif line.strip():
+            paragraph.append((number, line))
+        else:
+            yield from spans_of(paragraph)
+            paragraph = []
+    yield from spans_of(paragraph)
+
+
+# --- Commands: what the programs' --help offers ----------------------------------------------------------
+
+class Command:
+    """One program or subcommand as its --help describes it."""
+
+    def __init__(self, help_text):
+        self.flags = set()
+        self.subcommands = set()
+        self.choices = []  # the allowed values of each positional that lists them, in order
+        section = None
+        for line in help_text.splitlines():
+            heading = re.match(r'^(\w[\w ]*):\s*$', line)
+            if heading:
+                section = heading.group(1).lower()
+                continue
+            entry = re.match(r'^\s+(\S.*?)(?:\s{2,}|$)', line)
+            if not entry:
+                continue
+            if section == 'options':
+                self.flags.update(re.findall(r'(?<![\w-])(--?[A-Za-z][\w-]*)', entry.group(1)))
+            elif section == 'subcommands':
+                self.subcommands.add(entry.group(1).split()[0])
+            elif section == 'positionals':
+                listed = re.search(r'\{([^}]*)\}', entry.group(1))
+                if listed:
+                    self.choices.append({choice.strip() for choice in listed.group(1).split(',')})
+
+
+class Programs:
+    """The --help of cellmap, its subcommands (by path, e.g. ('security', 'init')) and cellmapd, asked once."""
+
+    def __init__(self, run_help):
+        self._run_help = run_help  # (program, subcommand path) -> help text
+        self._commands = {}
+
+    def command(self, program, path=()):
+        key = (program, tuple(path))
+        if key not in self._commands:
+            self._commands[key] = Command(self._run_help(program, tuple(path)))
+        return self._commands[key]
+
+    def every_flag(self):
+        """The flags of cellmapd, cellmap and every subcommand."""
+        flags = set(self.command('cellmapd').flags)
+        pending = [()]
+        while pending:
+            path = pending.pop()
+            command = self.command('cellmap', path)
+            flags |= command.flags
+            pending += [path + (sub,) for sub in command.subcommands]
+        return flags
+
+
+def run_help_of(binaries):
+    def run_help(program, path):
+        result = subprocess.run([binaries[program], *path, '--help'], capture_output=True, text=True,
+                                timeout=30, check=False)
+        return result.stdout + result.stderr
+    return run_help
+
+
+COMMAND = re.compile(r'(?:^|(?<=[\s(]))(?:[\w.-]*/)?(cellmapd|cellmap)(?=\s|$)')
+SHELL_END = re.compile(r'\s(?:\||&&|;|>|2>|#)\s|\s--\s|\s--$')  # where a command's own words end
+FLAG = re.compile(r'^(--?[A-Za-z][\w-]*)')
+NAME = re.compile(r'^[a-z][a-z0-9-]*(\|[a-z][a-z0-9-]*)*$')  # a subcommand, a choice or choices a|b
+LONE_FLAG = re.compile(r'^(--[a-z][\w-]*)(?:[ =].*)?$')
+
+
+def command_findings(where, text, programs):
+    """What a code text names of cellmap or cellmapd that their --help does not have."""
+    match = COMMAND.search(text)
+    if not match:
+        lone = LONE_FLAG.match(text.strip())
+        if lone and lone.group(1) not in programs.every_flag():
+            return [f'{where}: `{lone.group(1)}` is a flag of neither cellmap nor cellmapd']
+        return []
+    program = match.group(1)
+    words = text[match.end():]
+    end = SHELL_END.search(words)
+    words = (words[:end.start()] if end else words).split()
+    findings = []
+    path = []
+    after_flag = False  # the word after a flag is its value, unless it is a subcommand
+    positional = 0
+    for word in words:
+        command = programs.command(program, path)
+        flag = FLAG.match(word.strip('[]()|'))
+        if flag:
+            name = flag.group(1)
+            if name not in command.flags and not any(
+                    name in programs.command(program, path[:depth]).flags for depth in range(len(path))):
+                findings.append(f'{where}: `{" ".join([program, *path])}` has no flag {name}')
+            after_flag = True
+            continue
+        bare = word.strip('[](){}.,:;')
+        if bare in command.subcommands:
+            path.append(bare)
+            after_flag = False
+            continue
+        if after_flag or not NAME.match(bare):
+            after_flag = False  # a value, a placeholder (FILE, N, <cell>) or a path
+            continue
+        if command.subcommands:
+            findings.append(f'{where}: `{" ".join([program, *path])}` has no subcommand {bare}')
+            break
+        if positional < len(command.choices):
+            wrong = [choice for choice in bare.split('|') if choice not in command.choices[positional]]
+            if wrong:
+                allowed = '|'.join(sorted(command.choices[positional]))
+                findings.append(f'{where}: `{" ".join([program, *path])}` takes {allowed}, not {", ".join(wrong)}')
+        positional += 1
+    return findings
+
+
+def check_commands(docs, programs):
+    findings = []
+    for path, lines in docs:
+        for number, text in code_texts(lines):
+            for text_part in re.split(r'\s(?:&&|;)\s', text):
+                findings += command_findings(f'{path}:{number}', text_part, programs)
+    return findings
+
+
+# --- Config keys: docs/config.md's tables against the readers ---------------------------------------------
+
+READERS = ('daemon', 'segment', 'scene')
+# Where one reader reads another's keys: cellmapd's `segment` section is a segment.yaml, its `robot` section
+# a scene's robot, and each entry of `sources` is laid over the `source` section.
+NESTED = (('daemon', 'segment.', 'segment', ''), ('daemon', 'robot.', 'scene', 'robot.'))
+
+
+def normalise(key):
+    """A key path as docs/config.md writes it: list indices as [i], the entries of `sources` as `source`."""
+    key = re.sub(r'\[\d+\]', '[i]', key)
+    return re.sub(r'^sources(\[i\])?(?=\.|$)', 'source', key)
+
+
+def reader_of_heading(title):
+    lowered = title.lower()
+    for reader, marker in (('daemon', 'cellmapd.yaml'), ('segment', 'segment.yaml'), ('scene', 'scene')):
+        if marker in lowered:
+            return reader
+    return None
+
+
+def key_cells(cell):
+    """The keys a table's first cell names: `a`, `b` and `c.d`, `.e` (a sibling of c.d)."""
+    keys = []
+    for token in SPAN.findall(cell):
+        token = token.strip().rstrip(':')
+        if token.startswith('.') and keys:
+            token = keys[-1].rsplit('.', 1)[0] + token
+        if re.match(r'^[A-Za-z_][\w.\[\]]*$', token):
+            keys.append(token)
+    return keys
+
+
+def table_sections(paragraph, heading, maps):
+    """The sections a key table's keys are relative to: those its paragraph names, else its heading's."""
+    for text in (paragraph, heading):
+        named = [key for key in map(normalise, key_cells(' '.join(text))) if key in maps]
+        if named:
+            return list(dict.fromkeys(named))
+    return []
+
+
+def documented_keys(lines, maps):
+    """{reader: {key: line number}} from the key tables; `maps(reader)`: the keys that reader reads as maps."""
+    keys = {reader: {} for reader in READERS}
+    reader = None
+    heading_sections = []
+    paragraph = []
+    in_table = False
+    sections = []
+    for number, line in enumerate(lines, start=1):
+        heading = re.match(r'^(#+)\s+(.*)$', line)
+        if heading:
+            if len(heading.group(1)) <= 2:
+                reader = reader_of_heading(heading.group(2))
+            heading_sections = [heading.group(2)]
+            paragraph = []
+            in_table = False
+            continue
+        if not line.startswith('|'):
+            in_table = False
+            paragraph = paragraph + [line] if line.strip() else []
+            continue
+        cells = [cell.strip() for cell in line.strip().strip('|').split('|')]
+        if not in_table:
+            in_table = True
+            is_key_table = reader is not None and cells[0].lower() == 'key'
+            sections = table_sections(paragraph, heading_sections, maps(reader)) if is_key_table else None
+            continue
+        if sections is None or re.match(r'^:?-+', cells[0]):
+            continue
+        for key in key_cells(cells[0]):
+            for section in sections or ['']:
+                full = key if not section or key == section or key.startswith(section + '.') \
+                    else f'{section}.{key}'
+                keys[reader].setdefault(normalise(full), number)
+    return keys
+
+
+def covers(outer, key):
+    return key == outer or key.startswith(outer + '.') or key.startswith(outer + '[')
+
+
+def with_nested(keys_by_reader):
+    """Each reader's keys with those it reads through another reader's (NESTED), both ways."""
+    merged = {reader: dict(keys) for reader, keys in keys_by_reader.items()}
+    for outer, outer_prefix, inner, inner_prefix in NESTED:
+        for key, where in keys_by_reader[inner].items():
+            if key.startswith(inner_prefix):
+                merged[outer].setdefault(outer_prefix + key[len(inner_prefix):], where)
+        for key, where in keys_by_reader[outer].items():
+            if key.startswith(outer_prefix):
+                merged[inner].setdefault(inner_prefix + key[len(outer_prefix):], where)
+    return merged
+
+
+def check_keys(doc_path, lines, read):
+    """`read`: {reader: {key: the file it was read from}}."""
+    read = with_nested(read)
+    maps = {reader: {key.rsplit('.', 1)[0] for key in keys if '.' in key} |
+            {key.split('[')[0] for key in keys if '[' in key} for reader, keys in read.items()}
+    documented = with_nested(documented_keys(lines, lambda reader: maps.get(reader, set())))
+    findings = []
+    for reader in READERS:
+        for key, number in sorted(documented[reader].items(), key=lambda item: item[1]):
+            if not any(covers(key, known) for known in read[reader]):
+                findings.append(f'{doc_path}:{number}: {reader} key {key} is not read by the {reader} reader')
+        for key, source in sorted(read[reader].items()):
+            if not any(covers(doc, key) or covers(key, doc) for doc in documented[reader]):
+                number = nearest_line(key, documented[reader])
+                findings.append(f'{doc_path}:{number}: {reader} key {key} (read in {source}) is not documented')
+    return findings
+
+
+def nearest_line(key, documented):
+    """The line of the documented key that shares the longest leading part of `key` with it (where it
+    belongs), else 1."""
+    def shared(doc):
+        common = 0
+        for ours, theirs in zip(re.split(r'[.\[]', key), re.split(r'[.\[]', doc)):
+            if ours != theirs:
+                break
+            common += 1
+        return common
+    best = max(documented, key=lambda doc: (shared(doc), -documented[doc]), default=None)
+    return documented[best] if best and shared(best) else 1
+
+
+# --- Shipped files and the readers ---------------------------------------------------------------------------
+
+def reader_of_file(path, segment_sections):
+    """Which reader a shipped YAML file is for, by its top-level keys."""
+    top = set(re.findall(r'^([A-Za-z_]\w*):', path.read_text(encoding='utf-8'), re.MULTILINE))
+    if 'sensors' in top and 'cell' in top:
+        return 'scene'
+    if top and top <= segment_sections:
+        return 'segment'
+    return 'daemon'
+
+
+def read_config_keys(config_keys, reader, path):
+    """(accepted, {reader: keys}, message): the keys config_keys recorded while the reader read `path`."""
+    result = subprocess.run([config_keys, reader, str(path)], capture_output=True, text=True, timeout=60,
+                            check=False)
+    keys = {name: set() for name in READERS}
+    for line in result.stdout.splitlines():
+        name, key = line.split(' ', 1)
+        keys[name].add(normalise(key))
+    return result.returncode == 0, keys, result.stderr.strip()
+
+
+def check_shipped_configs(source_dir, config_keys):
+    """Findings for refused files, and {reader: {key: a file it was read from}}."""
+    findings = []
+    read = {reader: {} for reader in READERS}
+    with tempfile.NamedTemporaryFile('w', suffix='.yaml') as empty:
+        _, keys, _ = read_config_keys(config_keys, 'segment', empty.name)
+        segment_sections = {key.split('.')[0] for key in keys['segment']}
+        _, keys, _ = read_config_keys(config_keys, 'daemon', empty.name)  # the built-in defaults
+        for key in keys['daemon']:
+            read['daemon'].setdefault(key, 'the built-in defaults')
+    files = sorted((source_dir / 'config').glob('*.yaml')) + sorted((source_dir / 'config/scenes').glob('*.yaml'))
+    for path in files:
+        relative = path.relative_to(source_dir)
+        reader = reader_of_file(path, segment_sections)
+        # The daemon's files: with `cellmapd --check` this becomes [cellmapd, '--check', '--config', path].
+        accepted, keys, message = read_config_keys(config_keys, reader, path)
+        if not accepted:
+            findings.append(f'{relative}:1: refused by the {reader} reader: {message}')
+        for name, names in keys.items():
+            for key in names:
+                read[name].setdefault(key, str(relative))
+    return findings, read
+
+
+# --- Self-test ------------------------------------------------------------------------------------------------
+
+FAKE_HELP = {
+    ('cellmapd', ()): 'Usage: cellmapd [OPTIONS]\n\nOptions:\n  -h,--help  Print\n  --config TEXT  YAML\n',
+    ('cellmap', ()): 'Usage: cellmap [OPTIONS] SUBCOMMAND\n\nOptions:\n  -h,--help  Print\n  --version  V\n\n'
+                     'Subcommands:\n  bench  Run\n  security  Creds\n',
+    ('cellmap', ('bench',)): 'Positionals:\n  kind TEXT:{fusion,segment} REQUIRED  which\n',
+    ('cellmap', ('security',)): 'Subcommands:\n  init  Write\n',
+    ('cellmap', ('security', 'init')): 'Options:\n  --cell TEXT  cell\n',
+}
+
+FAKE_CONFIG_MD = '''# Configuration files
+## cellmapd.yaml
+### Top level
+| key | default |
+|---|---|
+| `cell` | `cell-1` |
+| `stale` | 0 |
+### `source`: the sensor
+`source.openni2`:
+| key | default |
+|---|---|
+| `width`, `height` | 640 |
+'''
+
+FAKE_READ = {'daemon': {'cell': 'x', 'source.openni2.width': 'x', 'source.openni2.height': 'x',
+                        'source.openni2.fps': 'x'}, 'segment': {}, 'scene': {}}
+
+
+def self_test():
+    programs = Programs(lambda program, path: FAKE_HELP.get((program, path), ''))
+    docs = [(Path('README.md'), ['Run `cellmap bench sim`, `cellmap bench fusion|segment` and',
+                                 '`cellmap security init DIR --cell C --days 3`.', '', '```',
+                                 'cellmapd --config x.yaml --sweeps 2', 'cellmap nosuch', '```',
+                                 'Use `--version` or `--nothing`.'])]
+    expected = ['README.md:1: `cellmap bench` takes fusion|segment, not sim',
+                'README.md:2: `cellmap security init` has no flag --days',
+                'README.md:5: `cellmapd` has no flag --sweeps',
+                'README.md:6: `cellmap` has no subcommand nosuch',
+                'README.md:8: `--nothing` is a flag of neither cellmap nor cellmapd']
+    expected += ['docs/config.md:7: daemon key stale is not read by the daemon reader',
+                 'docs/config.md:12: daemon key source.openni2.fps (read in x) is not documented']
+    found = check_commands(docs, programs) + check_keys(Path('docs/config.md'), FAKE_CONFIG_MD.splitlines(),
+                                                        FAKE_READ)
+    if found != expected:
+        print('self-test: expected\n  ' + '\n  '.join(expected) + '\nfound\n  ' + '\n  '.join(found))
+        return 1
+    print(f'self-test: each of the {len(expected)} findings reported')
+    return 0
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--self-test', action='store_true')
+    parser.add_argument('--source-dir', type=Path)
+    parser.add_argument('--cellmap')
+    parser.add_argument('--cellmapd')
+    parser.add_argument('--config-keys')
+    args = parser.parse_args()
+    if args.self_test:
+        return self_test()
+    if not (args.source_dir and args.cellmap and args.cellmapd and args.config_keys):
+        parser.error('--source-dir, --cellmap, --cellmapd and --config-keys are required')
+    programs = Programs(run_help_of({'cellmap': args.cellmap, 'cellmapd': args.cellmapd}))
+    findings = check_commands(markdown_files(args.source_dir), programs)
+    config_findings, read = check_shipped_configs(args.source_dir, args.config_keys)
+    findings += config_findings
+    config_md = Path('docs/config.md')
+    findings += check_keys(config_md, (args.source_dir / config_md).read_text(encoding='utf-8').splitlines(),
+                           read)
+    for finding in findings:
+        print(finding)
+    print(f'{len(findings)} findings' if findings else 'the docs match the programs')
+    return 1 if findings else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
