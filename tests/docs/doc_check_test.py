@@ -89,6 +89,7 @@ class Command:
         self.flags = set()
         self.subcommands = set()
         self.choices = []  # the allowed values of each positional that lists them, in order
+        self.passes_through = False  # a positional takes the remaining words (for another program)
         section = None
         for line in help_text.splitlines():
             heading = re.match(r'^(\w[\w ]*):\s*$', line)
@@ -103,6 +104,7 @@ class Command:
             elif section == 'subcommands':
                 self.subcommands.add(entry.group(1).split()[0])
             elif section == 'positionals':
+                self.passes_through |= entry.group(1).endswith('...')
                 listed = re.search(r'\{([^}]*)\}', entry.group(1))
                 if listed:
                     self.choices.append({choice.strip() for choice in listed.group(1).split(',')})
@@ -141,65 +143,123 @@ def run_help_of(binaries):
     return run_help
 
 
-COMMAND = re.compile(r'(?:^|(?<=[\s(]))(?:[\w.-]*/)?(cellmapd|cellmap)(?=\s|$)')
+COMMAND = re.compile(r'(?:^|(?<=\s))(?:[\w.-]*/)?(cellmapd|cellmap)(?=\s|$)')
 SHELL_END = re.compile(r'\s(?:\||&&|;|>|2>|#)\s|\s--\s|\s--$')  # where a command's own words end
 FLAG = re.compile(r'^(--?[A-Za-z][\w-]*)')
-NAME = re.compile(r'^[a-z][a-z0-9-]*(\|[a-z][a-z0-9-]*)*$')  # a subcommand, a choice or choices a|b
+NAME = re.compile(r'^[a-z][a-z0-9-]*([|/][a-z][a-z0-9-]*)*$')  # a subcommand or choice, or several: a|b, a/b
 LONE_FLAG = re.compile(r'^(--[a-z][\w-]*)(?:[ =].*)?$')
+HEADING = re.compile(r'^#+\s')
 
 
-def command_findings(where, text, programs):
-    """What a code text names of cellmap or cellmapd that their --help does not have."""
+class Walk:
+    """A command line's words followed through the subcommands, with what --help does not know."""
+
+    def __init__(self, where, program, programs):
+        self.where = where
+        self.program = program
+        self.programs = programs
+        self.paths = [()]  # several after alternatives (`cellmap echo|inject`)
+        self.findings = []
+        self.positional = 0
+        self.after_flag = False  # the word after a flag is its value, unless it is a subcommand
+
+    def commands(self):
+        """The commands the words reached and their parents (whose flags fall through to them)."""
+        return [self.programs.command(self.program, path[:depth])
+                for path in self.paths for depth in range(len(path) + 1)]
+
+    def passes_through(self):
+        """True when a command here hands its remaining words to another program (`cellmap bench`)."""
+        return any(command.passes_through for command in self.commands())
+
+    def name(self):
+        return ' '.join([self.program, *self.paths[0]]) if len(self.paths) == 1 else \
+            f'{self.program} {"|".join(" ".join(path) for path in self.paths)}'
+
+    def flag(self, name):
+        self.after_flag = True
+        if self.passes_through() and self.positional > 0:
+            return
+        if not any(name in command.flags for command in self.commands()):
+            self.findings.append(f'{self.where}: `{self.name()}` has no flag {name}')
+
+    def word(self, word):
+        """A word that is not a flag; False once the rest cannot be followed."""
+        subcommands = set().union(*(self.programs.command(self.program, path).subcommands for path in self.paths))
+        alternatives = re.split(r'[|/]', word)
+        if all(alternative in subcommands for alternative in alternatives):
+            self.paths = [path + (alternative,) for path in self.paths for alternative in alternatives
+                          if alternative in self.programs.command(self.program, path).subcommands]
+            self.after_flag = False
+            return True
+        if self.after_flag or not NAME.match(word):
+            self.after_flag = False  # a value, a placeholder (FILE, N, <cell>) or a path
+            return True
+        if subcommands:
+            self.findings.append(f'{self.where}: `{self.name()}` has no subcommand {word}')
+            return False
+        choices = [command.choices for command in map(lambda p: self.programs.command(self.program, p), self.paths)]
+        if len(self.paths) == 1 and self.positional < len(choices[0]):
+            allowed = choices[0][self.positional]
+            wrong = [alternative for alternative in alternatives if alternative not in allowed]
+            if wrong:
+                self.findings.append(
+                    f'{self.where}: `{self.name()}` takes {"|".join(sorted(allowed))}, not {", ".join(wrong)}')
+        self.positional += 1
+        return True
+
+
+def walk(where, text, programs):
+    """The Walk of the first cellmap or cellmapd command in a code text, or None."""
     match = COMMAND.search(text)
     if not match:
-        lone = LONE_FLAG.match(text.strip())
-        if lone and lone.group(1) not in programs.every_flag():
-            return [f'{where}: `{lone.group(1)}` is a flag of neither cellmap nor cellmapd']
-        return []
-    program = match.group(1)
+        return None
+    result = Walk(where, match.group(1), programs)
     words = text[match.end():]
     end = SHELL_END.search(words)
-    words = (words[:end.start()] if end else words).split()
-    findings = []
-    path = []
-    after_flag = False  # the word after a flag is its value, unless it is a subcommand
-    positional = 0
-    for word in words:
-        command = programs.command(program, path)
+    for word in (words[:end.start()] if end else words).split():
         flag = FLAG.match(word.strip('[]()|'))
         if flag:
-            name = flag.group(1)
-            if name not in command.flags and not any(
-                    name in programs.command(program, path[:depth]).flags for depth in range(len(path))):
-                findings.append(f'{where}: `{" ".join([program, *path])}` has no flag {name}')
-            after_flag = True
-            continue
-        bare = word.strip('[](){}.,:;')
-        if bare in command.subcommands:
-            path.append(bare)
-            after_flag = False
-            continue
-        if after_flag or not NAME.match(bare):
-            after_flag = False  # a value, a placeholder (FILE, N, <cell>) or a path
-            continue
-        if command.subcommands:
-            findings.append(f'{where}: `{" ".join([program, *path])}` has no subcommand {bare}')
+            result.flag(flag.group(1))
+        elif not result.word(word.strip('[](){}.,:;`')):
             break
-        if positional < len(command.choices):
-            wrong = [choice for choice in bare.split('|') if choice not in command.choices[positional]]
-            if wrong:
-                allowed = '|'.join(sorted(command.choices[positional]))
-                findings.append(f'{where}: `{" ".join([program, *path])}` takes {allowed}, not {", ".join(wrong)}')
-        positional += 1
-    return findings
+    return result
+
+
+def lone_flag_findings(where, text, section):
+    """A flag named on its own (`--role`) in a section headed by a command (### `cellmap echo`): is it that
+    command's, a parent's or a subcommand's? Elsewhere a lone flag may be any program's and is not checked."""
+    lone = LONE_FLAG.match(text.strip())
+    if not lone or section is None or section.passes_through():
+        return []
+    commands = section.commands()
+    pending = [(section.program, path) for path in section.paths]
+    while pending:
+        program, path = pending.pop()
+        for sub in section.programs.command(program, path).subcommands:
+            commands.append(section.programs.command(program, path + (sub,)))
+            pending.append((program, path + (sub,)))
+    if any(lone.group(1) in command.flags for command in commands):
+        return []
+    return [f'{where}: `{section.name()}` (the section\'s command) has no flag {lone.group(1)}']
 
 
 def check_commands(docs, programs):
     findings = []
     for path, lines in docs:
+        headings = [number for number, line in enumerate(lines, start=1) if HEADING.match(line)]
+        sections = {}  # heading line -> the Walk of the command it names, or None
         for number, text in code_texts(lines):
-            for text_part in re.split(r'\s(?:&&|;)\s', text):
-                findings += command_findings(f'{path}:{number}', text_part, programs)
+            where = f'{path}:{number}'
+            heading = max((line for line in headings if line <= number), default=None)
+            for part in re.split(r'\s(?:&&|;)\s', text):
+                result = walk(where, part, programs)
+                if result is not None:
+                    findings += result.findings
+                    if heading == number:
+                        sections.setdefault(heading, result)
+                else:
+                    findings += lone_flag_findings(where, part, sections.get(heading))
     return findings
 
 
@@ -385,7 +445,7 @@ FAKE_HELP = {
     ('cellmapd', ()): 'Usage: cellmapd [OPTIONS]\n\nOptions:\n  -h,--help  Print\n  --config TEXT  YAML\n',
     ('cellmap', ()): 'Usage: cellmap [OPTIONS] SUBCOMMAND\n\nOptions:\n  -h,--help  Print\n  --version  V\n\n'
                      'Subcommands:\n  bench  Run\n  security  Creds\n',
-    ('cellmap', ('bench',)): 'Positionals:\n  kind TEXT:{fusion,segment} REQUIRED  which\n',
+    ('cellmap', ('bench',)): 'Positionals:\n  kind TEXT:{fusion,segment} REQUIRED  which\n  flags TEXT ...  more\n',
     ('cellmap', ('security',)): 'Subcommands:\n  init  Write\n',
     ('cellmap', ('security', 'init')): 'Options:\n  --cell TEXT  cell\n',
 }
@@ -413,12 +473,14 @@ def self_test():
     docs = [(Path('README.md'), ['Run `cellmap bench sim`, `cellmap bench fusion|segment` and',
                                  '`cellmap security init DIR --cell C --days 3`.', '', '```',
                                  'cellmapd --config x.yaml --sweeps 2', 'cellmap nosuch', '```',
-                                 'Use `--version` or `--nothing`.'])]
+                                 '### `cellmap security init`', 'Use `--cell` or `--nothing`;',
+                                 '`cellmap security|bench --help`.', '### `cellmap bench`',
+                                 'Its own flags: `--benchmark_x`, `cellmap bench fusion --benchmark_y`.'])]
     expected = ['README.md:1: `cellmap bench` takes fusion|segment, not sim',
                 'README.md:2: `cellmap security init` has no flag --days',
                 'README.md:5: `cellmapd` has no flag --sweeps',
                 'README.md:6: `cellmap` has no subcommand nosuch',
-                'README.md:8: `--nothing` is a flag of neither cellmap nor cellmapd']
+                "README.md:9: `cellmap security init` (the section's command) has no flag --nothing"]
     expected += ['docs/config.md:7: daemon key stale is not read by the daemon reader',
                  'docs/config.md:12: daemon key source.openni2.fps (read in x) is not documented']
     found = check_commands(docs, programs) + check_keys(Path('docs/config.md'), FAKE_CONFIG_MD.splitlines(),
