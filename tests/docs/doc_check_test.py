@@ -32,6 +32,9 @@ from pathlib import Path
 
 FENCE = re.compile(r'^\s*(```|~~~)')
 SPAN = re.compile(r'`([^`]+)`')
+HEADING = re.compile(r'^#+\s')
+LIST_ITEM = re.compile(r'^\s*(?:[-*+]|\d+\.)\s')
+COMMAND_HEADING = re.compile(r'^#+\s+`[^`]+`\s*$')  # a section about one command: ### `cellmap echo`
 
 
 def markdown_files(source_dir):
@@ -42,8 +45,9 @@ def markdown_files(source_dir):
 
 
 def code_texts(lines):
-    """(line number, text) of every code span (a span broken over lines is joined) and every line of a fenced
-    code block (a line ending in a backslash continues on the next)."""
+    """(line number, text, paragraph) of every code span (a span broken over lines is joined) and every line of
+    a fenced code block (a line ending in a backslash continues on the next); paragraph: the line its paragraph
+    or code block starts on."""
     in_block = False
     paragraph = []  # (line number, text) of the prose lines since the last blank line
     pending = None  # a code block line continued with a backslash
@@ -56,13 +60,15 @@ def code_texts(lines):
             text += line + ' '
         for match in SPAN.finditer(text):
             number = max(n for offset, n in starts if offset <= match.start())
-            yield number, match.group(1)
+            yield number, match.group(1), starts[0][1]
 
+    block = None  # the line the code block starts on
     for number, line in enumerate(lines, start=1):
         if FENCE.match(line):
             yield from spans_of(paragraph)
             paragraph = []
             in_block = not in_block
+            block = number
             continue
         if in_block:
             if pending:
@@ -70,14 +76,33 @@ def code_texts(lines):
             else:
                 pending = (number, line)
             if not line.rstrip().endswith('\\'):
-                yield pending[0], pending[1].replace('\\', ' ')
+                yield pending[0], pending[1].replace('\\', ' '), block
                 pending = None
+        elif HEADING.match(line):  # a heading is a paragraph of its own
+            yield from spans_of(paragraph)
+            yield from spans_of([(number, line)])
+            paragraph = []
+        elif LIST_ITEM.match(line):  # each item of a list is a paragraph of its own
+            yield from spans_of(paragraph)
+            paragraph = [(number, line)]
         elif line.strip():
             paragraph.append((number, line))
         else:
             yield from spans_of(paragraph)
             paragraph = []
     yield from spans_of(paragraph)
+
+
+def heading_lines(lines):
+    """The numbers of the lines that are headings (not comments in code blocks)."""
+    in_block = False
+    numbers = []
+    for number, line in enumerate(lines, start=1):
+        if FENCE.match(line):
+            in_block = not in_block
+        elif not in_block and HEADING.match(line):
+            numbers.append(number)
+    return numbers
 
 
 # --- Commands: what the programs' --help offers ----------------------------------------------------------
@@ -148,7 +173,6 @@ SHELL_END = re.compile(r'\s(?:\||&&|;|>|2>|#)\s|\s--\s|\s--$')  # where a comman
 FLAG = re.compile(r'^(--?[A-Za-z][\w-]*)')
 NAME = re.compile(r'^[a-z][a-z0-9-]*([|/][a-z][a-z0-9-]*)*$')  # a subcommand or choice, or several: a|b, a/b
 LONE_FLAG = re.compile(r'^(--[a-z][\w-]*)(?:[ =].*)?$')
-HEADING = re.compile(r'^#+\s')
 
 
 class Walk:
@@ -226,40 +250,47 @@ def walk(where, text, programs):
     return result
 
 
-def lone_flag_findings(where, text, section):
-    """A flag named on its own (`--role`) in a section headed by a command (### `cellmap echo`): is it that
-    command's, a parent's or a subcommand's? Elsewhere a lone flag may be any program's and is not checked."""
+def lone_flag_findings(where, text, context):
+    """A flag named on its own (`--role`) where commands are being described (the section's command when the
+    heading is just that command, ### `cellmap echo`, and the commands its paragraph or list item names): is it
+    one of theirs, a parent's or a subcommand's? Elsewhere a lone flag may be any program's (a benchmark's, the
+    example planner's) and is not checked."""
     lone = LONE_FLAG.match(text.strip())
-    if not lone or section is None or section.passes_through():
+    if not lone or not context or any(walk.passes_through() for walk in context):
         return []
-    commands = section.commands()
-    pending = [(section.program, path) for path in section.paths]
-    while pending:
-        program, path = pending.pop()
-        for sub in section.programs.command(program, path).subcommands:
-            commands.append(section.programs.command(program, path + (sub,)))
-            pending.append((program, path + (sub,)))
+    commands = []
+    for walk in context:
+        commands += walk.commands()
+        pending = list(walk.paths)
+        while pending:
+            path = pending.pop()
+            for sub in walk.programs.command(walk.program, path).subcommands:
+                commands.append(walk.programs.command(walk.program, path + (sub,)))
+                pending.append(path + (sub,))
     if any(lone.group(1) in command.flags for command in commands):
         return []
-    return [f'{where}: `{section.name()}` (the section\'s command) has no flag {lone.group(1)}']
+    names = ', '.join(dict.fromkeys(f'`{walk.name()}`' for walk in context))
+    return [f'{where}: {lone.group(1)} is named for {names}; none of them has it']
 
 
 def check_commands(docs, programs):
     findings = []
     for path, lines in docs:
-        headings = [number for number, line in enumerate(lines, start=1) if HEADING.match(line)]
-        sections = {}  # heading line -> the Walk of the command it names, or None
-        for number, text in code_texts(lines):
+        headings = {number: [] for number in heading_lines(lines)}  # -> the Walk of the command it is about
+        paragraphs = {}  # paragraph line -> the Walks of the commands it names
+        for number, text, paragraph in code_texts(lines):
             where = f'{path}:{number}'
             heading = max((line for line in headings if line <= number), default=None)
             for part in re.split(r'\s(?:&&|;)\s', text):
                 result = walk(where, part, programs)
                 if result is not None:
                     findings += result.findings
-                    if heading == number:
-                        sections.setdefault(heading, result)
+                    paragraphs.setdefault(paragraph, []).append(result)
+                    if heading == number and COMMAND_HEADING.match(lines[number - 1]):
+                        headings[heading].append(result)
                 else:
-                    findings += lone_flag_findings(where, part, sections.get(heading))
+                    context = headings.get(heading, []) + paragraphs.get(paragraph, [])
+                    findings += lone_flag_findings(where, part, context)
     return findings
 
 
@@ -480,7 +511,7 @@ def self_test():
                 'README.md:2: `cellmap security init` has no flag --days',
                 'README.md:5: `cellmapd` has no flag --sweeps',
                 'README.md:6: `cellmap` has no subcommand nosuch',
-                "README.md:9: `cellmap security init` (the section's command) has no flag --nothing"]
+                "README.md:9: --nothing is named for `cellmap security init`; none of them has it"]
     expected += ['docs/config.md:7: daemon key stale is not read by the daemon reader',
                  'docs/config.md:12: daemon key source.openni2.fps (read in x) is not documented']
     found = check_commands(docs, programs) + check_keys(Path('docs/config.md'), FAKE_CONFIG_MD.splitlines(),
