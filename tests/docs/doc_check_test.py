@@ -3,7 +3,8 @@
 
 1. commands: every `cellmap ...` and `cellmapd ...` in a code span or code block of README.md and docs/**/*.md
    names subcommands, flags and choices that the programs' --help lists (`cellmap <sub> --help` for each
-   subcommand); a flag named on its own (`--role`) must be a flag of one of them;
+   subcommand); a flag named on its own (`--role`) where a command is described (in a section headed by just
+   that command, or in a paragraph or list item naming it) must be one of that command's;
 2. config keys: every key the tables of docs/config.md list (the first column of a table whose header starts
    with "key") is one the readers read, and every key they read is listed. What the readers read comes from
    the readers (config_keys, tests/docs/config_keys.cpp, records the keys they read or ask about while they
@@ -113,7 +114,7 @@ class Command:
     def __init__(self, help_text):
         self.flags = set()
         self.subcommands = set()
-        self.choices = []  # the allowed values of each positional that lists them, in order
+        self.choices = []  # each positional's allowed values in order, None where --help lists none
         self.passes_through = False  # a positional takes the remaining words (for another program)
         section = None
         for line in help_text.splitlines():
@@ -131,8 +132,7 @@ class Command:
             elif section == 'positionals':
                 self.passes_through |= entry.group(1).endswith('...')
                 listed = re.search(r'\{([^}]*)\}', entry.group(1))
-                if listed:
-                    self.choices.append({choice.strip() for choice in listed.group(1).split(',')})
+                self.choices.append({choice.strip() for choice in listed.group(1).split(',')} if listed else None)
 
 
 class Programs:
@@ -147,17 +147,6 @@ class Programs:
         if key not in self._commands:
             self._commands[key] = Command(self._run_help(program, tuple(path)))
         return self._commands[key]
-
-    def every_flag(self):
-        """The flags of cellmapd, cellmap and every subcommand."""
-        flags = set(self.command('cellmapd').flags)
-        pending = [()]
-        while pending:
-            path = pending.pop()
-            command = self.command('cellmap', path)
-            flags |= command.flags
-            pending += [path + (sub,) for sub in command.subcommands]
-        return flags
 
 
 def run_help_of(binaries):
@@ -224,9 +213,9 @@ class Walk:
         if subcommands:
             self.findings.append(f'{self.where}: `{self.name()}` has no subcommand {word}')
             return False
-        choices = [command.choices for command in map(lambda p: self.programs.command(self.program, p), self.paths)]
-        if len(self.paths) == 1 and self.positional < len(choices[0]):
-            allowed = choices[0][self.positional]
+        choices = self.programs.command(self.program, self.paths[0]).choices
+        allowed = choices[self.positional] if len(self.paths) == 1 and self.positional < len(choices) else None
+        if allowed:
             wrong = [alternative for alternative in alternatives if alternative not in allowed]
             if wrong:
                 self.findings.append(
