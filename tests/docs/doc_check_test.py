@@ -4,7 +4,7 @@
 1. commands: every `cellmap ...` and `cellmapd ...` in a code span or code block of README.md and docs/**/*.md
    names subcommands, flags and choices that the programs' --help lists (`cellmap <sub> --help` for each
    subcommand); a flag named on its own (`--role`) where a command is described (in a section headed by just
-   that command, or in a paragraph or list item naming it) must be one of that command's;
+   that command, or in a paragraph or list item that starts with it) must be one of that command's;
 2. config keys: every key the tables of docs/config.md list (the first column of a table whose header starts
    with "key") is one the readers read, and every key they read is listed. What the readers read comes from
    the readers (config_keys, tests/docs/config_keys.cpp, records the keys they read or ask about while they
@@ -36,6 +36,8 @@ SPAN = re.compile(r'`([^`]+)`')
 HEADING = re.compile(r'^#+\s')
 LIST_ITEM = re.compile(r'^\s*(?:[-*+]|\d+\.)\s')
 COMMAND_HEADING = re.compile(r'^#+\s+`[^`]+`\s*$')  # a section about one command: ### `cellmap echo`
+# A paragraph or list item about one command starts with it: **`cellmap sensors`** lists ..., - `cellmapd ...`:
+COMMAND_PARAGRAPH = re.compile(r'^\s*(?:(?:[-*+]|\d+\.)\s+)?[*_]*`(?:[\w.-]*/)?cellmapd?[\s`]')
 
 
 def markdown_files(source_dir):
@@ -242,10 +244,10 @@ def walk(where, text, programs):
 
 
 def lone_flag_findings(where, text, context):
-    """A flag named on its own (`--role`) where commands are being described (the section's command when the
-    heading is just that command, ### `cellmap echo`, and the commands its paragraph or list item names): is it
-    one of theirs, a parent's or a subcommand's? Elsewhere a lone flag may be any program's (a benchmark's, the
-    example planner's) and is not checked."""
+    """A flag named on its own (`--role`) where a command is being described (a section whose heading is just
+    that command, ### `cellmap echo`, or a paragraph or list item that starts with it): is it that command's, a
+    parent's or a subcommand's? Elsewhere a lone flag may be any program's (a benchmark's, the example
+    planner's, one of several commands a sentence names) and is not checked."""
     lone = LONE_FLAG.match(text.strip())
     if not lone or not context or any(walk.passes_through() for walk in context):
         return []
@@ -268,7 +270,7 @@ def check_commands(docs, programs):
     findings = []
     for path, lines in docs:
         headings = {number: [] for number in heading_lines(lines)}  # -> the Walk of the command it is about
-        paragraphs = {}  # paragraph line -> the Walks of the commands it names
+        paragraphs = {}  # paragraph line -> the Walk of the command it starts with
         for number, text, paragraph in code_texts(lines):
             where = f'{path}:{number}'
             heading = max((line for line in headings if line <= number), default=None)
@@ -276,7 +278,8 @@ def check_commands(docs, programs):
                 result = walk(where, part, programs)
                 if result is not None:
                     findings += result.findings
-                    paragraphs.setdefault(paragraph, []).append(result)
+                    if COMMAND_PARAGRAPH.match(lines[paragraph - 1]):
+                        paragraphs.setdefault(paragraph, [result])
                     if heading == number and COMMAND_HEADING.match(lines[number - 1]):
                         headings[heading].append(result)
                 else:
