@@ -4,7 +4,8 @@
 1. commands: every `cellmap ...` and `cellmapd ...` in a code span or code block of README.md and docs/**/*.md
    names subcommands, flags and choices that the programs' --help lists (`cellmap <sub> --help` for each
    subcommand); a flag named on its own (`--role`) where a command is described (in a section headed by just
-   that command, or in a paragraph or list item that starts with it) must be one of that command's;
+   that command, or in a paragraph or list item that starts with it) must be one of that command's; and the
+   other way round, docs/cli.md has a section for every subcommand that names each of its options;
 2. config keys: every key the tables of docs/config.md list (the first column of a table whose header starts
    with "key") is one the readers read, and every key they read is listed. What the readers read comes from
    the readers (config_keys, tests/docs/config_keys.cpp, records the keys they read or ask about while they
@@ -116,6 +117,7 @@ class Command:
 
     def __init__(self, help_text):
         self.flags = set()
+        self.options = []  # each option's spellings, e.g. ('-o', '--output')
         self.subcommands = set()
         self.choices = []  # each positional's allowed values in order, None where --help lists none
         self.passes_through = False  # a positional takes the remaining words (for another program)
@@ -125,11 +127,13 @@ class Command:
             if heading:
                 section = heading.group(1).lower()
                 continue
-            entry = re.match(r'^\s+(\S.*?)(?:\s{2,}|$)', line)
+            entry = re.match(r'^ {1,4}(\S.*?)(?:\s{2,}|$)', line)  # deeper: a description's next line
             if not entry:
                 continue
             if section == 'options':
                 self.flags.update(re.findall(r'(?<![\w-])(--?[A-Za-z][\w-]*)', entry.group(1)))
+                spellings = re.sub(r'\{[^}]*\}', '', entry.group(1).split()[0])  # --no-robot{false}
+                self.options.append(tuple(spellings.split(',')))
             elif section == 'subcommands':
                 self.subcommands.add(entry.group(1).split()[0])
             elif section == 'positionals':
@@ -286,6 +290,49 @@ def check_commands(docs, programs):
                 else:
                     context = headings.get(heading, []) + paragraphs.get(paragraph, [])
                     findings += lone_flag_findings(where, part, context)
+    return findings
+
+
+def command_paths(programs):
+    """(program, subcommand path) of cellmapd, cellmap and every subcommand."""
+    paths = [('cellmapd', ())]
+    pending = [()]
+    while pending:
+        path = pending.pop()
+        paths.append(('cellmap', path))
+        pending += [path + (sub,) for sub in sorted(programs.command('cellmap', path).subcommands)]
+    return paths
+
+
+def check_cli_reference(doc_path, lines, programs):
+    """The other way round, for the command-line reference: every subcommand has a section (### `cellmap
+    echo`, or one of a parent or a child: `cellmap inject` holds add-box) and every option of a command is
+    named in that section."""
+    sections = {}  # (program, path) -> (heading line, the section's text)
+    numbers = heading_lines(lines) + [len(lines) + 1]
+    for start, end in zip(numbers, numbers[1:]):
+        if COMMAND_HEADING.match(lines[start - 1]):
+            words = SPAN.search(lines[start - 1]).group(1).split()
+            key = (words[0], tuple(words[1:]))
+            sections[key] = (start, '\n'.join(lines[start - 1:end - 1]))
+    findings = []
+    for program, path in command_paths(programs):
+        related = [key for key in sections if key[0] == program and (
+            key[1][:len(path)] == path or (path[:len(key[1])] == key[1] and key[1]))]
+        if not related:
+            findings.append(f'{doc_path}:1: `{" ".join([program, *path])}` has no section (### `{program} ...`)')
+            continue
+        own = (program, path) if (program, path) in sections else max(
+            (key for key in related if path[:len(key[1])] == key[1]), key=lambda key: len(key[1]), default=None)
+        if own is None:
+            continue  # documented by its subcommands' sections
+        number, text = sections[own]
+        for spellings in programs.command(program, path).options:
+            if '--help' in spellings:
+                continue
+            if not any(re.search(rf'(?<![\w-]){re.escape(flag)}(?![\w-])', text) for flag in spellings):
+                findings.append(f'{doc_path}:{number}: `{" ".join([program, *path])}` option {"/".join(spellings)} '
+                                f'is not described in this section')
     return findings
 
 
@@ -525,6 +572,15 @@ FAKE_CONFIG_MD = '''# Configuration files
 | `width`, `height` | 640 |
 '''
 
+FAKE_CLI_MD = '''# Command lines
+## `cellmapd`
+Runs the cell.
+## `cellmap`
+`--version` prints it.
+### `cellmap bench`
+Runs a benchmark.
+'''
+
 FAKE_READ = {'daemon': {'cell': 'x', 'source.openni2.width': 'x', 'source.openni2.height': 'x',
                         'source.openni2.fps': 'x'}, 'segment': {}, 'scene': {}}
 
@@ -544,8 +600,12 @@ def self_test():
                 "README.md:9: --nothing is named for `cellmap security init`; none of them has it"]
     expected += ['docs/config.md:7: daemon key stale is not read by the daemon reader',
                  'docs/config.md:12: daemon key source.openni2.fps (read in x) is not documented']
+    expected += ['docs/cli.md:2: `cellmapd` option --config is not described in this section',
+                 'docs/cli.md:1: `cellmap security` has no section (### `cellmap ...`)',
+                 'docs/cli.md:1: `cellmap security init` has no section (### `cellmap ...`)']
     found = check_commands(docs, programs) + check_keys(Path('docs/config.md'), FAKE_CONFIG_MD.splitlines(),
                                                         FAKE_READ)
+    found += check_cli_reference(Path('docs/cli.md'), FAKE_CLI_MD.splitlines(), programs)
     if found != expected:
         print('self-test: expected\n  ' + '\n  '.join(expected) + '\nfound\n  ' + '\n  '.join(found))
         return 1
@@ -569,6 +629,9 @@ def main():
     findings = check_commands(markdown_files(args.source_dir), programs)
     config_findings, read = check_shipped_configs(args.source_dir, args.config_keys, args.cellmapd)
     findings += config_findings
+    cli_md = Path('docs/cli.md')
+    findings += check_cli_reference(cli_md, (args.source_dir / cli_md).read_text(encoding='utf-8').splitlines(),
+                                    programs)
     config_md = Path('docs/config.md')
     findings += check_keys(config_md, (args.source_dir / config_md).read_text(encoding='utf-8').splitlines(),
                            read)
