@@ -1,7 +1,7 @@
-// config_keys: reads config files with cellmap's own readers, as cellmapd and `cellmap segment` read them, and
-// prints every key path each reader read or asked about (YamlKeyLog), one "<reader> <path>" line each, e.g.
-// "daemon source.openni2.uri". Exit 1 with the reader's message when a file is refused: the keys a reader
-// accepts and the check that a shipped file is accepted come from the same code the programs run.
+// config_keys: reads config files with cellmap's own readers, as cellmapd and `cellmap segment` read them,
+// and prints every key path each reader read or asked about (YamlKeyLog), one "<reader> <path>" line each,
+// e.g. "daemon source.openni2.uri". Exit 1 with the reader's message when a file is refused: the keys a
+// reader accepts and the check that a shipped file is accepted come from the same code the programs run.
 //
 //   config_keys daemon|scene|segment FILE...
 // A daemon config's simulated scene (sources[i].scene) is read too, as cellmapd would at start.

@@ -11,9 +11,13 @@ namespace {
 thread_local YamlKeyLog* active_key_log = nullptr;
 }  // namespace
 
-YamlKeyLog::YamlKeyLog() : outer_(active_key_log) { active_key_log = this; }
+YamlKeyLog::YamlKeyLog() : outer_(active_key_log) {
+  active_key_log = this;
+}
 
-YamlKeyLog::~YamlKeyLog() { active_key_log = outer_; }
+YamlKeyLog::~YamlKeyLog() {
+  active_key_log = outer_;
+}
 
 void YamlMap::mark_read(const std::string& key) {
   read_.insert(key);

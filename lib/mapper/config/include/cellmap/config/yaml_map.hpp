@@ -101,8 +101,8 @@ class YamlMap {
 };
 
 /// Records, while it lives, the full path of every key that any YamlMap of this thread reads or asks about
-/// (`has`), e.g. "source.openni2.intrinsics": the keys a reader accepts, taken from the reader itself, for the
-/// check that the documentation lists each of them. Nests: the innermost log records.
+/// (`has`), e.g. "source.openni2.intrinsics": the keys a reader accepts, taken from the reader itself, for
+/// the check that the documentation lists each of them. Nests: the innermost log records.
 class YamlKeyLog final {
  public:
   YamlKeyLog();
