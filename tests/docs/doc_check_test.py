@@ -351,6 +351,7 @@ def normalise(key):
 
 
 def reader_of_heading(title):
+    """Whose keys the tables under a `## ` heading list: the one whose file the heading names."""
     lowered = title.lower()
     for reader, marker in (('daemon', 'cellmapd.yaml'), ('segment', 'segment.yaml'), ('scene', 'scene')):
         if marker in lowered:
@@ -387,8 +388,9 @@ def documented_keys(lines, maps):
     paragraph = []
     in_table = False
     sections = []
+    headings = set(heading_lines(lines))
     for number, line in enumerate(lines, start=1):
-        heading = re.match(r'^(#+)\s+(.*)$', line)
+        heading = re.match(r'^(#+)\s+(.*)$', line) if number in headings else None
         if heading:
             if len(heading.group(1)) <= 2:
                 reader = reader_of_heading(heading.group(2))
