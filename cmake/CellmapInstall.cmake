@@ -95,10 +95,9 @@ install(FILES ${PROJECT_BINARY_DIR}/cellmapConfig.cmake ${PROJECT_BINARY_DIR}/ce
 
 # Programs, configuration and the service.
 install(TARGETS cellmap_cli cellmapd RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(FILES ${PROJECT_SOURCE_DIR}/config/cellmapd.yaml ${PROJECT_SOURCE_DIR}/config/cell.yaml
-              ${PROJECT_SOURCE_DIR}/config/segment.yaml ${PROJECT_SOURCE_DIR}/config/sensors.example.yaml
-        DESTINATION ${CELLMAP_INSTALL_CONFIGDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/scenes DESTINATION ${CELLMAP_INSTALL_CONFIGDIR})
+# Every shipped cell with what it names (scenes, robots and their meshes), laid out as in config/: paths in
+# these files are relative to the file, so each runs from the install as it does from the source tree.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CELLMAP_INSTALL_CONFIGDIR})
 # The unit in scripts/ names the /usr/local paths; the installed one names where this install put things
 # (decided at install time: `cmake --install --prefix` may differ from the configured prefix).
 install(CODE "set(CELLMAPD_UNIT_IN [[${PROJECT_SOURCE_DIR}/scripts/cellmapd.service]])

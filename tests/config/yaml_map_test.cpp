@@ -5,6 +5,8 @@
 #include "support/test_support.hpp"
 
 #include <functional>
+#include <set>
+#include <string>
 
 namespace cellmap {
 namespace {
@@ -19,6 +21,22 @@ TEST(YamlMapTest, ReadsValuesAndDefaults) {
   EXPECT_EQ(sub.integer("k", 0, 1, 100), 7);
   EXPECT_NO_THROW(sub.expect_all_read());
   EXPECT_NO_THROW(root.expect_all_read());
+}
+
+TEST(YamlMapTest, KeyLogRecordsEveryKeyReadOrAskedAboutWithItsPath) {
+  YamlMap root = YamlMap::parse("a: 2.5\nsub:\n  k: 7\n", "cfg.yaml");
+  (void)root.number("before", 1.0, 0.0, 10.0);  // read before the log: not recorded
+  const YamlKeyLog log;
+  (void)root.number("a", 1.0, 0.0, 10.0);
+  (void)root.get<std::string>("absent", "");
+  (void)root.has("optional");
+  (void)root.child("sub").integer("k", 0, 1, 100);
+  {
+    const YamlKeyLog inner;  // the innermost log records; the outer one sees nothing meanwhile
+    (void)root.has("inner_only");
+    EXPECT_EQ(inner.keys(), (std::set<std::string>{"inner_only"}));
+  }
+  EXPECT_EQ(log.keys(), (std::set<std::string>{"a", "absent", "optional", "sub", "sub.k"}));
 }
 
 TEST(YamlMapTest, UnknownKeyIsNamedWithItsPath) {

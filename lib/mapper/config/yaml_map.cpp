@@ -7,6 +7,22 @@
 #include "cellmap/common/text.hpp"
 
 namespace cellmap {
+namespace {
+thread_local YamlKeyLog* active_key_log = nullptr;
+}  // namespace
+
+YamlKeyLog::YamlKeyLog() : outer_(active_key_log) {
+  active_key_log = this;
+}
+
+YamlKeyLog::~YamlKeyLog() {
+  active_key_log = outer_;
+}
+
+void YamlMap::mark_read(const std::string& key) {
+  read_.insert(key);
+  if (active_key_log) active_key_log->keys_.insert(key_path(key));
+}
 
 YamlMap::YamlMap(YAML::Node node, std::string path, std::string source)
     : node_(std::move(node)), path_(std::move(path)), source_(std::move(source)) {
@@ -40,6 +56,7 @@ YamlMap YamlMap::load(const std::string& file) {
 }
 
 bool YamlMap::has(const std::string& key) const {
+  if (active_key_log) active_key_log->keys_.insert(key_path(key));
   return static_cast<bool>(node_[key]);
 }
 
@@ -103,12 +120,12 @@ Eigen::Isometry3d YamlMap::pose(const std::string& key) {
 }
 
 YamlMap YamlMap::child(const std::string& key) {
-  read_.insert(key);
+  mark_read(key);
   return YamlMap(node_[key], key_path(key), source_);
 }
 
 YAML::Node YamlMap::node(const std::string& key) {
-  read_.insert(key);
+  mark_read(key);
   return node_[key];
 }
 

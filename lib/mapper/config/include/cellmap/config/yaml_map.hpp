@@ -38,7 +38,7 @@ class YamlMap {
   template <typename T>
   [[nodiscard]] T get(const std::string& key, const T& fallback) {
     if (!has(key)) {
-      read_.insert(key);
+      mark_read(key);
       return fallback;
     }
     return require<T>(key);
@@ -47,7 +47,7 @@ class YamlMap {
   /// The value of `key` converted to T. @throws Error naming the key if absent or not convertible.
   template <typename T>
   [[nodiscard]] T require(const std::string& key) {
-    read_.insert(key);
+    mark_read(key);
     const YAML::Node value = node_[key];
     if (!value) fail(key, "is required");
     try {
@@ -95,10 +95,30 @@ class YamlMap {
   [[nodiscard]] const std::string& source() const { return source_; }
 
  private:
+  void mark_read(const std::string& key);
+
   YAML::Node node_;
   std::string path_;
   std::string source_;
   std::set<std::string> read_;
+};
+
+/// Records, while it lives, the full path of every key that any YamlMap of this thread reads or asks about
+/// (`has`), e.g. "source.openni2.intrinsics": the keys a reader accepts, taken from the reader itself, for
+/// the check that the documentation lists each of them. Nests: the innermost log records.
+class YamlKeyLog final {
+ public:
+  YamlKeyLog();
+  ~YamlKeyLog();
+  YamlKeyLog(const YamlKeyLog&) = delete;
+  YamlKeyLog& operator=(const YamlKeyLog&) = delete;
+
+  [[nodiscard]] const std::set<std::string>& keys() const { return keys_; }
+
+ private:
+  friend class YamlMap;
+  std::set<std::string> keys_;
+  YamlKeyLog* outer_;
 };
 
 }  // namespace cellmap
