@@ -30,9 +30,7 @@ std::filesystem::path write_config(const test::TempDir& dir, const std::string& 
 
 TEST(ConfigCheckTest, EveryShippedCellmapdConfigPasses) {
   // config/ also holds what is not a cellmapd config: the default scene and the points pipeline's keys.
-  // sensors.example.yaml is being rewritten for the schema cellmapd reads (issue 42); once it is, drop it
-  // from this list so that it is checked too.
-  const std::set<std::string> not_cellmapd{"cell.yaml", "segment.yaml", "sensors.example.yaml"};
+  const std::set<std::string> not_cellmapd{"cell.yaml", "segment.yaml"};
   const test::TempDir dir;
   int checked = 0;
   for (const auto& entry : std::filesystem::directory_iterator(CELLMAP_SOURCE_DIR "/config")) {
