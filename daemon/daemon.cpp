@@ -33,7 +33,7 @@ void log_dds_security(const dds::Participant& participant, int domain) {
   const auto left = credentials->expires - std::chrono::system_clock::now();
   if (left < std::chrono::hours(24 * 30)) {
     spdlog::warn(
-        "DDS Security: the credentials expire in {} days; issue new ones (docs/security.md, "Rotating")",
+        "DDS Security: the credentials expire in {} days; issue new ones (docs/security.md, Rotating)",
         std::chrono::duration_cast<std::chrono::hours>(left).count() / 24);
   }
 }
