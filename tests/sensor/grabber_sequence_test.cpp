@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSequence = fs::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
+const fs::path kSequence = test::shared_data_dir() / "pcl" / "grabber_sequence";
 
 // The three frames, by stem ("frame_20121214T142255.814212"), in time order.
 std::vector<std::string> frame_stems() {
