@@ -79,10 +79,17 @@ OpenNI2Config dummy_device() {
 }
 
 TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
-  OpenNI2Source source(dummy_device());
+  OpenNI2Config config = dummy_device();
+  // Streaming, not reconnecting (SilentDeviceTurnsDisconnectedAndIsReopened): a loaded machine's pause between
+  // two frames must not reopen the device, which would restart its stamps.
+  config.reconnect.frame_timeout = 60.0;
+  OpenNI2Source source(config);
+  const double before_open = realtime_seconds();
   ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
   std::vector<Frame> frames;
-  for (int i = 0; i < 50 && frames.size() < 3; ++i) {
+  // Three frames, however long a loaded machine takes: only a failing test waits out the minute.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (frames.size() < 3 && std::chrono::steady_clock::now() < deadline) {
     if (auto frame = source.next(milliseconds(200))) frames.push_back(std::move(*frame));
   }
   ASSERT_EQ(frames.size(), 3u) << source.status().reason;
@@ -122,7 +129,9 @@ TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
   // arrival times; how much it shrinks here depends on the delivery delays of a loaded machine).
   EXPECT_LE(frames[2].stamp - frames[1].stamp, 0.033 + 1e-6);
   EXPECT_GT(frames[2].stamp, frames[1].stamp);
-  EXPECT_NEAR(frames[0].stamp, realtime_seconds(), 5.0);
+  // On the host's realtime clock: the first frame after open() is stamped when it arrived.
+  EXPECT_GE(frames[0].stamp, before_open);
+  EXPECT_LE(frames[0].stamp, realtime_seconds());
   EXPECT_EQ(source.status().frames, 3u);
   source.close();
   EXPECT_EQ(source.status().state, SourceState::kClosed);
@@ -155,8 +164,10 @@ TEST(OpenNI2SourceTest, SilentDeviceTurnsDisconnectedAndIsReopened) {
   OpenNI2Source source(config);
   ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
   bool saw_disconnect = false;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (std::chrono::steady_clock::now() < until && (!saw_disconnect || source.status().frames < 2)) {
+  // Until it was disconnected and delivered twice, however long a loaded machine takes: only a failing test
+  // waits out the minute.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline && (!saw_disconnect || source.status().frames < 2)) {
     (void)source.next(milliseconds(5));
     if (source.status().state == SourceState::kDisconnected) {
       saw_disconnect = true;
