@@ -80,8 +80,8 @@ OpenNI2Config dummy_device() {
 
 TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
   OpenNI2Config config = dummy_device();
-  // Streaming, not reconnecting (SilentDeviceTurnsDisconnectedAndIsReopened): a loaded machine's pause between
-  // two frames must not reopen the device, which would restart its stamps.
+  // Streaming, not reconnecting (SilentDeviceTurnsDisconnectedAndIsReopened): a loaded machine's pause
+  // between two frames must not reopen the device, which would restart its stamps.
   config.reconnect.frame_timeout = 60.0;
   OpenNI2Source source(config);
   const double before_open = realtime_seconds();

@@ -116,9 +116,9 @@ TEST(ReplaySourceTest, PlaysDepthImagesAndCloudsInOrder) {
   EXPECT_EQ(source.status().frames, 3u);
 }
 
-// Frame i is due i / rate_hz after the source opened, and next() hands it out then: not before (a shorter wait
-// returns nothing after waiting its time), not later. On a clock the test drives, so a slow read or a loaded
-// machine cannot make a frame look early or late.
+// Frame i is due i / rate_hz after the source opened, and next() hands it out then: not before (a shorter
+// wait returns nothing after waiting its time), not later. On a clock the test drives, so a slow read or a
+// loaded machine cannot make a frame look early or late.
 TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
   Recording recording;
   ReplayConfig config;

@@ -69,7 +69,8 @@ void Reconnector::retry_or_wait(std::chrono::milliseconds timeout,
   }
   const double wait = std::min(next_attempt_ - now, static_cast<double>(timeout.count()) * 1e-3);
   // Rounded up: a sleep that ends a nanosecond before the attempt is due would cost the caller a second call.
-  clock_->sleep_for(std::chrono::ceil<SteadyClock::duration>(std::chrono::duration<double>(std::max(wait, 0.0))));
+  clock_->sleep_for(
+      std::chrono::ceil<SteadyClock::duration>(std::chrono::duration<double>(std::max(wait, 0.0))));
 }
 
 }  // namespace cellmap

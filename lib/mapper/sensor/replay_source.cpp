@@ -114,8 +114,7 @@ class ReplaySource::Reader final {
   // @throws Error as the read did.
   std::optional<Frame> take(std::size_t index, std::chrono::milliseconds patience) {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (!changed_.wait_for(lock, patience, [&] { return asked_ == index && outcome_; }))
-      return std::nullopt;
+    if (!changed_.wait_for(lock, patience, [&] { return asked_ == index && outcome_; })) return std::nullopt;
     Outcome outcome = std::move(*outcome_);
     outcome_.reset();
     asked_ = kNone;
@@ -176,7 +175,8 @@ class ReplaySource::Reader final {
   std::thread thread_;  // last: started once the rest is set up
 };
 
-ReplaySource::ReplaySource(ReplayConfig config, SteadyClock& clock) : config_(std::move(config)), clock_(clock) {
+ReplaySource::ReplaySource(ReplayConfig config, SteadyClock& clock)
+    : config_(std::move(config)), clock_(clock) {
   if (!(config_.speed > 0) || !std::isfinite(config_.speed)) throw Error("replay: speed must be > 0");
   if (!(config_.rate_hz > 0) || !std::isfinite(config_.rate_hz)) throw Error("replay: rate_hz must be > 0");
 }

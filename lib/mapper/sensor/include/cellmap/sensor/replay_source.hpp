@@ -85,8 +85,8 @@ struct ReplayConfig final {
 /// the recording's cost, not the frame's; a camera delivers pixels); a frame whose file is still being
 /// read when it is due comes late, and a file that cannot be read turns kError when its frame is due.
 /// Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly
-/// as recorded. When a frame is due is read on `clock`, and next() sleeps on it; the read of a frame's file is
-/// real work, so next() waits for it up to `timeout` of real time after the frame is due. Not thread-safe
+/// as recorded. When a frame is due is read on `clock`, and next() sleeps on it; the read of a frame's file
+/// is real work, so next() waits for it up to `timeout` of real time after the frame is due. Not thread-safe
 /// (one thread calls it; the reader thread is internal).
 class ReplaySource final : public DepthSource {
  public:
@@ -127,7 +127,7 @@ class ReplaySource final : public DepthSource {
   std::vector<ReplayEntry> entries_;
   std::size_t next_index_ = 0;
   std::unique_ptr<Reader> reader_;  // while open; reads frame next_index_ before it is due
-  SteadyClock::time_point start_;  // on clock_
+  SteadyClock::time_point start_;   // on clock_
 };
 
 }  // namespace cellmap
