@@ -85,9 +85,9 @@ struct ReplayConfig final {
 /// the recording's cost, not the frame's; a camera delivers pixels); a frame whose file is still being
 /// read when it is due comes late, and a file that cannot be read turns kError when its frame is due.
 /// Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly
-/// as recorded. When a frame is due is read on `clock`, and next() sleeps on it; the read of a frame's file
-/// is real work, so next() waits for it up to `timeout` of real time after the frame is due. Not thread-safe
-/// (one thread calls it; the reader thread is internal).
+/// as recorded. Frames fall due on the source's clock, and next() sleeps on that clock; reading a frame's
+/// file is real work, so next() then waits for the read up to `timeout` of real time. Not thread-safe (one
+/// thread calls it; the reader thread is internal).
 class ReplaySource final : public DepthSource {
  public:
   /// `clock` (which must outlive the source) times the playback; a test passes one it drives.
