@@ -86,7 +86,7 @@ void BM_FusionOctomap(benchmark::State& state, const std::string& set, bool disc
 // Each real frame is a sweep of its own.
 std::vector<Sweep> grabber_frames() {
   std::vector<Sweep> sweeps;
-  for (cellmap::Scan& scan : cellmap::testing::grabber_scans()) {
+  for (cellmap::Scan& scan : cellmap::testing::grabber_scans(CELLMAP_SHARED_DATA)) {
     sweeps.emplace_back();
     sweeps.back().scans.push_back(std::move(scan));
   }

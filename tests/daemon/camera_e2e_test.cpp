@@ -62,7 +62,7 @@ class CameraE2eTest : public ::testing::Test {
 };
 
 TEST_F(CameraE2eTest, ReplayOfTheGrabberFramesProducesAnEnvironmentHoldingTheirPoints) {
-  const fs::path data = fs::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
+  const fs::path data = test::shared_data_dir() / "pcl" / "grabber_sequence";
   CELLMAP_SKIP_WITHOUT_DATA(data);
   std::vector<fs::path> frames;
   for (const auto& entry : fs::directory_iterator(data)) {

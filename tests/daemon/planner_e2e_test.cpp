@@ -117,9 +117,9 @@ TEST(PlannerCommandLineTest, BadPathIsRefusedWithOneLine) {
   // stderr through the pipe: the reason is the only output.
   test::ChildProcess planner(
       {"/bin/sh", "-c", "exec \"$0\" \"$@\" 2>&1", CELLMAP_PLANNER, "--control-points", "1,2;3,4,5"});
-  EXPECT_EQ(planner.read_line(10s).value_or(""),
+  EXPECT_EQ(planner.read_line(test::kDaemonPatience).value_or(""),
             "cellmap_example_planner: --control-points: '1,2' is not x,y,z");
-  EXPECT_EQ(planner.read_line(10s), std::nullopt);
+  EXPECT_EQ(planner.read_line(test::kDaemonPatience), std::nullopt);  // the end of its output
   const int status = planner.wait();
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 1);

@@ -12,8 +12,8 @@ namespace cellmap {
 namespace {
 
 TEST(GrabberAgreementTest, SameOccupancyAsOctomapInsertPointCloud) {
-  CELLMAP_SKIP_WITHOUT_DATA(std::string(CELLMAP_SHARED_DATA) + "/pcl/grabber_sequence");
-  const std::vector<Scan> scans = testing::grabber_scans();
+  CELLMAP_SKIP_WITHOUT_DATA(test::shared_data_dir() / "pcl" / "grabber_sequence");
+  const std::vector<Scan> scans = testing::grabber_scans(test::shared_data_dir());
   ASSERT_EQ(scans.size(), 3u);
 
   const OccupancyConfig config;

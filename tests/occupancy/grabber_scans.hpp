@@ -13,10 +13,10 @@
 
 namespace cellmap::testing {
 
-/// The grabber PCD frames, or none when the shared data folder is absent.
+/// The grabber PCD frames of the shared data folder `shared_data`, or none when they are absent.
 /// @throws Error if a frame is present but unreadable.
-inline std::vector<Scan> grabber_scans() {
-  const std::filesystem::path dir = std::filesystem::path(CELLMAP_SHARED_DATA) / "pcl" / "grabber_sequence";
+inline std::vector<Scan> grabber_scans(const std::filesystem::path& shared_data) {
+  const std::filesystem::path dir = shared_data / "pcl" / "grabber_sequence";
   std::vector<std::filesystem::path> files;
   if (std::filesystem::is_directory(dir)) {
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Every idl/ros2/<pkg>/msg/<Type>.idl against ROS 2's <pkg>/msg/<Type>.msg (CELLMAP_SHARED_DATA/ros2): the
+"""Every idl/ros2/<pkg>/msg/<Type>.idl against ROS 2's <pkg>/msg/<Type>.msg (<shared data>/ros2): the
 struct's name, each field's name, type, order, array size and bounds, and each constant's name, type and
 value, by the mapping of idl/ros2/ros2_idl.py. Prints one line per disagreement, naming the file and the
-field; exits 1 if there is any. Exits 77 (skipped) when the shared data is absent, or 1 under
-CELLMAP_REQUIRE_DATA=1 (as tests/support/shared_data.hpp).
+field; exits 1 if there is any. The shared data folder is the environment's CELLMAP_SHARED_DATA if set, else
+--shared-data (the build's). Exits 77 (skipped) when it is absent, or 1 under CELLMAP_REQUIRE_DATA=1, saying so
+in the words of tests/support/shared_data.hpp (scripts/test counts the skips by them).
 
 --self-test instead shows that the check catches drift: a made-up .msg, its IDL, and that IDL drifted one way
 at a time (order, type, size, bound, constant, ...), each of which must be reported.
@@ -17,6 +18,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'idl' / 'ros2'))
 from ros2_idl import parse_idl, parse_msg  # noqa: E402
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE for this test
+SHARED_DATA_MISSING = 'shared test data missing (CELLMAP_SHARED_DATA)'  # as kSharedDataMissing
 
 
 def _compare(kind, ours, theirs, describe):
@@ -80,7 +82,7 @@ def check(idl_root, msg_root):
         if os.environ.get('CELLMAP_REQUIRE_DATA') == '1':
             print(f'{msg_root} is absent and CELLMAP_REQUIRE_DATA=1 requires the shared data')
             return 1
-        print(f'{msg_root} is absent (shared test data): skipping')
+        print(f'{SHARED_DATA_MISSING}: "{msg_root}" is absent')
         return SKIPPED
     idl_files = sorted(idl_root.rglob('*.idl'))
     problems = [f'{idl_root}: no IDL files'] if not idl_files else []
@@ -181,14 +183,16 @@ def self_test():
 def main():
     arguments = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     arguments.add_argument('--idl-root', type=Path, help='idl/ros2')
-    arguments.add_argument('--msg-root', type=Path, help='the shared data\'s ros2 folder')
+    arguments.add_argument('--shared-data', type=Path,
+                           help='the shared data folder, unless the environment\'s CELLMAP_SHARED_DATA names one')
     arguments.add_argument('--self-test', action='store_true', help='check that drift is caught')
     options = arguments.parse_args()
     if options.self_test:
         return self_test()
-    if not options.idl_root or not options.msg_root:
-        arguments.error('--idl-root and --msg-root are needed')
-    return check(options.idl_root, options.msg_root)
+    shared_data = os.environ.get('CELLMAP_SHARED_DATA') or options.shared_data
+    if not options.idl_root or not shared_data:
+        arguments.error('--idl-root and --shared-data (or CELLMAP_SHARED_DATA) are needed')
+    return check(options.idl_root, Path(shared_data) / 'ros2')
 
 
 if __name__ == '__main__':

@@ -14,7 +14,7 @@
 namespace cellmap {
 namespace {
 
-const std::string kDir = std::string(CELLMAP_SHARED_DATA) + "/mosd";
+const std::string kDir = (test::shared_data_dir() / "mosd").string();
 
 #define SKIP_WITHOUT_DATA() CELLMAP_SKIP_WITHOUT_DATA(kDir + "/learn0.pcd")
 

@@ -16,13 +16,14 @@
 #include "cellmap/sim/scene.hpp"
 #include "cellmap/sim/simulator.hpp"
 #include "cellmap/urdf/urdf_model.hpp"
+#include "support/shared_data.hpp"
 
 namespace cellmap {
 namespace {
 
 const std::string kArmScene = std::string(CELLMAP_SOURCE_DIR) + "/config/scenes/arm_cell.yaml";
 const std::filesystem::path kIrb2400 =
-    std::filesystem::path(CELLMAP_SHARED_DATA) / "robots" / "abb_irb2400_support" / "urdf" / "irb2400.urdf";
+    test::shared_data_dir() / "robots" / "abb_irb2400_support" / "urdf" / "irb2400.urdf";
 
 struct Box {
   Eigen::Vector3d centre;
@@ -338,7 +339,7 @@ TEST(SelfFilterTest, TheWristCameraKeepsTheTable) {
 }
 
 TEST(SelfFilterTest, TheAbbIrb2400MeshesRemoveThemselves) {
-  if (!std::filesystem::exists(kIrb2400)) GTEST_SKIP() << kIrb2400 << " not found";
+  CELLMAP_SKIP_WITHOUT_DATA(kIrb2400);
   sim::Scene scene = sim::load_scene(kArmScene);
   Eigen::Isometry3d X_C_base = Eigen::Isometry3d::Identity();
   X_C_base.translation() = Eigen::Vector3d(1.5, -0.45, 0.5);

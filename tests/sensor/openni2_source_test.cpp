@@ -79,10 +79,17 @@ OpenNI2Config dummy_device() {
 }
 
 TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
-  OpenNI2Source source(dummy_device());
+  OpenNI2Config config = dummy_device();
+  // Streaming, not reconnecting (SilentDeviceTurnsDisconnectedAndIsReopened): a loaded machine's pause
+  // between two frames must not reopen the device, which would restart its stamps.
+  config.reconnect.frame_timeout = 60.0;
+  OpenNI2Source source(config);
+  const double before_open = realtime_seconds();
   ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
   std::vector<Frame> frames;
-  for (int i = 0; i < 50 && frames.size() < 3; ++i) {
+  // Three frames, however long a loaded machine takes: only a failing test waits out the minute.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (frames.size() < 3 && std::chrono::steady_clock::now() < deadline) {
     if (auto frame = source.next(milliseconds(200))) frames.push_back(std::move(*frame));
   }
   ASSERT_EQ(frames.size(), 3u) << source.status().reason;
@@ -122,7 +129,9 @@ TEST(OpenNI2SourceTest, StreamsFromARealOpenNI2Driver) {
   // arrival times; how much it shrinks here depends on the delivery delays of a loaded machine).
   EXPECT_LE(frames[2].stamp - frames[1].stamp, 0.033 + 1e-6);
   EXPECT_GT(frames[2].stamp, frames[1].stamp);
-  EXPECT_NEAR(frames[0].stamp, realtime_seconds(), 5.0);
+  // On the host's realtime clock: the first frame after open() is stamped when it arrived.
+  EXPECT_GE(frames[0].stamp, before_open);
+  EXPECT_LE(frames[0].stamp, realtime_seconds());
   EXPECT_EQ(source.status().frames, 3u);
   source.close();
   EXPECT_EQ(source.status().state, SourceState::kClosed);
@@ -154,18 +163,27 @@ TEST(OpenNI2SourceTest, SilentDeviceTurnsDisconnectedAndIsReopened) {
   config.reconnect.max_backoff = 0.010;
   OpenNI2Source source(config);
   ASSERT_EQ(source.open().state, SourceState::kConnected) << source.status().reason;
+  // Until it was disconnected, reopened and delivered again, however long a loaded machine takes: only a
+  // failing test waits out the minute. (Frames before the first disconnect do not count: a loaded machine may
+  // read two before the first gap.)
   bool saw_disconnect = false;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (std::chrono::steady_clock::now() < until && (!saw_disconnect || source.status().frames < 2)) {
+  std::uint64_t frames_before_disconnect = 0;
+  const auto reopened_and_streaming = [&] {
+    return saw_disconnect && source.status().attempts >= 2 &&
+           source.status().frames > frames_before_disconnect;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline && !reopened_and_streaming()) {
     (void)source.next(milliseconds(5));
     if (source.status().state == SourceState::kDisconnected) {
+      if (!saw_disconnect) frames_before_disconnect = source.status().frames;
       saw_disconnect = true;
       EXPECT_EQ(source.status().reason, "no frames for 0.01 s");
     }
   }
   EXPECT_TRUE(saw_disconnect);
   EXPECT_GE(source.status().attempts, 2u);
-  EXPECT_GE(source.status().frames, 2u);
+  EXPECT_GT(source.status().frames, frames_before_disconnect) << "no frame after the reopen";
 }
 
 TEST(OpenNI2SourceTest, ModeTheDeviceDoesNotOfferIsAnErrorListingWhatItOffers) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cellmap/common/error.hpp"
+#include "support/manual_clock.hpp"
 
 namespace cellmap {
 namespace {
@@ -74,27 +75,31 @@ TEST(ReconnectorTest, ErrorIsFinalUntilClosed) {
 }
 
 TEST(ReconnectorTest, RetryOrWaitSleepsUntilTheAttemptIsDueThenConnects) {
-  // Times with room for a stalled, shared CI machine: the attempt is due 1 s after the loss, the waits are
-  // 20 ms (too short) and 5 s (cut at the attempt).
+  // On a clock the test drives: the attempt is due 1 s after the loss; a 20 ms wait is too short, a 5 s wait
+  // is cut at the attempt.
   ReconnectParams p = policy();
   p.initial_backoff = 1.0;
-  Reconnector r(p);
-  r.lost(steady_seconds(), "unplugged");
+  test::ManualClock clock;
+  const auto seconds = [&] { return std::chrono::duration<double>(clock.now().time_since_epoch()).count(); };
+  Reconnector r(p, clock);
+  const double lost_at = seconds();
+  r.lost(lost_at, "unplugged");
   int attempts = 0;
   const auto connect = [&](double now) {
     ++attempts;
+    EXPECT_DOUBLE_EQ(now, seconds());
     EXPECT_GE(now, r.next_attempt());
     r.lost(now, "still unplugged");
   };
-  const double start = steady_seconds();
   r.retry_or_wait(std::chrono::milliseconds(20), connect);  // not due: waits out the 20 ms, no attempt
   EXPECT_EQ(attempts, 0);
-  EXPECT_GE(steady_seconds() - start, 0.019);
-  while (attempts == 0 && steady_seconds() - start < 20.0)
-    r.retry_or_wait(std::chrono::milliseconds(5000), connect);
+  EXPECT_NEAR(seconds() - lost_at, 0.020, 1e-6);
+  r.retry_or_wait(std::chrono::milliseconds(5000), connect);  // sleeps until the attempt is due, not 5 s
+  EXPECT_EQ(attempts, 0);
+  EXPECT_NEAR(seconds() - lost_at, 1.0, 1e-6);
+  r.retry_or_wait(std::chrono::milliseconds(5000), connect);  // due: tries at once
   EXPECT_EQ(attempts, 1);
-  // The wait was cut at the attempt time (1 s), not the 5 s timeout.
-  EXPECT_LT(steady_seconds() - start, 4.0);
+  EXPECT_NEAR(seconds() - lost_at, 1.0, 1e-6);
   EXPECT_DOUBLE_EQ(r.backoff(), 4.0);  // 1 → 2 after the first loss, 4 (the cap) after the failed retry
 }
 

@@ -14,18 +14,27 @@
 #include "cellmap/common/error.hpp"
 #include "cellmap/sensor/depth_io.hpp"
 #include "sensor/sensor_test_util.hpp"
+#include "support/manual_clock.hpp"
 
 namespace cellmap {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace std::chrono_literals;
 
+using test::ManualClock;
 using test::ramp;
 using test::TempDir;
 
-// How long a test waits for a frame that is due: the reader thread reads it, which a loaded machine (or a
-// sanitizer) can make slow. Only a failing test waits that long.
-constexpr std::chrono::milliseconds kReadWait{5000};
+// How long a test waits for a frame that is due: the reader thread reads it at the lowest CPU priority, which
+// a loaded machine (or a sanitizer) can make slow. Only a failing test waits that long. The tests of when
+// frames are due play on a ManualClock, which stands still while they wait for a read.
+constexpr std::chrono::milliseconds kReadWait{60000};
+
+// Seconds from `start` to now on `clock`.
+double seconds_since(const ManualClock& clock, SteadyClock::time_point start) {
+  return std::chrono::duration<double>(clock.now() - start).count();
+}
 
 // A replay directory: two PNG depth frames with intrinsics.yaml and one PCD frame.
 struct Recording {
@@ -107,21 +116,29 @@ TEST(ReplaySourceTest, PlaysDepthImagesAndCloudsInOrder) {
   EXPECT_EQ(source.status().frames, 3u);
 }
 
+// Frame i is due i / rate_hz after the source opened, and next() hands it out then: not before (a shorter
+// wait returns nothing after waiting its time), not later. On a clock the test drives, so a slow read or a
+// loaded machine cannot make a frame look early or late.
 TEST(ReplaySourceTest, FixedRateSpacesTheFrames) {
   Recording recording;
   ReplayConfig config;
   config.directory = recording.dir.path().string();
   config.playback = ReplayConfig::Playback::kFixed;
   config.rate_hz = 20.0;  // 50 ms apart
-  ReplaySource source(config);
-  // The replay's clock starts when it opens, so the elapsed time counts from before that.
-  const auto start = std::chrono::steady_clock::now();
+  ManualClock clock;
+  ReplaySource source(config, clock);
+  const SteadyClock::time_point start = clock.now();
   ASSERT_EQ(source.open().state, SourceState::kConnected);
-  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
-  // The second frame is due 50 ms after the start: a 1 ms wait returns nothing.
-  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());
-  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
-  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(50));
+  ASSERT_TRUE(source.next(kReadWait).has_value());
+  EXPECT_EQ(seconds_since(clock, start), 0.0) << "frame 0 is due when the source opens";
+  EXPECT_FALSE(source.next(1ms).has_value()) << "frame 1 is not due for 50 ms";
+  EXPECT_NEAR(seconds_since(clock, start), 0.001, 1e-9) << "a wait that ends before the frame is due";
+  ASSERT_TRUE(source.next(kReadWait).has_value());
+  EXPECT_NEAR(seconds_since(clock, start), 0.050, 1e-9);
+  ASSERT_TRUE(source.next(kReadWait).has_value());
+  EXPECT_NEAR(seconds_since(clock, start), 0.100, 1e-9);
+  EXPECT_FALSE(source.next(kReadWait).has_value());
+  EXPECT_EQ(source.status().state, SourceState::kEnded);
 }
 
 // The next frame's file is read while the source waits for its time, so a frame is not late by its
@@ -132,17 +149,21 @@ TEST(ReplaySourceTest, ReadsTheNextFrameAheadOfItsTime) {
   config.directory = recording.dir.path().string();
   config.playback = ReplayConfig::Playback::kFixed;
   config.rate_hz = 1.0;
-  ReplaySource source(config);
+  ManualClock clock;  // stands still while the test waits for the read: frame 1 stays a second ahead
+  ReplaySource source(config, clock);
+  const SteadyClock::time_point start = clock.now();
   ASSERT_EQ(source.open().state, SourceState::kConnected);
-  ASSERT_TRUE(source.next(std::chrono::milliseconds(200)).has_value());
-  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());  // frame 1 is due in a second
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(900);
+  ASSERT_TRUE(source.next(kReadWait).has_value());
+  EXPECT_FALSE(source.next(1ms).has_value());  // frame 1 is due in a second
+  const auto give_up = std::chrono::steady_clock::now() + kReadWait;
   while (!source.next_frame_read() && std::chrono::steady_clock::now() < give_up)
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  ASSERT_TRUE(source.next_frame_read()) << "frame 1 was not read within 0.9 s of frame 0";
+    std::this_thread::sleep_for(1ms);
+  ASSERT_TRUE(source.next_frame_read()) << "frame 1 was not read ahead";
+  EXPECT_LT(seconds_since(clock, start), 1.0) << "read ahead means before it is due";
   fs::remove(recording.dir.path() / "f1.png");
   const std::optional<Frame> f1 = source.next(kReadWait);
   ASSERT_TRUE(f1.has_value()) << source.status().reason;
+  EXPECT_NEAR(seconds_since(clock, start), 1.0, 1e-9);
   EXPECT_DOUBLE_EQ(f1->stamp, 100.05);
   EXPECT_EQ(f1->points_S.size(), 6u * 4u - 4u);
   EXPECT_EQ(source.status().state, SourceState::kConnected);
@@ -154,15 +175,16 @@ TEST(ReplaySourceTest, AGivenStartIsWhenTheFirstFrameIsDue) {
   Recording recording;
   ReplayConfig config;
   config.directory = recording.dir.path().string();
-  const auto start = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  ManualClock clock;
+  const SteadyClock::time_point start = clock.now() + 300ms;
   config.start = start;
-  ReplaySource source(config);
+  ReplaySource source(config, clock);
   ASSERT_EQ(source.open().state, SourceState::kConnected);
-  EXPECT_FALSE(source.next(std::chrono::milliseconds(1)).has_value());  // not yet due
+  EXPECT_FALSE(source.next(1ms).has_value()) << "not due for 300 ms";
   ASSERT_TRUE(source.next(kReadWait).has_value());
-  EXPECT_GE(std::chrono::steady_clock::now(), start);
+  EXPECT_EQ(seconds_since(clock, start), 0.0);
   ASSERT_TRUE(source.next(kReadWait).has_value());
-  EXPECT_GE(std::chrono::steady_clock::now(), start + std::chrono::milliseconds(50));
+  EXPECT_NEAR(seconds_since(clock, start), 0.050, 1e-6);  // the recorded interval (stamps 100 and 100.05)
 }
 
 TEST(ReplaySourceTest, BrokenRecordingsAreErrorsNamingTheProblem) {

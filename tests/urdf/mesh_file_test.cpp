@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kAbbPackage = fs::path(CELLMAP_SHARED_DATA) / "robots" / "abb_irb2400_support";
+const fs::path kAbbPackage = test::shared_data_dir() / "robots" / "abb_irb2400_support";
 
 // What a binary STL holds, read here byte by byte (not through assimp): triangles, distinct vertices, bounds.
 struct StlFacts {

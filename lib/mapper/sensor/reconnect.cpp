@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <sstream>
-#include <thread>
 
 #include "cellmap/common/error.hpp"
 
@@ -15,7 +14,8 @@ void ReconnectParams::validate() const {
   if (!(factor >= 1.0)) throw Error("reconnect: factor must be >= 1");
 }
 
-Reconnector::Reconnector(const ReconnectParams& policy) : policy_(policy), backoff_(policy.initial_backoff) {
+Reconnector::Reconnector(const ReconnectParams& policy, SteadyClock& clock)
+    : policy_(policy), clock_(&clock), backoff_(policy.initial_backoff) {
   policy_.validate();
 }
 
@@ -62,13 +62,15 @@ bool Reconnector::retry_due(double now) const {
 
 void Reconnector::retry_or_wait(std::chrono::milliseconds timeout,
                                 const std::function<void(double now)>& connect) {
-  const double now = steady_seconds();
+  const double now = std::chrono::duration<double>(clock_->now().time_since_epoch()).count();
   if (retry_due(now)) {
     connect(now);
     return;
   }
   const double wait = std::min(next_attempt_ - now, static_cast<double>(timeout.count()) * 1e-3);
-  std::this_thread::sleep_for(std::chrono::duration<double>(std::max(wait, 0.0)));
+  // Rounded up: a sleep that ends a nanosecond before the attempt is due would cost the caller a second call.
+  clock_->sleep_for(
+      std::chrono::ceil<SteadyClock::duration>(std::chrono::duration<double>(std::max(wait, 0.0))));
 }
 
 }  // namespace cellmap

@@ -86,7 +86,6 @@ void write_replay_poses(const std::string& path, const std::vector<ReplayEntry>&
 // Reads one asked-for frame at a time on a thread of its own, at the lowest CPU priority.
 class ReplaySource::Reader final {
  public:
-  using Clock = std::chrono::steady_clock;
   explicit Reader(const ReplaySource& source) : source_(source), thread_([this] { run(); }) {}
   ~Reader() {
     {
@@ -110,12 +109,12 @@ class ReplaySource::Reader final {
     }
     changed_.notify_all();
   }
-  // Frame `index` (asked for) once read, waiting for the read until `deadline`; nullopt if it is not read by
-  // then. Credits the calling thread with the read's CPU time. @throws Error as the read did.
-  std::optional<Frame> take(std::size_t index, Clock::time_point deadline) {
+  // Frame `index` (asked for) once read, waiting up to `patience` (real time: the read is real work) for the
+  // read; nullopt if it is not read by then. Credits the calling thread with the read's CPU time.
+  // @throws Error as the read did.
+  std::optional<Frame> take(std::size_t index, std::chrono::milliseconds patience) {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (!changed_.wait_until(lock, deadline, [&] { return asked_ == index && outcome_; }))
-      return std::nullopt;
+    if (!changed_.wait_for(lock, patience, [&] { return asked_ == index && outcome_; })) return std::nullopt;
     Outcome outcome = std::move(*outcome_);
     outcome_.reset();
     asked_ = kNone;
@@ -176,7 +175,8 @@ class ReplaySource::Reader final {
   std::thread thread_;  // last: started once the rest is set up
 };
 
-ReplaySource::ReplaySource(ReplayConfig config) : config_(std::move(config)) {
+ReplaySource::ReplaySource(ReplayConfig config, SteadyClock& clock)
+    : config_(std::move(config)), clock_(clock) {
   if (!(config_.speed > 0) || !std::isfinite(config_.speed)) throw Error("replay: speed must be > 0");
   if (!(config_.rate_hz > 0) || !std::isfinite(config_.rate_hz)) throw Error("replay: rate_hz must be > 0");
 }
@@ -214,7 +214,7 @@ SourceStatus ReplaySource::open() {
   }
   status_.state = entries_.empty() ? SourceState::kEnded : SourceState::kConnected;
   status_.reason = entries_.empty() ? config_.directory + ": poses.csv lists no frames" : "";
-  start_ = config_.start.value_or(std::chrono::steady_clock::now());
+  start_ = config_.start.value_or(clock_.now());
   if (!entries_.empty()) {
     reader_ = std::make_unique<Reader>(*this);
     reader_->ask(0);
@@ -295,23 +295,23 @@ std::optional<Frame> ReplaySource::next(std::chrono::milliseconds timeout) {
     return std::nullopt;
   }
   reader_->ask(next_index_);
-  using Clock = std::chrono::steady_clock;
-  Clock::time_point due = Clock::now();
+  using Duration = SteadyClock::duration;
+  SteadyClock::time_point due = clock_.now();
   if (config_.playback == ReplayConfig::Playback::kRecorded) {
-    due = start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+    due = start_ + std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
                        (entries_[next_index_].stamp - entries_.front().stamp) / config_.speed));
   } else if (config_.playback == ReplayConfig::Playback::kFixed) {
-    due = start_ + std::chrono::duration_cast<Clock::duration>(
+    due = start_ + std::chrono::duration_cast<Duration>(
                        std::chrono::duration<double>(static_cast<double>(next_index_) / config_.rate_hz));
   }
-  if (due > Clock::now() + timeout) {
-    std::this_thread::sleep_for(timeout);
+  if (due > clock_.now() + timeout) {
+    clock_.sleep_for(timeout);
     return std::nullopt;
   }
-  std::this_thread::sleep_until(due);
+  clock_.sleep_until(due);
   std::optional<Frame> frame;
   try {
-    frame = reader_->take(next_index_, std::max(due, Clock::now()) + timeout);
+    frame = reader_->take(next_index_, timeout);
     if (!frame) return std::nullopt;  // still being read: late
     if (next_index_ + 1 < entries_.size()) reader_->ask(next_index_ + 1);
     to_points(*frame);

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "cellmap/common/steady_clock.hpp"
 #include "cellmap/sensor/depth_source.hpp"
 
 namespace cellmap {
@@ -21,8 +22,9 @@ struct ReconnectParams final {
   void validate() const;
 };
 
-/// Connection state machine of one source. Times are seconds on any monotonic clock, given by the caller, so
-/// the logic is tested without sleeping. Transitions:
+/// Connection state machine of one source. Times are seconds on the source's steady clock (seconds since its
+/// epoch), given by the caller, so the logic is tested without sleeping; only retry_or_wait() reads the clock
+/// and sleeps on it. Transitions:
 ///   closed/disconnected --connected()--> connected --frame()--> connected (back-off reset to initial)
 ///   connected --lost() or check() after frame_timeout without frames--> disconnected (retry at now +
 ///   back-off) any --failed()--> error (no retries) ; any --closed()--> closed
@@ -30,8 +32,9 @@ struct ReconnectParams final {
 /// Not thread-safe.
 class Reconnector final {
  public:
+  /// `clock` (which must outlive the reconnector) is what retry_or_wait() reads and sleeps on.
   /// @throws Error if the policy is invalid.
-  explicit Reconnector(const ReconnectParams& policy = {});
+  explicit Reconnector(const ReconnectParams& policy = {}, SteadyClock& clock = SteadyClock::real());
 
   /// An open succeeded at `now`; the frame timeout starts counting.
   void connected(double now);
@@ -50,8 +53,8 @@ class Reconnector final {
   /// True when disconnected and the next attempt is due at `now`.
   [[nodiscard]] bool retry_due(double now) const;
   /// What a source's next() does while disconnected: calls `connect(now)` (which reports connected() or
-  /// lost()) if the attempt is due on the steady clock (steady_seconds()), else sleeps until it is due or
-  /// `timeout` passed, whichever comes first, so callers never spin.
+  /// lost()) if the attempt is due now on the clock (for the real one: steady_seconds()), else sleeps on it
+  /// until the attempt is due or `timeout` passed, whichever comes first, so callers never spin.
   void retry_or_wait(std::chrono::milliseconds timeout, const std::function<void(double now)>& connect);
 
   [[nodiscard]] SourceState state() const { return state_; }
@@ -64,6 +67,7 @@ class Reconnector final {
 
  private:
   ReconnectParams policy_;
+  SteadyClock* clock_;  // never null
   SourceState state_ = SourceState::kClosed;
   std::string reason_;
   double last_frame_ = 0.0;

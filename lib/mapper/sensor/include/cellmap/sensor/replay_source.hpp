@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "cellmap/common/steady_clock.hpp"
 #include "cellmap/frame/pose_buffer.hpp"
 #include "cellmap/sensor/depth_source.hpp"
 
@@ -70,10 +71,10 @@ struct ReplayConfig final {
   Playback playback = Playback::kRecorded;
   double speed = 1.0;     ///< kRecorded: 2 plays twice as fast
   double rate_hz = 10.0;  ///< kFixed
-  /// When the first frame is due (kRecorded, kFixed); none: when open() succeeds. Replays given the same
-  /// start play on one clock, as their cameras did, whatever the order they open in (not in the
-  /// configuration files: for programs that play recordings against a clock of their own).
-  std::optional<std::chrono::steady_clock::time_point> start;
+  /// When the first frame is due (kRecorded, kFixed), on the source's clock; none: when open() succeeds.
+  /// Replays given the same start play on one clock, as their cameras did, whatever the order they open in
+  /// (not in the configuration files: for programs that play recordings against a clock of their own).
+  std::optional<SteadyClock::time_point> start;
 };
 
 /// Plays a replay directory through the DepthSource interface. open() reads poses.csv and checks that every
@@ -84,11 +85,14 @@ struct ReplayConfig final {
 /// the recording's cost, not the frame's; a camera delivers pixels); a frame whose file is still being
 /// read when it is due comes late, and a file that cannot be read turns kError when its frame is due.
 /// Stamps are the recorded ones; feed poses() to the sensor's PoseBuffer so frames and poses meet exactly
-/// as recorded. Not thread-safe (one thread calls it; the reader thread is internal).
+/// as recorded. Frames fall due on the source's clock, and next() sleeps on that clock; reading a frame's
+/// file is real work, so next() then waits for the read up to `timeout` of real time. Not thread-safe (one
+/// thread calls it; the reader thread is internal).
 class ReplaySource final : public DepthSource {
  public:
+  /// `clock` (which must outlive the source) times the playback; a test passes one it drives.
   /// @throws Error if speed or rate_hz is not positive.
-  explicit ReplaySource(ReplayConfig config);
+  explicit ReplaySource(ReplayConfig config, SteadyClock& clock = SteadyClock::real());
   ~ReplaySource() override;
   ReplaySource(const ReplaySource&) = delete;
   ReplaySource& operator=(const ReplaySource&) = delete;
@@ -118,11 +122,12 @@ class ReplaySource final : public DepthSource {
   [[nodiscard]] PinholeIntrinsics intrinsics_for(const std::string& image_path, int width, int height) const;
 
   ReplayConfig config_;
+  SteadyClock& clock_;
   SourceStatus status_;
   std::vector<ReplayEntry> entries_;
   std::size_t next_index_ = 0;
   std::unique_ptr<Reader> reader_;  // while open; reads frame next_index_ before it is due
-  std::chrono::steady_clock::time_point start_;
+  SteadyClock::time_point start_;   // on clock_
 };
 
 }  // namespace cellmap
