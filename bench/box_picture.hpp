@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A picture of boxes over a simulated scene's true obstacles: an SVG with a top view (x right, y up) and a
 // front view (x right, z up), orthographic. Obstacles are filled grey silhouettes, boxes red wireframes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The boxes of cellmapd's first version on the default simulated cell, scored by volume against the scene's
 // true solids; scripts/box_tradeoff runs it over a grid of `segment` settings.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Collision benchmarks against FCL 0.7 (GST_INDEP, the solver that gets box distances right), same run.
 #include <benchmark/benchmark.h>
 #include <fcl/narrowphase/collision.h>

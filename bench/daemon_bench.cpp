@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap bench daemon: the whole daemon path fed with two native cameras of the default cell at frame rate.
 //
 // Two replay recordings of the default cell's cameras on the gantry's tool, in their native modes (Kinect v2

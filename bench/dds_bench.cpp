@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap bench dds: what a one-box change costs a planner over DDS, ours (a delta through the planner client
 // library) against the anchor (the full 200-box snapshot each version, read by a plain snapshot reader),
 // measured in the same run with the subscriber in a second process on loopback.

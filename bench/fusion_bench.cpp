@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap bench fusion: our sweep fusion (OccupancyMap::integrate) against OctoMap's own
 // OcTree::insertPointCloud on the same frames, in the same run. Each frame is one sweep; a frame set is fused
 // into a fresh map per iteration. Prints the voxel-state agreement of the resulting maps before the timings.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scoring boxes against the per-point object labels of the mOSD scenes (shared by the data test and the
 // mosd_table program, so both report the same figures).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Prints the per-scene table of the batch pipeline on the mOSD box scenes: points, clusters, boxes, coverage,
 // volumetric and point-set IoU per object (see mosd_score.hpp) and time per stage.
 // Usage: cellmap-mosd-table [DIR] [FIRST LAST] [--config FILE] [--verbose]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Native depth modes of the default cell's cameras that the simulator's models do not default to.
 

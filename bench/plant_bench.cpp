@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap bench plant: many cells on one DDS domain, every part a real process on loopback.
 //
 // Starts N cellmapd daemons on simulated cells (cell-1 .. cell-N, each its own state directory, the OS32C

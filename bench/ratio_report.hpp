@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Shared main for cellmap's Google Benchmark programs: runs the registered benchmarks, then prints each
 // configured comparison as "ratio <name>: <anchor time / our time>x", both measured in this same run.

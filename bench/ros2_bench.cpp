@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap bench ros2: ROS 2 sensor input read straight off DDS (lib/ros2), against its own anchor.
 //
 // 1. Conversion (Google Benchmark, the ratio lines): sensor_msgs/msg/PointCloud2 bytes to points, ours

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-stage time of the batch pipeline on a real Kinect scene (mOSD learn3, 307k points of which 206k finite)
 // against the same stage done with plain PCL, in the same run:
 //   outliers         ours (kNN + two-sided test)       vs pcl::StatisticalOutlierRemoval (k = 40, u = 3)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmap bench fusion, self-filter part: the filter's cost per frame against the fusion's cost for the same
 // frame (the filtered one, as the daemon fuses it), and fusion with the filter's clear-only rays against

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Simulated camera frames: one 640×480 frame of the default cell (its 17 obstacles plus 13 more = 30),
 // rendered by the simulator (tile culling, 2 threads, noise, quantization, back-projection) against the
 // anchor: the same rays cast one by one against every obstacle on one thread (what a straightforward caster

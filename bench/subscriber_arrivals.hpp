@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the benchmarks that time DDS share: loopback-only Cyclone settings, and a subscriber process reporting
 // each version it received to its parent, stamped on CLOCK_MONOTONIC (comparable across processes).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Installs cellmap for use outside the tree: the stage libraries with their public headers, the generated DDS
 # types, the `cellmap` and `cellmapd` programs, the daemon's configuration, the systemd unit, and a CMake
 # package (cellmapConfig.cmake) exporting

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Runs at install time (see CellmapInstall.cmake): writes the systemd unit with the paths of this install,
 # rewriting the ExecStart line only (the comments keep describing the by-hand install).
 cmake_path(ABSOLUTE_PATH CELLMAPD_BINDIR BASE_DIRECTORY "${CMAKE_INSTALL_PREFIX}" OUTPUT_VARIABLE bindir)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's acquisition: the frames of the configured sensors (the simulated cell's sweeps, or the cameras'
 // posed frames grouped into sweeps as they come) into the frame queue of the thread that fuses them, with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Back-pressure between acquisition and processing: a bounded queue where, when full, the newest wins.
 

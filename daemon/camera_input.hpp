@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Depth cameras as cellmapd's sensors: frames from each camera's DepthSource, posed in the cell (fixed, or
 // on the tool through the robot's poses at the frame's stamp) with the robot as it stood then.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // On a machine with few cores, the version a closed sweep makes would wait for the CPU that gathering the
 // next sweep's frames takes meanwhile. Those frames are not needed before their own sweep closes, a sweep

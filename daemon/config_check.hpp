@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `cellmapd --check`: what would stop the daemon at start, found without starting it.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's wiring: the state directory, the cell pipeline, DDS, the sweep source and the threads.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's configuration: one YAML file, each stage's section read by that stage's own reader.
 

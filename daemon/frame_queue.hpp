@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Frames on their way from the acquisition to the thread that gathers them into sweeps, with the ends of the
 // sweeps between them.

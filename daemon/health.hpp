@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's health as cellmap/status reports it: the daemon's state and why, each sensor's state, the
 // sweeps.

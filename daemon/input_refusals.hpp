@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The DDS inputs cellmapd refused (scene edits, robot poses): counted for cellmap/status and logged, at most
 // one line a second so that a flood of bad samples cannot flood the log.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The daemon's optional layers (cellmap/layer/...): the occupied voxels of the map, the change regions of the
 // latest sweep, where its frames were taken from and where the robot was, written after a sweep only while a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd: keeps one cell's collision environment up to date and publishes its versions over DDS.
 // The command line and the logger; the daemon itself is daemon.hpp.
 #include <spdlog/sinks/stdout_color_sinks.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SIGHUP: what a running cellmapd takes from its re-read config file.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ros2_outputs.hpp"
 
 #include <spdlog/spdlog.h>

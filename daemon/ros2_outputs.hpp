@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's ROS 2 outputs (the `ros2` section): each published version to MoveIt's collision objects and
 // RViz's markers, and the whole environment again to a move_group that joins later.

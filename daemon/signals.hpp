@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Signal handling for cellmapd: signals are blocked in every thread and taken synchronously by the main
 // thread, so no handler ever runs inside library code.

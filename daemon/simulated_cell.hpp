@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The simulated sensors of cellmapd: the simulator's scene seen by the configured sensors of the scene,
 // editable between sweeps through cellmap/sim/scene_edits. With a scene motion the robot moves all the time

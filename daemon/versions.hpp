@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmapd's versions: the pipeline recovered from the state directory, and each version of its boxes
 // numbered, stamped, saved and only then published, retried until it is out.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A DDS sample as the receive path decodes it, for the harnesses of DDS inputs: Cyclone's checks of a
 // received payload (encapsulation kind, dds_stream_normalize against the type's ops), then dds_stream_read

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A point cloud file through load_cloud_file, as `cellmap segment` and the replay source read it. Built
 // twice: CELLMAP_FUZZ_EXTENSION ".pcd" (target fuzz_pcd) and ".ply" (fuzz_ply).
 #include "cellmap/io/cloud_file.hpp"

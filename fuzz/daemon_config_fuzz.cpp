@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd's configuration file (every section: source, occupancy, change, segment, reconcile).
 #include "daemon_config.hpp"
 #include "fuzz_support.hpp"

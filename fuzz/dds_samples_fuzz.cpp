@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // DDS samples as received: the first byte picks the topic type, the rest is the serialized payload as it
 // arrives in a DATA submessage (4-byte encapsulation header, then CDR). The payload goes through Cyclone's
 // own receive steps for it (the checks of serdata_default_from_ser: encapsulation kind, dds_stream_normalize

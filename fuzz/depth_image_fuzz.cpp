@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A replay frame's depth image: the first byte picks PNG (even) or TIFF (odd), the rest is the file.
 #include "cellmap/sensor/depth_io.hpp"
 #include "fuzz_support.hpp"

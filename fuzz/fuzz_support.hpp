@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What every harness shares: the input as a file (for readers that take a path) and the rule that a reader
 // either accepts its input or refuses it with cellmap::Error whose message is one line. Any other exception,

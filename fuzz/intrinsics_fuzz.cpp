@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A replay directory's depth intrinsics: the same bytes as intrinsics.yaml and as a PCL grabber .xml.
 #include "cellmap/sensor/depth_io.hpp"
 #include "fuzz_support.hpp"

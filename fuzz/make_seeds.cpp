@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes the seeds that programs write (the YAML, CSV, URDF and mesh seeds are written by hand): point clouds
 // as PCL's writers save them, depth images as cellmap and libtiff write them, DDS samples as Cyclone
 // serializes them, a state directory's snapshot and blob as VersionStore saves them, and map states as the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The map state the daemon saves with each version (header, viewpoint, the change detector's pending flips,
 // OctoMap tree) and reads back at start; an unreadable one must be refused (the daemon then starts with an
 // empty map). With the daemon's built-in pipeline settings.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A URDF's mesh file read with assimp (load_mesh): the first byte picks the format by extension (.stl, .obj,
 // .dae), the rest is the file. A mesh that loads must be valid (triangles, indices in range, finite corners).
 #include "cellmap/urdf/mesh_file.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A replay directory's poses.csv.
 #include "cellmap/sensor/replay_source.hpp"
 #include "fuzz_support.hpp"

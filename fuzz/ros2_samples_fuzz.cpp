@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 2 sensor samples as received from any ROS 2 node: the first byte picks the type (PointCloud2,
 // LaserScan, JointState), the rest is the serialized payload (4-byte encapsulation header, then CDR). The
 // payload goes through Cyclone's receive steps (cdr_sample.hpp), then through what cellmapd's ROS 2 inputs

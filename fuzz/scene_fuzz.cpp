@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A simulated cell's scene file (obstacles, robot, sensors, sweep plans), validated as load_scene does. The
 // SCARA arm of config/scenes/ lies beside the input, so scenes may name it as a relative URDF path.
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The segmentation config (config/segment.yaml, also cellmapd's `segment` section).
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/segment/pipeline.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A robot description (URDF) as the daemon's `robot` section and scenes load it: the chain to tool link
 // "tool0" and its collision geometry (a mesh URI may name mesh.stl, a small STL beside the input, read with
 // assimp). A robot that loads must pose its links.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A state directory as the daemon finds it at start: the input up to its first NUL byte is the newest
 // snapshot (environment-<version>.json, the boxes JSON plus cell, stamp, next box id and blob size/checksum),
 // the rest its blob. VersionStore must load it or skip it as corrupt, never fail otherwise.

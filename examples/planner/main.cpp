@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An example planner built on cellmap's client library (cellmap::client): it holds one path, follows a cell's
 // environment over DDS, re-checks the path with the collision library on every new version, and prints one
 // line each time the path's state changes ("path free", or "path blocked by box <id> at ...").

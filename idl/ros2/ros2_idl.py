@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ROS 2 message types as cellmap writes them in IDL (idl/ros2/<pkg>/msg/<Type>.idl) and as ROS writes them
 (.msg files), parsed into one model; and their REP 2011 type hashes (RIHS01).
 

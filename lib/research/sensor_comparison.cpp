@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/research/sensor_comparison.hpp"
 
 #include <pcl/filters/voxel_grid.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal to the research stage: the one SVG writer behind its figures (the paper's fig. 6b line plot, the
 // sensor comparison's bar charts). Plain SVG 1.1 text, white background, sans-serif 12 px; coordinates in

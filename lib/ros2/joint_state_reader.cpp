@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/ros2/joint_state_reader.hpp"
 
 #include <cstdlib>

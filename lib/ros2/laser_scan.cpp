@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/ros2/laser_scan.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/ros2/point_cloud2.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // How lib/ros2 quotes text from the network in its refusals: internal.
 

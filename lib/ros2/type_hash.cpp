@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/ros2/type_hash.hpp"
 
 #include "cellmap/common/error.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The received ROS 2 samples (idlc's structs of idl/ros2) as lib/ros2's value views: internal to the stage
 // (and its fuzz harness), so the public headers never name the generated types.

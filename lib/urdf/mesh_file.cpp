@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/urdf/mesh_file.hpp"
 
 #include <assimp/config.h>

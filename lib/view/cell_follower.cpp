@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/view/cell_follower.hpp"
 
 #include "cellmap/common/wall_clock.hpp"

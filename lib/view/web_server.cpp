@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/view/web_server.hpp"
 
 #include <civetweb.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Running a benchmark program from a test: its exit code and output, and the numbers it prints.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap bench daemon` at a low frame rate: the bench runs cellmapd's path end to end, fuses every frame
 // of both cameras and its subscriber receives the versions it publishes. Speed is not asserted here.
 #include <gtest/gtest.h>

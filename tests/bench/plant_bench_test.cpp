@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap bench plant` with two cells: both daemons, both planners and the monitor run as real processes on
 // loopback, each planner gets its cell's snapshot, the changes of cell-1 reach its planner, and the planner
 // of cell-2 counts what of cell-1 reached it. Speed is not asserted here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap bench ros2` for a second per input variant: both conversions agree, both ratio lines and every
 // input line are printed, every writer published at 30 Hz and the clouds a writer in the same process
 // publishes reach the source. Speed, and how many clouds cross loopback UDP, are not asserted here.

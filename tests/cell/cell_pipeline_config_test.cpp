@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cell pipeline's config: its sections and the settling and gathering policies, read from the `change`
 // section (settle_sweeps, gather_sweeps).
 #include <gtest/gtest.h>

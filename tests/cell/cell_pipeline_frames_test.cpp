@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cell pipeline on depth frames built by hand (an 80 × 60 camera at the cell's origin looking along +z):
 // pixels without a return clearing their line of sight (SweepFrame::no_return_range), and a change confirmed
 // in two parts a sweep apart published as one version (change.gather_sweeps). Known answers, milliseconds.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cell pipeline's re-segmentation of a box that lost part of its voxels (CellPipeline::resegment on a map
 // settled from a cloud of voxel centres, with the change given by hand): it shrinks in place when the box of
 // what it still holds blocks little seen free space, and its extent is re-segmented when that box would

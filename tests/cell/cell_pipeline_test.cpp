@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cell pipeline (fusion → change → re-segmentation → reconcile) on the simulated cell with
 // planted changes: exact deltas with stable ids, every change covered, removals within the documented sweeps,
 // and no versions from sensor noise.

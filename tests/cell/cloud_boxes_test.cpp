@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One cloud through the cell pipeline's stages (the batch tool's path): every point inside a box or counted
 // as noise, few boxes on the default cell.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Grouping frames into sweeps by their stamps as they arrive: where each frame falls, known answers.
 #include "cellmap/cell/frame_grouper.hpp"
 

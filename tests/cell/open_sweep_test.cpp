@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The open sweep: frames gathered one by one (on a thread of their own, as in cellmapd) make exactly what
 // the whole sweep makes in the cell pipeline; a gathered frame keeps its pose, not its points; a frame that
 // cannot be fused is left out.

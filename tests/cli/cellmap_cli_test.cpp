@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The `cellmap` tool's front door as a process: an unknown subcommand is an error whatever the flags, and
 // `cellmap status` says so when no daemon answers.
 #include <gtest/gtest.h>

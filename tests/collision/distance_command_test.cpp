@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runs the real `cellmap distance` program and checks its JSON and its refusals.
 #include <gtest/gtest.h>
 

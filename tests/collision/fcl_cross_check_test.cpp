@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Randomized cross-check against FCL 0.7 (GST_INDEP) with an independent brute-force referee.
 //
 // The referee for separated boxes is a feature enumeration (8 + 8 vertex-to-box distances and 144 edge-edge

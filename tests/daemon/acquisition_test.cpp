@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd's acquisition of the simulated cell: sweeps into the frame queue, scene edits over real DDS
 // applied when they are for this cell (or every cell), ignored when they are for another, refused and counted
 // when they leave the cell.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd with real camera sources, as a real process on loopback DDS:
 // - a replay of the three real grabber frames (../shared/data) produces a persisted and published
 //   environment whose boxes hold the frames' points, in the cell frame given by the recorded tool pose;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd on the simulated cell as a real process, a planner subscriber on loopback DDS, and `cellmap
 // inject` as a separate process: injected changes arrive as exact deltas; versions survive SIGKILL without
 // reuse (those run plain and with DDS Security on every participant). The daemon's status, SIGHUP, the

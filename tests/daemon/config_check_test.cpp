@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmapd --check` as a process: every cellmapd config shipped in config/ passes; a broken config prints
 // each of its problems with its key and exits 1, without joining DDS.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd as a real process with its state directory on a small tmpfs (tests run as root; without the
 // right to mount they skip): the disk full when the first version is due and when a later one is, the state
 // directory read-only and removed. Each time the status says degraded with the reason, subscribers (a late

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd's health: which state the status topic shows, and why.
 #include "health.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd's refused DDS inputs: every one counted, at most one log line a second.
 #include "input_refusals.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The daemon's layers: written after a sweep only while read, only when they changed or a reader joined
 // (real participants on loopback, one domain per test); sensor views from real frames through the sweep
 // stage.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The example planner (examples/planner) as a real process against cellmapd on the simulated cell: a box
 // injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
 // by it; removing the box frees the path again; a clean daemon restart does not read as "all removed". Plain

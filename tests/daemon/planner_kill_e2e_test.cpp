@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SIGKILL at random points: cellmapd and a planner subscriber (the example planner, a real process using the
 // client library) are killed and restarted in several rounds while boxes are being injected. Then no process
 // crashed, the daemon's versions rise strictly across all its lives, no version number ever carried two

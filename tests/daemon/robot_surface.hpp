@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot's surface as points, for tests that ask whether a box of the environment lies on the robot.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // DDS Security as an attacker meets it, with real processes on loopback: a participant without credentials
 // (a forging process, and our own tools without --security, as anyone on the plant network can run them)
 // on a secured cell's domain reaches nobody and receives nothing; each role can create only the writers and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helper for the DDS Security end-to-end tests: one participant, of one role or without credentials, in
 // a process of its own (Cyclone DDS takes one security setting per domain and process).
 //

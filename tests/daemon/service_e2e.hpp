@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Helpers for end-to-end tests of the service: cellmapd on the simulated cell as a real process (exact
 // depths, a private state directory), `cellmap inject` as a process, and in-process planner subscribers; all

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap status` against cellmapd on the simulated cell with two sensors, on loopback DDS: the table and
 // the JSON show the cell, its state, its sensors by name and the version the daemon has.
 #include <gtest/gtest.h>

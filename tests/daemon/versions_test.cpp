@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd's versions: the pipeline recovered from a state directory, and each version saved before it is
 // published to a real subscriber on loopback DDS, retried through save and write faults, stamped in order
 // when the clock steps back.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd in a working cell, as a real process on loopback DDS: the simulated arm cell (the arm moving all
 // the time, noise on), its frames self filtered with the robot posed from the controller's joint samples.
 // Short runs here; CELLMAP_LONG_TESTS=1 runs the documented lengths (500 sweeps).

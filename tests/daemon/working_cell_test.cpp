@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The daemon's simulated arm cell and cell pipeline driven sweep by sweep (each sweep one second of the
 // motion, so sweep numbers are the motion's seconds): pick and place, people walking through, joint stamps
 // that are late. Noise on. The arm cell's config (config/arm-cell.yaml) with the post camera only; and the

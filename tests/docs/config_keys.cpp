@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // config_keys: reads config files with cellmap's own readers, as cellmapd and `cellmap segment` read them,
 // and prints every key path each reader read or asked about (YamlKeyLog), one "<reader> <path>" line each,
 // e.g. "daemon source.openni2.uri". Exit 1 with the reader's message when a file is refused: the keys a

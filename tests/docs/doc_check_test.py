@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """What the documentation says that can be checked mechanically, against the programs themselves:
 
 1. commands: every `cellmap ...` and `cellmapd ...` in a code span or code block of README.md and docs/**/*.md

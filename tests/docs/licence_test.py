@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Every code file of the source tree says its licence in an SPDX line near its top, and LICENSE is the
 Apache License 2.0 that line names: what a user who copies one file needs to know it may.
 

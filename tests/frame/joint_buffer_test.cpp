@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Joint-state input: joints interpolated to frame times, forward kinematics at that time, the payload of the
 // nearer sample, and the drop-without-bracketing-samples rule.
 #include "cellmap/frame/joint_buffer.hpp"

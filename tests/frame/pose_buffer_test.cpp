@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Robot pose input: interpolation to frame times and the drop-without-pose rule.
 #include "cellmap/frame/pose_buffer.hpp"
 

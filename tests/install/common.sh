@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Sourced by the install tests: a temporary directory removed at exit with every process the test started,
 # fail(), and Cyclone DDS on loopback only (1 s lease: a stopped daemon is noticed soon).
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/cellmap-install-XXXXXX")

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Test and benchmark support: renders deterministic depth frames of a scene of axis-aligned boxes with a
 // pinhole camera (optionally with Gaussian depth noise), until the simulator stage can stand in.

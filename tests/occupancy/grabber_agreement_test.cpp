@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Real frames: our sweep fusion against OctoMap's own insertPointCloud on the grabber sequence.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Test and benchmark support: the real Kinect frames of ../shared/data/pcl/grabber_sequence as scans taken
 // from the cell origin (camera frame = cell frame), in file-name order.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Test support: a scan as OctoMap's point cloud, for the tests that compare the occupancy stage with
 // OctoMap's own insert.

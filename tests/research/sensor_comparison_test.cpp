@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap sensor-comparison` on the bundled cell: the paper's finding, reproduced in simulation.
 // The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision
 // Detection for Industrial Robotics Applications", AIRoV 2024.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Every idl/ros2/<pkg>/msg/<Type>.idl against ROS 2's <pkg>/msg/<Type>.msg (<shared data>/ros2): the
 struct's name, each field's name, type, order, array size and bounds, and each constant's name, type and
 value, by the mapping of idl/ros2/ros2_idl.py. Prints one line per disagreement, naming the file and the

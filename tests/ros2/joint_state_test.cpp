@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // JointState names matched to the robot's joints: any order, other joints ignored, gaps refused.
 #include "cellmap/ros2/joint_state.hpp"
 

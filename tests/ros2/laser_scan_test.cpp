@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sensor_msgs/msg/LaserScan → points with known answers (REP 117's meanings of inf and NaN), the fan, and
 // every malformed kind refused.
 #include "cellmap/ros2/laser_scan.hpp"

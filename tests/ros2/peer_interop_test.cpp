@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ros2_peer (eProsima Fast DDS 2.9 with fastddsgen's types, standing in for a ROS 2 node) against plain
 // Cyclone DDS with idlc's types of the same idl/ros2 files: every field arrives exactly, both ways, on
 // loopback. What passes here is what two independent vendors agree on: ROS 2's topic and type names, QoS and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sensor_msgs/msg/PointCloud2 layouts as ROS 2 drivers send them, read for x, y, z with known answers, and
 // every malformed kind refused with its reason.
 #include "cellmap/ros2/point_cloud2.hpp"

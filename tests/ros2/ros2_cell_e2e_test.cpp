@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd on config/ros2-cell.yaml fed only by a ROS 2 node of another DDS vendor (Fast DDS:
 // tests/ros2/peer), all real processes on loopback: the node publishes the depth camera's PointCloud2
 // (rendered by cellmap's simulator, exact depths) and reads what MoveIt's planning scene monitor and RViz

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ROS 2 sources and writers against plain Cyclone DDS participants speaking ROS's wire types (idl/ros2),
 // in one process on loopback: what a ROS 2 driver sends becomes frames and joint samples, what cellmapd
 // writes reaches a MoveIt- or RViz-like reader with every field as sent.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The ROS 2 node of the end-to-end tests: tests/ros2/peer's Fast DDS program (another DDS vendor, ROS 2's
 // default one) as a child process, told what to publish on its stdin, its JSON lines read on a thread of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmapd fed by ROS 2 sensor drivers on a moving robot, all through a ROS 2 node of another DDS vendor
 // (Fast DDS: tests/ros2/peer): the arm cell's fixed camera with the arm's joints only on /joint_states
 // (ros2_control's joint_state_broadcaster), and the default cell's gantry sweeping a 2D lidar whose scans

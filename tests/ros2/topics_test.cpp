@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 2 topic names on DDS.
 #include "cellmap/ros2/topics.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap security init`'s library side: every file of a cell's credentials, with its mode, and documents
 // that grant each role exactly its topics. The credential check (credentials_test.cpp) is the referee for
 // signatures and validity.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The check every DDS program makes before joining with DDS Security: each way a credentials directory can be
 // wrong is refused with one line naming the file and the reason.
 #include "cellmap/security/credentials.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The batch pipeline on real Kinect scenes (mOSD, boxes on a table and stacked boxes) with per-point labels.
 // Figures are defined in bench/mosd_score.hpp; scripts/mosd_table prints them for all 25 scenes.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/segment/region_growing.hpp"
 
 #include <gtest/gtest.h>

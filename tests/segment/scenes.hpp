@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Synthetic scenes for the segmentation tests: grid-sampled surfaces as a depth sensor at `viewpoint` sees
 // them (only faces turned toward it), with the true object of every point.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap segment` as a process: exit codes, the one-line reason on bad input, and the boxes file it writes.
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>

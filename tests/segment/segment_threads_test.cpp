@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The re-segmentation's stages split over threads give the same result on any number of them (a program of
 // its own: the ThreadSanitizer pass of CI runs it).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The self filter against known answers: a box robot in front of a camera (which points go, which stay, where
 // the clear-only rays end, what fusion makes of it), the padding's documented growth, a line scanner, the
 // mesh arms of the simulated cell, and bad input.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Depth image files (16-bit PNG and TIFF) and intrinsics files, on files the test writes itself.
 #include "cellmap/sensor/depth_io.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pure logic shared by the camera sources: depth mode negotiation, Z16 decoding, device clock mapping,
 // intrinsics from a field of view and the RealSense defaults.
 #include <gtest/gtest.h>

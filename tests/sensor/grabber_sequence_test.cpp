@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Depth → points and replay on three real frames of one Kinect-type sensor
 // (shared/data/pcl/grabber_sequence): each frame is stored as raw 16-bit depth (TIFF, millimetres), its
 // intrinsics (PCL grabber XML) and the organized cloud PCL's grabber computed from the same depth (PCD).

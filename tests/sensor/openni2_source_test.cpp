@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OpenNI2 source on this machine. No camera is plugged in here, so the tests check the no-device path (a
 // clear reason, a clean disconnected status, retries with back-off). The OpenNI2 driver path itself runs on
 // the "Dummy" device of Debian's OpenNI2 (libDummyDevice.so, a real OpenNI2 driver that streams a synthetic

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reconnect state machine, driven by a clock the test passes in.
 #include "cellmap/sensor/reconnect.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Depth image files and replay directories, on files the test writes itself.
 #include "cellmap/sensor/replay_source.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-sensor configuration: the source chosen by `source:` and its settings.
 #include "cellmap/sensor/sensor_config.hpp"
 

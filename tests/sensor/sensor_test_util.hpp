@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Helpers shared by the sensor tests: files in a temporary folder, fast reconnect timings, a synthetic depth
 // image.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // V4L2 source on this machine: no /dev/video* node exists here (and no kernel module can be loaded), so the
 // tests check the missing-device and wrong-node paths; negotiation and Z16 decoding are in depth_source_test.
 #include "cellmap/sensor/v4l2_source.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The moving cell: a robot that moves all the time along its path while frames are taken, the controller's
 // joint samples, pick and place, and a person walking through.
 #include "cellmap/sim/motion.hpp"

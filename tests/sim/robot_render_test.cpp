@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The robot in the simulator: its collision shapes (primitives and meshes through a bounding-volume
 // hierarchy) and payload rendered by the ray caster, fixed and wrist sensors, and the arm cell.
 #include <gtest/gtest.h>

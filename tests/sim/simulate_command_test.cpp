@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap simulate` as a user runs it: files on disk, exit codes, one-line errors.
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>

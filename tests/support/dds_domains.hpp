@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Every DDS domain id the tests use, in one table. ctest runs tests side by side (-j 2) and DDS tests on
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.

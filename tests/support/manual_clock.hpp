@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A clock the test drives, for code that takes a SteadyClock: what it does at which instant is then checked
 // exactly, and a loaded machine (or a sanitizer) cannot move the instants.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Tests that read the shared data (real sensor frames, robot packages, ROS 2 message files: ../shared/data
 // beside the checkout, or wherever CELLMAP_SHARED_DATA points) skip when it is absent, so a checkout without

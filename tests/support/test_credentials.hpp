@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // DDS Security credentials for one test cell and domain, written as `cellmap security init` writes them.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Frames → sweeps: posing by the robot's poses, the drop-without-pose rule, grouping by stamp.
 #include "cellmap/sweep/sweep_assembler.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pins a defect of the Cyclone DDS that Debian ships (0.10.2), found by fuzz_dds_samples
 // (fuzz/regressions/dds_samples/xcdr2_truncated_robot_state): dds_stream_normalize, the check the receive
 // path runs on every payload before a reader may take it, bounds an XCDR2 payload's 8-byte values by 4 bytes

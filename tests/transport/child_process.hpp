@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A child process for end-to-end tests: started with execv, its stdout read line by line with a timeout;
 // optionally its stdin written by the test.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every rule a DDS input of the daemon must pass, one by one, as the readers apply them: the wire format's
 // (from_wire: finite numbers, unit quaternions, known kinds, names) and the cell's (check_limits: inside the
 // cell, sizes that fit, stamps near now).

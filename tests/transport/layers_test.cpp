@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The optional layers: voxel runs against known answers, their bytes, and a writer that can tell whether
 // anyone reads (real participants on loopback, domain 222).
 #include "cellmap/transport/layers.hpp"

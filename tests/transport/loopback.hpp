@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // DDS test setup: real participants on the loopback interface only, no multicast (lo has none), so tests
 // run on machines without a network and do not leak traffic. Each test uses its own domain id (transport

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helper for the transport end-to-end tests: a minimal "daemon" that publishes the test sequence of
 // environments for cell "cell-e2e", persisting each version in a VersionStore before publishing it.
 //   transport_publisher_helper DOMAIN STATE_DIR VERSIONS INTERVAL_MS

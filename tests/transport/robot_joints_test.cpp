@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap/robot_joints on real Cyclone DDS participants (loopback): the controller's side writes joint
 // positions (and what the tool holds), the daemon's side reads them for its cell and robot, refusing what
 // does not fit the robot.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap/robot_state on real Cyclone DDS participants (loopback): the robot controller's side writes tool
 // poses, the daemon's side reads them for its cell.
 #include "cellmap/transport/robot_state.hpp"

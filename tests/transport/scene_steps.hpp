@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A deterministic sequence of environments for transport tests: each version changes exactly one box
 // (every third version adds one, the others move one); no version removes a box, so a subscriber that

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Publisher, planner subscriber and `cellmap echo` as separate processes on loopback DDS.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Publisher and subscribers in one process, on real Cyclone DDS participants (loopback only).
 #include <gtest/gtest.h>
 

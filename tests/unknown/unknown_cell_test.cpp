@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Unknown space in the default simulated cell: what its Kinect has not seen over the table once the first
 // version is out, covered by few boxes that hold every pocket and block little seen free space.
 

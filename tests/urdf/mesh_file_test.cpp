@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh files through assimp and robot descriptions with mesh collision geometry: the real ABB IRB 2400 (7 STL
 // collision meshes, ../shared/data/robots) checked against its files read independently, and against the
 // joint origins of its URDF.

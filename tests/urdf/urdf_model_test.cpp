@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/urdf/urdf_model.hpp"
 
 #include <gtest/gtest.h>

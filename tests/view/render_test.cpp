@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Still pictures: the projection against hand-computed answers, and the PNG and SVG cairo writes from it.
 #include "cellmap/view/render.hpp"
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """`cellmap view` in a real browser: cellmapd on the simulated cell (exact depths), `cellmap view`, `cellmap
 inject` and `cellmap render` as processes, and Debian's chromium (headless) driven by python3-selenium. At the
 end cellmapd runs the arm cell (its fixed camera only) on the same domain, to see the robot layer move.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the viewer tells its pages: the messages of ViewState for versions, status and layers, and the state a
 // page gets when it connects.
 #include "cellmap/view/view_state.hpp"

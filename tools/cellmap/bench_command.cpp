@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap bench fusion|segment|collision|dds|daemon|plant|ros2`: runs the benchmark program built beside
 // this tool.
 #include <unistd.h>

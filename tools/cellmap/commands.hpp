@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Each subcommand of the `cellmap` tool lives in its own file and registers itself on the app through one
 // function declared here; main.cpp calls them all. A subcommand reports failure by throwing cellmap::Error

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap distance BOX_A BOX_B`: the signed box-box distance of the collision library, as one JSON object.
 #include <iostream>
 #include <nlohmann/json.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap echo [--domain N] [--cell C] [--count K] [--timeout SEC] [--security DIR [--role R]]`: one JSON
 // line per snapshot/delta received.
 #include <chrono>

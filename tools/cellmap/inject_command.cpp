@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap inject [--domain N] [--security DIR [--role R]] add-box|remove|move ...`: edits the simulated
 // scene of a running cellmapd.
 #include <chrono>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap: the command-line tool over the cellmap library.
 #include <algorithm>
 #include <iostream>

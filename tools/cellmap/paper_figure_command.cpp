@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap paper-figure -o DIR`: the paper's minimum-distance sweep (GJK vs spheres N = 1, 2, 6), in the
 // paper's setup and in ours.
 // The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration and Collision

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap render ENV.json|--domain N [--cell C] [--scene S] -o OUT.png|OUT.svg`: a still picture of a cell's
 // boxes (top, side and perspective views) from a boxes file or a saved version, or from the live environment
 // on DDS with the robot where the daemon last saw it; a simulated cell's true obstacles drawn under the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap robot-pose --cell C (--pose X,Y,Z[,QW,QX,QY,QZ] | --joints NAME=V,...|V1,V2,... [--payload ...])
 // [--rate HZ] [--duration S]`: publishes a standing robot's tool pose on cellmap/robot_state, or its joint
 // positions (and what the tool holds) on cellmap/robot_joints, stamped with the current time, as a robot

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap security init DIR --cell C [--domain N] [--days D] [--plant-ca DIR0]`: the DDS Security
 // credentials of one cell (with new CAs, or with those of another cell of the plant).
 #include <chrono>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `--security DIR --role R`, the same on every subcommand that joins a DDS domain.
 

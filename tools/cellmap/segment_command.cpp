@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap segment IN.{pcd,ply} [--pipeline cell|points] [--config FILE] [--boxes obb|aabb] -o OUT.json`: one
 // cloud → boxes, by the cell pipeline's stages with cellmapd's config (default) or by the paper's point
 // pipeline.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap sensor-comparison [SCENE.yaml] [--pipeline cell|points] [--config FILE] [--voxel M] [--region ...]
 // -o DIR`: the paper's sensor comparison on a simulated cell. Every sensor of the scene sweeps the same cell;
 // its merged cloud goes through the batch path (cellmap segment's library calls) and the boxes are scored

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap sensors: lists the OpenNI2 and V4L2 depth devices on this machine with their depth modes.
 #include <algorithm>
 #include <iostream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap simulate [SCENE.yaml] [--sensor NAME] [--seed N] [--exact] -o DIR`: one simulated sweep on disk,
 // as a replay directory (replay_source.hpp) plus frames.csv (sensor poses and joint vectors) and the merged
 // cloud.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap status [--domain N] [--cell C] [--wait S] [--json] [--security DIR [--role R]]`: the daemons'
 // reports on cellmap/status, as a table or one JSON document.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR] [--security DIR [--role R]]`:
 // follows the cell(s) over DDS as a planner does (with a planner's credentials under DDS Security) and serves
 // a live 3D view of them at http://ADDR:P/ until SIGINT or SIGTERM.

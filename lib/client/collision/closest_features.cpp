@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "closest_features.hpp"
 
 #include <cmath>

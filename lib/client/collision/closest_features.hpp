@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: exact closest points of two separated boxes without iterating GJK, certified by a separating
 // axis: a pair of points, one per box, is a closest pair when it reaches the axis's lower bound of the

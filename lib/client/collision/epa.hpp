@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: EPA (expanding polytope) penetration depth, a general polytope algorithm kept as an independent
 // cross-check of the separating-axis depth that signed_distance uses (exact and faster on boxes).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: GJK minimum distance between two boxes (with the signed-volumes sub-algorithm), the fallback of
 // signed_distance for the pairs no closest-feature certificate settles, and EPA's start.

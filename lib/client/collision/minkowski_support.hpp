@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: the support mapping of the Minkowski difference D = A - B of two boxes, in A's frame, shared by
 // GJK and EPA.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: closest points of two boxes by alternating closest-point projections, the fast path of
 // signed_distance. Inline so that the loop keeps its numbers in registers inside the caller.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: the first alternating projections of mutual_projections.hpp, written once over a number type T:
 // `double` for one box pair (signed_distance) and `Double2`, two pairs in the two halves of an SSE2 register,

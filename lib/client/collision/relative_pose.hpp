@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: box B seen from box A, the frame every box-box algorithm here computes in.
 

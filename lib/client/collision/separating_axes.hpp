@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: the 15 separating axes of two boxes (3 + 3 face normals, 9 edge-edge cross products) with exact
 // rotation terms, for the exact depth and the distance lower bound.

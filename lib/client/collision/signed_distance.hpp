@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: the two halves of signed_distance, shared with EPA, and its baseline build.
 

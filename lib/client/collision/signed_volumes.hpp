@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: GJK's sub-algorithm, the point of a simplex closest to the origin, by "signed volumes"
 // (Montanari, Petrinic, Barbieri, ACM TOG 2017): the supporting face is decided by signs of (projected)

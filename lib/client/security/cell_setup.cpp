@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/security/cell_setup.hpp"
 
 #include <fcntl.h>

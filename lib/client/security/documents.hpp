@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The governance and permissions documents of DDS Security 1.1 (9.4.1.2.3 and 9.4.1.3), written for one cell,
 // and their S/MIME signature (private to lib/client/security).

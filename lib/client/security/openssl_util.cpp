@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "openssl_util.hpp"
 
 #include <openssl/err.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // OpenSSL objects owned by unique_ptr, and the conversions the credential check and the setup share
 // (private to lib/client/security).

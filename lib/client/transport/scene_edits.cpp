@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/transport/scene_edits.hpp"
 
 #include "cellmap/common/error.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Conversions between cellmap's value types and the idlc-generated wire types (private to this stage).
 // Outgoing: a *Sample object builds the C struct pointing into its own storage (nothing is dds_alloc'ed), so

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal (tests and the dds benchmark): how many bytes an environment or a delta costs on the wire.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/cell/cell_pipeline.hpp"
 
 namespace cellmap {

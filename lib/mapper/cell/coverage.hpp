@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The cell pipeline's safety pass (internal): every occupied voxel of the map wholly inside a box at every
 // version, including the voxels noise added outside the changed area since that area was last fitted.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/cell/frame_grouper.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Free-space evidence from camera pixels without a return (SweepFrame::no_return_range): internal to the cell
 // pipeline.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Timing of the cell pipeline's stages (internal): wall time, and CPU time of the calling thread with the
 // helper threads it split its work onto.

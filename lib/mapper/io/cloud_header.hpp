@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Checks of what a PCD or PLY header claims, made before PCL's readers see the file: PCL sizes its buffers by
 // the header (a 5 KB PLY claiming 1e11 vertices made it allocate 14 GB), so the header must be well-formed,

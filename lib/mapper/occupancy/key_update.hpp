@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The voxels one sweep observes — occupied endpoints and crossed free space — computed without touching the
 // tree, so that the tree is then updated once per voxel, subtree by subtree, instead of once per ray step.

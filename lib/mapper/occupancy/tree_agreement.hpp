@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // How closely two occupancy trees agree, voxel by voxel: used to check the fast sweep fusion against
 // OctoMap's own OcTree::insertPointCloud.

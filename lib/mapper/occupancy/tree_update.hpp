@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Applying a sweep's KeyUpdate to the OcTree: each brick's subtree descended once, with OctoMap's per-voxel
 // update rules.

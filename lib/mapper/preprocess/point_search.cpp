@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/preprocess/point_search.hpp"
 
 // FLANN's templates instantiated here stay ours: exported, they would replace the copies PCL's libraries

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/segment/free_space.hpp"
 
 #include <algorithm>

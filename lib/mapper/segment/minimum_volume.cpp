@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "minimum_volume.hpp"
 
 #include <libqhull_r/qhull_ra.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal to box fitting: the axes of the minimum-volume box around a point set.
 

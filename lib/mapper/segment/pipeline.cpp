@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Equation and algorithm numbers are those of K. Zauner, J. El Dib, H. Gattringer, A. Müller,
 // "Workspace Registration and Collision Detection for Industrial Robotics Applications", AIRoV 2024.
 #include "cellmap/segment/pipeline.hpp"

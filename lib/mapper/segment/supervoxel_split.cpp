@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/segment/supervoxel_split.hpp"
 
 #include <pcl/segmentation/supervoxel_clustering.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: a CPU z-buffer for one pinhole camera, into which the padded robot's triangles are drawn.
 //

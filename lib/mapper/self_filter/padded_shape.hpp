@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: the robot's collision shapes grown by the padding and turned into triangles in their own frame G.
 

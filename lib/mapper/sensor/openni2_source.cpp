@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/sensor/openni2_source.hpp"
 
 #include <OpenNI.h>

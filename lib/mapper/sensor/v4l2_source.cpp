@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/sensor/v4l2_source.hpp"
 
 #include <fcntl.h>

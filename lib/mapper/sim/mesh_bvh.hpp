@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A bounding-volume hierarchy over a triangle mesh for ray casting (internal to the sim stage).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/sim/ray_cast.hpp"
 
 #include <algorithm>

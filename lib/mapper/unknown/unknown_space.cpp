@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "cellmap/unknown/unknown_space.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // cellmap view: the cell's boxes in 3D, kept live over a WebSocket from `cellmap view` (the protocol is
 // described in cellmap/view/view_state.hpp). Read-only: the page only asks to see things.
 import * as THREE from '/three/build/three.module.js';

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One line of ros2_peer's input: a verb and `key=value` words, e.g.
 //   pub-joints topic=/joint_states names=a,b positions=1.5,-2

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -P script: runs fastddsgen once on ROOTS (IDL files relative to IDL_ROOT, comma-separated) and files
 # the generated sources of every type in FILES (the roots and all they include) under OUT_DIR as
 # <package>/msg/<Type>{.h,.cxx,PubSubTypes.h,PubSubTypes.cxx}. fastddsgen writes every type it generates into

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ros2_peer's input: command lines and raw payloads from stdin, and SIGTERM/SIGINT. Both come through one
 // poll(), so a signal ends a blocked read, a sleep or a wait at once and the peer still leaves DDS cleanly

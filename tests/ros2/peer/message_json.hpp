@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ros2_peer's output: one JSON object per line on stdout, flushed at once (a test reads the lines as they
 // come). The received messages are printed whole, every field under its ROS name; doubles and floats with 17

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "node.hpp"
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>

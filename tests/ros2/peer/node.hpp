@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The stand-in ROS 2 node on Fast DDS 2.9: one participant on 127.0.0.1 only, and writers and readers that
 // follow ROS 2's wire conventions (rmw_fastrtps and rmw_cyclonedds agree on them):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ros2_peer --domain N: a stand-in ROS 2 node on eProsima Fast DDS 2.9, driven by commands on stdin, one per
 // line; it prints JSON lines on stdout (tests/ros2/peer/README.md has the protocol) and diagnostics on
 // stderr. Tests use it to check that cellmap (Cyclone DDS) meets ROS 2 nodes on the wire.

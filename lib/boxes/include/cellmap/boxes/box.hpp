@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The collision box: what segmentation produces, environments version and planners check against.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Volumes of box overlaps: how much of one box lies inside another, exactly (fidelity is measured by volume).
 

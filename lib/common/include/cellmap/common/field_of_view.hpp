@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a sensor can see, in its own frame S: the one description of a field of view, shared by the sensors
 // that know theirs and the viewer that draws it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Splitting a loop over a few threads: the one thread splitter of the library (the simulator's rays, the
 // occupancy map's ray casting), and the CPU time of a thread with the helpers it split its work onto.

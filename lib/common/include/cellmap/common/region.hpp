@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // An axis-aligned region of space: the one axis-aligned box type (cell bounds, change regions, workspace
 // boxes, evaluation regions).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The monotonic clock that code which waits for a time reads and sleeps on, so a test can drive it.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Parsing of the small text formats cellmap reads (CSV pose files, comma lists on the command line), and the
 // quoting of input in messages.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A version of a cell's collision environment and the delta between two versions.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reconciling re-segmented boxes with the previous environment: stable ids, minimal deltas.
 

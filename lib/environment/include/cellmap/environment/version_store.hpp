@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Crash-safe persistence of a cell's environment versions in a state directory.
 

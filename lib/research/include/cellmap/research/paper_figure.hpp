@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The paper's comparison (section 5.3, fig. 6b): a cube moved along y past a row of boxes; its minimum
 // distance by GJK and by bounding spheres with N = 1, 2, 6 per box, and the constraints each method costs.

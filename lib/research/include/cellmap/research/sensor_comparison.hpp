@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The paper's sensor comparison on a simulated cell: every sensor of the scene sweeps the same cell once, its
 // merged cloud goes through the batch path (the cell pipeline's stages on the cloud's occupied voxels, or the

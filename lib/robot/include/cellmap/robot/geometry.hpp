@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Solid shapes and triangle meshes: the collision geometry of a robot's links and the obstacles of the
 // simulated cell. Plain value types in the shape's own frame G; Eigen only (meshes are read from files by the

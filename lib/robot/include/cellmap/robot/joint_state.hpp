@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot's state at one instant as the controller reports it: joint positions and what the tool holds.
 // The one joint-sample type of the DDS topic cellmap/robot_joints (transport), the joint buffer (frame) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot model: kinematics (joint vector q → pose of every link and of the tool in the cell frame) and the
 // collision geometry fixed to its links (boxes, cylinders, spheres, triangle meshes). One model serves the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The environment for ROS 2 nodes: MoveIt 2's planning scene monitor (moveit_msgs/msg/CollisionObject on
 // /collision_object) and RViz (visualization_msgs/msg/MarkerArray on /cellmap/markers), straight over DDS.

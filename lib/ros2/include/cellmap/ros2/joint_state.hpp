@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // sensor_msgs/msg/JointState → the robot's joint positions: what ros2_control's joint_state_broadcaster
 // publishes on /joint_states, matched to the robot model's joints by name.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot's joints from ROS 2: sensor_msgs/msg/JointState samples (ros2_control's joint_state_broadcaster
 // on /joint_states) as cellmap's joint samples, an alternative to cellmap/robot_joints.

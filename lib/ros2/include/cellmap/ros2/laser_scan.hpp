@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // sensor_msgs/msg/LaserScan → points: what a 2D lidar's ROS 2 driver publishes (the paper's OS32C, swept
 // by the gantry, among them). Frame: the scanner's, beams in its x–y plane, angles about +z from +x (as

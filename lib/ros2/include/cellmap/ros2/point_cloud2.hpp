@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // sensor_msgs/msg/PointCloud2 → points: what any ROS 2 depth camera or 3D lidar driver publishes, read for x,
 // y and z wherever the cloud's layout puts them.

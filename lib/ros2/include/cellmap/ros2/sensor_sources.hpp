@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ROS 2 sensor drivers as cellmap depth sources: sensor_msgs/msg/PointCloud2 (depth cameras, 3D lidars) and
 // sensor_msgs/msg/LaserScan (2D lidars) read straight off DDS, no ROS installed. The frames they give are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ROS 2's conventions on DDS, as rmw_cyclonedds and rmw_fastrtps apply them: ROS topic `/a/b` is DDS topic
 // `rt/a/b` in the default partition; type `pkg/msg/Type` is DDS type `pkg::msg::dds_::Type_` (idl/ros2);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // REP 2011 type hashes of the ROS 2 message types cellmap speaks (idl/ros2). ROS 2 Jazzy's RMWs put
 // "typehash=RIHS01_<hex>;" in the USER_DATA QoS of every writer and reader, which is how `ros2 topic info -v`

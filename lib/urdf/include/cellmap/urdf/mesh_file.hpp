@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Triangle meshes read from files (STL, COLLADA .dae, OBJ, and what else assimp reads) and the mesh URIs of
 // robot descriptions resolved to files. The one place cellmap links assimp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading a robot from URDF (urdfdom): its serial chain for forward kinematics and the collision geometry of
 // its links (boxes, cylinders, spheres, meshes read with assimp: mesh_file.hpp). The one place cellmap parses

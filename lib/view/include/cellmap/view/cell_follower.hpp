@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The viewer's DDS side: follows one cell, or every cell on the domain, exactly as a planner does (an
 // EnvironmentSubscriber per cell: snapshot at start, deltas, resync after a gap), reads the daemons' status

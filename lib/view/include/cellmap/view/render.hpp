@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A still picture of a cell's boxes for reports and the README, without a browser: three panels (top, side
 // and perspective views) drawn with cairo into a PNG or an SVG, optionally with the robot where it was and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the viewer's web page shows, kept by the server as DDS brings it: per cell the boxes (with the version
 // that last changed each), a timeline of versions, the daemon's status and whether a daemon is there at all,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The viewer's web server (civetweb): serves the page's own files (embedded in the program) and three.js from
 // the installed libjs-three, and pushes messages to every open page over one WebSocket endpoint, /ws.

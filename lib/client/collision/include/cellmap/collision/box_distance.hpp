@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Box-box queries: the separating-axis overlap test and the exact signed distance with witness points.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Broad phase: a static AABB tree over environment boxes, so a query touches only the boxes near it.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The oriented box as the collision library computes with it: cellmap::Box with its rotation matrix
 // precomputed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A robot's collision geometry: boxes fixed to its links, placed in the cell frame by forward kinematics.
 

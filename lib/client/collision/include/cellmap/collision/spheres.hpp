@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Bounding spheres: the paper's cheap, conservative approximation of a box by N spheres, and the sphere
 // queries.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Path checks for planners: a B-spline path sampled at N checkpoints, every robot box against every
 // environment box.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `cellmap security init`: everything one cell needs for DDS Security, made with OpenSSL (the layout is in
 // credentials.hpp). Two CAs (identity, permissions; ECDSA P-256, SHA-256), one identity per role, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // DDS Security credentials of one cell, as `cellmap security init DIR` writes them (cell_setup.hpp), and the
 // check a program makes before it hands them to DDS:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A small RAII layer over the Cyclone DDS 0.10 C API: each class owns one DDS entity and deletes it (and so
 // its children) when destroyed. Every call's return code is checked; failures throw cellmap::Error with

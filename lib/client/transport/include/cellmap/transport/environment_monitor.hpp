@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Watches every snapshot and delta on a domain, of every cell, as they arrive (what `cellmap echo` prints).
 

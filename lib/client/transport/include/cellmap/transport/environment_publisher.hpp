@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The daemon side of cellmap/environment, cellmap/environment_delta and cellmap/status for one cell.
 

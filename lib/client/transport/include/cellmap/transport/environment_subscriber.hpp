@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The planner client: subscribe to one cell and keep a local copy of its environment current.
 

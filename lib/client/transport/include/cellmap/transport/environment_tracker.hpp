@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The planner side's bookkeeping, free of DDS so it can be tested sample by sample: a local copy of one
 // cell's environment kept current from snapshots and deltas arriving in any order.

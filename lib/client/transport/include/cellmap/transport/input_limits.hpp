@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a daemon accepts from outside over DDS besides what the wire format already enforces (every number
 // finite, unit quaternions, known enum values, names present): positions inside the cell, boxes that fit in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The optional layers a viewer can ask the daemon for: the occupied voxels of the map, the change regions
 // of the latest sweep, where its frames were taken from and where the robot was. A layer has its own topic

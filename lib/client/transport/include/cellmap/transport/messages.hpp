@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Value types for the status, scene-edit, robot-state and robot-joints topics (the environment ones are
 // cellmap::Environment and cellmap::EnvironmentDelta). The DDS wire types (idl/cellmap.idl) stay inside

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmap/robot_joints: the robot controller tells cellmapd its joint positions and what the tool holds, so
 // the daemon knows where every link, every sensor on the robot and the robot itself in its sensors' view are.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmap/robot_state: the robot controller tells cellmapd where the tool is, so camera frames get their
 // pose.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmap/sim/scene_edits: how `cellmap inject` edits the simulated scene of a running daemon.
 

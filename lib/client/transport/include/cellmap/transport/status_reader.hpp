@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reads cellmap/status: the health reports of one cell's daemon or of every cell daemon on a domain.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // cellmap's DDS topics and their QoS (the contract: docs/dds.md). Writers and readers both use these, so a
 // reader never silently falls back to Cyclone's BEST_EFFORT/VOLATILE defaults.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The cell pipeline: one cell's incremental processing of sweeps, self filter → fusion → change detection →
 // re-segmentation of the changed regions only → reconciliation with the current boxes. Its output is the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One cloud → boxes by the cell pipeline's own stages: the batch tool's path (`cellmap segment`,
 // `cellmap sensor-comparison`). The cloud becomes the occupied voxels of the map's grid, groups too small to

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // How the posed frames of a cell's sensors (one or several cameras, each on the tool or fixed) become sweeps:
 // grouped by their stamps into sweep windows, whichever sensor took them.

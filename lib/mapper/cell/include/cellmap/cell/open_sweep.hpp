@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The per-frame part of the cell pipeline: each frame of a sweep cut (self filter), converted to its scan
 // and its observed voxels gathered as it arrives, so that the end of a sweep leaves only the map update,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Change detection: which parts of the occupancy map changed, as connected regions with bounds, with
 // hysteresis so that sensor noise does not produce changes.

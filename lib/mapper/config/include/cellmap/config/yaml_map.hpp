@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Strict reading of YAML configuration maps: every key is either read or reported as unknown.
 

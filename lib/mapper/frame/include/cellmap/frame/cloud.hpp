@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The point cloud type the map-making stages exchange (PCL; the planner's client never sees it).
 

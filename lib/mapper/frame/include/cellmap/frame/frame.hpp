@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One sensor frame and the depth-image → points conversion every camera source shares.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Joint-state input of the map maker: stamped joint samples of the robot (cellmap/robot_joints, a
 // simulator), interpolated to frame times and turned into link poses by the robot model. The joint-space

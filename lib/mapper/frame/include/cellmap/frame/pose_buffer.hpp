@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Robot pose input of the map maker: stamped end-effector poses, interpolated to frame times, and the
 // composition X_CS = X_CE * X_ES that gives every frame its sensor pose.

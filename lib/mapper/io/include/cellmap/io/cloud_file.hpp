@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading point cloud files (PCD, PLY) into the cloud type the stages exchange.
 

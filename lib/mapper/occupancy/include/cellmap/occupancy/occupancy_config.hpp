@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Parameters of the occupancy map: OctoMap's probabilistic sensor model plus the range and threads of the
 // sweep fusion.

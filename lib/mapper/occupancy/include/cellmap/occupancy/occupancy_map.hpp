@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The occupancy map: an octomap::OcTree that each sweep updates with hits at the points and free-space
 // evidence along the rays from each scan's origin.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Exact nearest-neighbour and radius queries on a cloud's points, for the stages that search a cloud point
 // by point (neighbourhoods, region growing's leftovers, convex merging's patches, supervoxel filling).

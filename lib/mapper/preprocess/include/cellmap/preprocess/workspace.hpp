@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot's reachable workspace, used to crop clouds to what can matter for collisions.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Few, tight boxes: a segment's box is split where the parts' boxes block markedly less free space, and
 // boxes are joined where their union box blocks little more. Both judge free space as the sensor saw it

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Object-level merging: join segments across convex edges, keep concave edges as splits (LCCP's criterion).
 

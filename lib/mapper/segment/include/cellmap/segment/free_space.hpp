@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the sensor saw to be free around a group of points: the measure behind splitting and merging boxes.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The paper's batch pipeline on one cloud: crop → neighbourhoods and features (eq. 1, 2) → outlier removal →
 // region growing → leftovers → convex merge → split (the paper's VCCS, or by free space) → join by free space

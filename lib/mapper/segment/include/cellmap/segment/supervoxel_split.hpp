@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Splitting oversized segments into VCCS supervoxels (paper fig. 3/4): one box around a very large cluster
 // swallows free workspace. The paper: K. Zauner, J. El Dib, H. Gattringer, A. Müller, "Workspace Registration

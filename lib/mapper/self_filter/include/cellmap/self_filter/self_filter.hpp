@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The self filter: a frame's measurements of the robot itself (its links' collision shapes at the frame's
 // joint state, and the payload it holds) are removed before fusion, so the robot never becomes an obstacle.

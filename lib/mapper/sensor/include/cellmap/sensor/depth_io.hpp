@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Depth images on disk: 16-bit PNG and TIFF, and the intrinsics files that go with them.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The one interface every depth camera source implements (OpenNI2, V4L2, replay), and the value types they
 // share: depth modes, source status, device descriptions.

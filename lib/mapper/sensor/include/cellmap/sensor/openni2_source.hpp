@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Kinect-class depth cameras (PrimeSense, Xtion, Kinect via its OpenNI2 driver) and .oni recordings, through
 // OpenNI2 (Debian libopenni2; drivers in /usr/lib/x86_64-linux-gnu/OpenNI2/Drivers).

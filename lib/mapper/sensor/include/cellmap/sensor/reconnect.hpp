@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // When a camera source should try to (re)connect: a small state machine driven by a clock the caller passes
 // in.

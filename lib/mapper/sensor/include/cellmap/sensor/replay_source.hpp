@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Replay of recorded frames from a directory: reproduces a field problem on a desk.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One sensor's configuration: which source it is, its settings and its hand-eye extrinsic; and the factory
 // that builds the source.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Depth cameras that expose 16-bit depth as a V4L2 video device (Intel RealSense D4xx through the uvcvideo
 // driver: one of its /dev/videoN nodes offers the Z16 pixel format), through libv4l2.

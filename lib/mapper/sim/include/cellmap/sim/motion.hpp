@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What moves in the simulated cell while frames are taken: the robot along a production path (with what it
 // picks and places) and people walking through. Plain value types; the Simulator renders them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Ray casting against the scene's primitives (boxes, cylinders, spheres) and the robot's collision shapes
 // (primitives and triangle meshes) at its joint state.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Files of a simulated sweep beside the replay directory format of the sensor stage (replay_source.hpp, whose
 // depth PNG writer and poses.csv we reuse): the frames file with sensor poses and joint vectors, intrinsics,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The simulated cell: its bounds, the obstacles in it, the robot, the sensors (on the robot or fixed), the
 // sweep plan, and what moves while frames are taken (the robot's motion, walkers).

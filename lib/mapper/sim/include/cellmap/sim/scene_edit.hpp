@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Changes to a simulated scene between sweeps: how tests and `cellmap inject` plant synthetic changes. The
 // edit is the cellmap/sim/scene_edits topic's value type, transport::SceneEdit.

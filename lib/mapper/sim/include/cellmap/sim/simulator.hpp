@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The simulated sensors: frames rendered by ray casting the scene from the robot's sensor poses.
 

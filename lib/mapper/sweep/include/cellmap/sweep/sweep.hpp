@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A sweep: the frames taken at the stops of one pass over the working area, in the cell frame.
 

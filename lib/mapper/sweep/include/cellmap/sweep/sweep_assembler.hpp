@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // How a camera's stream of frames becomes sweeps: each frame gets its sensor pose from the robot's poses
 // (X_CS = X_CE(stamp) * X_ES), frames without a pose are dropped, and posed frames are grouped by their

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Unknown space: the voxels of the workspace that no sensor has observed (never hit, never crossed by a ray;
 // the robot's body, which the self filter cuts out, included), covered by few conservative axis-aligned
