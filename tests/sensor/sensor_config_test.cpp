@@ -91,26 +91,3 @@ TEST(SensorConfigTest, ErrorsNameTheKey) {
 
 }  // namespace
 }  // namespace cellmap
-
-namespace cellmap {
-namespace {
-
-TEST(SensorConfigTest, TheExampleConfigParses) {
-  YamlMap root = YamlMap::load(std::string(CELLMAP_SOURCE_DIR) + "/config/sensors.example.yaml");
-  YamlMap sensors = root.child("sensors");
-  std::vector<std::string> kinds;
-  for (const auto& entry : sensors.node()) {
-    const std::string name = entry.first.as<std::string>();
-    YamlMap map = sensors.child(name);
-    const SensorConfig config = read_sensor_config(map, name);
-    EXPECT_EQ(make_depth_source(config)->name(), name);
-    kinds.push_back(std::holds_alternative<OpenNI2Config>(config.source) ? "openni2"
-                    : std::holds_alternative<V4l2Config>(config.source)  ? "v4l2"
-                                                                         : "replay");
-  }
-  EXPECT_EQ(kinds, (std::vector<std::string>{"openni2", "v4l2", "replay"}));
-  root.expect_all_read();
-}
-
-}  // namespace
-}  // namespace cellmap
