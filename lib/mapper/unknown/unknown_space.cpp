@@ -79,10 +79,8 @@ std::size_t mask_index(const Eigen::Vector3i& size, int x, int y, int z) {
 }
 
 // The unknown voxels that some all-unknown cube of `edge` voxels holds: the pockets worth covering.
-VoxelMask pockets(const VoxelStateGrid& grid, int edge) {
+VoxelMask pockets(const VoxelStateGrid& grid, const VoxelCounts& unknown, int edge) {
   const Eigen::Vector3i& size = grid.size();
-  const VoxelCounts unknown(size,
-                            [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
   const long long full = static_cast<long long>(edge) * edge * edge;
   const Eigen::Vector3i cube = Eigen::Vector3i::Constant(edge);
   // A cube fits with its low corner at v.
@@ -307,7 +305,9 @@ UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& conf
   config.validate();
   const Eigen::Vector3i& size = grid.size();
   const int edge = std::max(1, static_cast<int>(std::ceil(config.min_size / grid.resolution() - 1e-9)));
-  const VoxelMask pocket = pockets(grid, edge);
+  const VoxelCounts unknown(size,
+                            [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
+  const VoxelMask pocket = pockets(grid, unknown, edge);
   const CoverCounts counts{
       VoxelCounts(size, [&](int x, int y, int z) { return pocket[mask_index(size, x, y, z)] != 0; }),
       VoxelCounts(size, [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::free; })};
@@ -320,8 +320,6 @@ UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& conf
 
   const double voxel_volume = std::pow(grid.resolution(), 3);
   const IndexBox whole{Eigen::Vector3i::Zero(), size};
-  const VoxelCounts unknown(size,
-                            [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
   UnknownCover cover;
   for (const IndexBox& box : boxes) cover.boxes.push_back(to_box(box, grid, counts.pocket));
   const auto [boxed, blocked_free] = boxed_voxels(boxes, grid);
