@@ -76,6 +76,34 @@ std::vector<std::string> sensor_names(const DaemonConfig& config) {
   return names;
 }
 
+void describe_unknown_space(const UnknownSpaceConfig& unknown) {
+  if (!unknown.enabled) {
+    spdlog::warn("unknown space off (unknown.enabled: false): planners take space no sensor has seen for free");
+  } else if (!unknown.workspace) {
+    spdlog::warn(
+        "unknown space not tracked: no workspace (set unknown.workspace or segment.workspace); planners take "
+        "space no sensor has seen for free");
+  } else {
+    const Region& w = *unknown.workspace;
+    spdlog::info("unknown space tracked in [{}, {}, {}]–[{}, {}, {}] m: pockets from {} m, at most {} boxes",
+                 w.min.x(), w.min.y(), w.min.z(), w.max.x(), w.max.y(), w.max.z(), unknown.cover.min_size,
+                 unknown.cover.max_boxes);
+  }
+}
+
+void log_unknown_space(const SweepReport& report, const std::optional<UnknownCover>& cover) {
+  if (report.unknown.empty()) return;
+  spdlog::info("unknown space: {} added, {} shrunk, {} removed, {} unknown boxes ({:.3f} s)",
+               report.unknown.added.size(), report.unknown.modified.size(), report.unknown.removed.size(),
+               report.unknown_boxes, report.t_unknown);
+  if (!report.unknown_covered || !cover) return;
+  spdlog::info(
+      "unknown space: {:.2f} of {:.2f} m³ of the workspace never observed ({:.0f} %), {:.2f} m³ of it in "
+      "pockets under unknown.min_size left out; the unknown boxes hold {:.2f} m³, {:.2f} m³ of it seen free",
+      cover->unknown_volume, cover->grid_volume, 100.0 * cover->unknown_volume / cover->grid_volume,
+      cover->ignored_volume, cover->boxed_volume, cover->blocked_free_volume);
+}
+
 }  // namespace
 
 Daemon::Daemon(DaemonConfig config, RunOptions options)
@@ -106,6 +134,7 @@ Daemon::Daemon(DaemonConfig config, RunOptions options)
   spdlog::info("cell '{}' on DDS domain {}, state in {}, source {}, version {}", config_.cell, config_.domain,
                store_.directory().string(), acquisition_->describe(), keeper_.published().version());
   if (!ros2_outputs_.describe().empty()) spdlog::info("ROS 2 outputs: {}", ros2_outputs_.describe());
+  describe_unknown_space(config_.pipeline.unknown);
 }
 
 void Daemon::use_self_filter() {
@@ -282,6 +311,7 @@ std::optional<SweepReport> Daemon::run_pipeline(GatheredSweep& sweep, std::uint6
         number, report.frames, report.points, report.robot_points, report.hit_voxels, report.free_voxels,
         report.flipped, report.regions, report.boxes, report.t_filter, report.t_fuse, report.t_update,
         report.t_change, report.t_segment, sweeps_.dropped(), dropped_frames());
+    log_unknown_space(report, pipeline_.unknown_cover());
     return report;
   } catch (const Error& e) {
     health_.sweep_failed("sweep " + std::to_string(number) + ": " + e.what());

@@ -75,7 +75,7 @@ void VersionKeeper::flush(const CellPipeline& pipeline) {
 }
 
 void VersionKeeper::publish_boxes(const CellPipeline& pipeline) {
-  if (save_due(pipeline.boxes())) save(pipeline);
+  if (save_due(pipeline.environment_boxes())) save(pipeline);
   if (saved_.version() > published_.version()) publish_saved();
 }
 
@@ -103,7 +103,7 @@ bool VersionKeeper::save_due(const std::vector<Box>& boxes) {
 }
 
 void VersionKeeper::save(const CellPipeline& pipeline) {
-  const Environment next(saved_.cell(), store_.next_version(), next_stamp(), pipeline.boxes());
+  const Environment next(saved_.cell(), store_.next_version(), next_stamp(), pipeline.environment_boxes());
   try {
     store_.save(next, std::nullopt, pipeline.next_box_id());
   } catch (const Error& e) {

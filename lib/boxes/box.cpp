@@ -55,6 +55,12 @@ class Reader {
     return out;
   }
 
+  BoxSpace space(const json& value, const std::string& where) const {
+    if (value == "occupied") return BoxSpace::kOccupied;
+    if (value == "unknown") return BoxSpace::kUnknown;
+    fail(where, "must be \"occupied\" or \"unknown\"");
+  }
+
  private:
   std::string source_;
 };
@@ -70,15 +76,21 @@ bool Box::is_axis_aligned() const {
   return rotation.angularDistance(Eigen::Quaterniond::Identity()) == 0.0;
 }
 
+const char* space_name(BoxSpace space) {
+  return space == BoxSpace::kUnknown ? "unknown" : "occupied";
+}
+
 std::string to_json(const BoxSet& set) {
   json boxes = json::array();
   for (const Box& box : set.boxes) {
     const Eigen::Quaterniond& q = box.rotation;
-    boxes.push_back({{"id", box.id},
-                     {"center", vector_json(box.center)},
-                     {"half_extents", vector_json(box.half_extents)},
-                     {"rotation", json::array({q.w(), q.x(), q.y(), q.z()})},
-                     {"points", box.points}});
+    json item = {{"id", box.id},
+                 {"center", vector_json(box.center)},
+                 {"half_extents", vector_json(box.half_extents)},
+                 {"rotation", json::array({q.w(), q.x(), q.y(), q.z()})},
+                 {"points", box.points}};
+    if (box.space != BoxSpace::kOccupied) item["space"] = space_name(box.space);
+    boxes.push_back(std::move(item));
   }
   json doc = {{"version", set.version}, {"frame", set.frame}, {"boxes", boxes}};
   return doc.dump(1) + "\n";
@@ -115,6 +127,8 @@ BoxSet box_set_from_json(const std::string& text, const std::string& source) {
     // from disk must equal the one written (or a restart reports it as modified).
     if (std::abs(box.rotation.norm() - 1.0) > 1e-14) box.rotation.normalize();
     box.points = reader.count(reader.field(item, "points", where), where + ".points");
+    if (const auto space = item.find("space"); space != item.end())
+      box.space = reader.space(*space, where + ".space");
     set.boxes.push_back(box);
   }
   return set;

@@ -44,7 +44,7 @@ const Box* Environment::find(std::uint64_t id) const {
 
 bool same_box(const Box& a, const Box& b) {
   return a.id == b.id && a.center == b.center && a.half_extents == b.half_extents &&
-         a.rotation.coeffs() == b.rotation.coeffs() && a.points == b.points;
+         a.rotation.coeffs() == b.rotation.coeffs() && a.points == b.points && a.space == b.space;
 }
 
 bool operator==(const Environment& a, const Environment& b) {

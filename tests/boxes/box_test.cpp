@@ -62,6 +62,23 @@ TEST(BoxTest, JsonMatchesTheContract) {
   EXPECT_DOUBLE_EQ(set.boxes[0].half_extents.z(), 0.1);
 }
 
+TEST(BoxTest, SpaceIsWrittenForUnknownBoxesOnlyAndReadBack) {
+  Box unknown = rotated_box();
+  unknown.space = BoxSpace::kUnknown;
+  const std::string text = to_json(BoxSet{1, "cell", {unknown, Box{}}});
+  EXPECT_NE(text.find("\"space\": \"unknown\""), std::string::npos);
+  EXPECT_EQ(text.find("\"occupied\""), std::string::npos);  // absent means occupied
+  const BoxSet back = box_set_from_json(text);
+  ASSERT_EQ(back.boxes.size(), 2u);
+  EXPECT_EQ(back.boxes[0].space, BoxSpace::kUnknown);
+  EXPECT_EQ(back.boxes[1].space, BoxSpace::kOccupied);
+  // Older files have no space at all: every box in them holds occupied space.
+  const BoxSet old = box_set_from_json(R"({"version": 1, "frame": "cell", "boxes": [{"id": 1,
+      "center": [0, 0, 0], "half_extents": [1, 1, 1], "rotation": [1, 0, 0, 0], "points": 0}]})");
+  EXPECT_EQ(old.boxes[0].space, BoxSpace::kOccupied);
+  EXPECT_STREQ(space_name(BoxSpace::kUnknown), "unknown");
+}
+
 std::string error_of(const std::string& text) {
   try {
     (void)box_set_from_json(text, "in.json");
@@ -85,6 +102,9 @@ TEST(BoxTest, MalformedJsonNamesTheField) {
   EXPECT_EQ(error_of(R"({"version": 1, "frame": "cell", "boxes": [{"id": 1, "center": [0, 0, 0],
       "half_extents": [1, 1, 1], "rotation": [2, 0, 0, 0], "points": 0}]})"),
             "in.json: boxes[0].rotation: must be a unit quaternion [w, x, y, z]");
+  EXPECT_EQ(error_of(R"({"version": 1, "frame": "cell", "boxes": [{"id": 1, "center": [0, 0, 0],
+      "half_extents": [1, 1, 1], "rotation": [1, 0, 0, 0], "points": 0, "space": "hazard"}]})"),
+            "in.json: boxes[0].space: must be \"occupied\" or \"unknown\"");
 }
 
 }  // namespace

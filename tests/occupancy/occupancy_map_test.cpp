@@ -298,6 +298,16 @@ TEST(OccupancyMapTest, ReportsFlipsAndStates) {
   const OccupancyUpdate second = map.integrate(sweep);
   EXPECT_TRUE(second.appeared.empty());
   EXPECT_TRUE(second.vanished.empty());
+  // Newly observed: every voxel the first sweep made known (leaves of pruned blocks counted whole), none of
+  // the second, which looked at the same space.
+  std::size_t known = 0;
+  for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it) {
+    known += std::size_t{1} << (3 * (map.tree().getTreeDepth() - it.getDepth()));
+  }
+  EXPECT_EQ(first.newly_observed, known);
+  EXPECT_EQ(second.newly_observed, 0u);
+  const OccupancyUpdate aside = map.integrate(sweep_of(scene, {camera_at({0, 0, 0}, 0.6)}));
+  EXPECT_GT(aside.newly_observed, 0u);  // tilted, it sees space beside the first view's
 }
 
 // A removed object vanishes after exactly config.sweeps_to_clear() sweeps that see through it.

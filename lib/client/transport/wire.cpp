@@ -39,6 +39,7 @@ cellmap_msg_Box to_msg(const Box& box) {
   msg.rotation[2] = box.rotation.y();
   msg.rotation[3] = box.rotation.z();
   msg.points = box.points;
+  msg.space = static_cast<std::uint8_t>(box.space);
   return msg;
 }
 
@@ -68,6 +69,9 @@ Box from_msg(const cellmap_msg_Box& msg, const std::string& where) {
   box.rotation = Eigen::Quaterniond(msg.rotation[0], msg.rotation[1], msg.rotation[2], msg.rotation[3]);
   if (std::abs(box.rotation.norm() - 1.0) > 1e-6) throw Error(where + ".rotation: must be a unit quaternion");
   box.points = msg.points;
+  if (msg.space > static_cast<std::uint8_t>(BoxSpace::kUnknown))
+    throw Error(where + ".space: " + std::to_string(msg.space) + " is not 0 (occupied) or 1 (unknown)");
+  box.space = static_cast<BoxSpace>(msg.space);
   return box;
 }
 

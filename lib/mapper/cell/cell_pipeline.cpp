@@ -109,6 +109,19 @@ CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> bo
     throw Error("change.gather_sweeps: must be an integer in [0, 1000], got " +
                 std::to_string(config_.gather_sweeps));
   if (map_state) restore(*map_state);
+  start_unknown(boxes_);
+}
+
+// Splits the boxes the cell started from: obstacle boxes stay, unknown boxes go to the tracker (or are
+// dropped when unknown space is not tracked: the next version removes them).
+void CellPipeline::start_unknown(std::vector<Box>& boxes) {
+  std::vector<Box> unknown;
+  const auto is_unknown = [](const Box& b) { return b.space == BoxSpace::kUnknown; };
+  std::copy_if(boxes.begin(), boxes.end(), std::back_inserter(unknown), is_unknown);
+  boxes.erase(std::remove_if(boxes.begin(), boxes.end(), is_unknown), boxes.end());
+  if (!config_.unknown.active()) return;
+  unknown_.emplace(config_.unknown, unknown);
+  unknown_due_ = !settling_ && unknown.empty();
 }
 
 CellPipeline::~CellPipeline() = default;
@@ -167,6 +180,12 @@ std::size_t CellPipeline::settle_on(const Cloud& points_C) {
 
 void CellPipeline::filter_robot(const Robot& robot) {
   filter_ = std::make_unique<SelfFilter>(robot, config_.self_filter);
+  robot_parts_ = robot.shape_boxes();
+  for (LinkBox& part : robot_parts_) {
+    part.half_extents = part.half_extents * config_.self_filter.padding_scale +
+                        Eigen::Vector3d::Constant(config_.self_filter.padding);
+  }
+  robot_links_.assign(robot.shape_links().begin(), robot.shape_links().end());
   open_.reset();
 }
 
@@ -192,6 +211,9 @@ SweepReport CellPipeline::process(GatheredSweep& sweep) {
   report.cpu_filter = sweep.cpu_filter;
   report.t_gathering = sweep.t_gathering;
   if (!sweep.frames.frames.empty()) viewpoint_C_ = sweep.viewpoint_C;
+  for (const SweepFrame& frame : sweep.frames.frames) {
+    if (frame.robot) robot_at_ = frame.robot;
+  }
 
   const StageClock update_clock;
   const OccupancyUpdate update = map_.integrate(sweep.voxels);
@@ -228,15 +250,73 @@ void CellPipeline::detect_and_resegment(const OccupancyUpdate& update, SweepRepo
   change_clock.add_to(report.t_change, report.cpu_change);
   report.regions = changes.regions.size();
   report.boxes = boxes_.size();
-  if (!resegmentation_due(changes)) return;
 
-  const StageClock segment_clock;
-  // The map has settled: one segmentation of all of it makes the first version; changes from then on.
-  Resegmentation resegmentation = settling_ ? resegment_everything() : resegment(changes);
-  settling_ = false;
-  segment_clock.add_to(report.t_segment, report.cpu_segment);
-  report.changes = std::move(changes);
-  apply(std::move(resegmentation), report);
+  const bool due = resegmentation_due(changes);
+  const bool first_version = due && settling_;
+  if (due) {
+    const StageClock segment_clock;
+    // The map has settled: one segmentation of all of it makes the first version; changes from then on.
+    Resegmentation resegmentation = settling_ ? resegment_everything() : resegment(changes);
+    settling_ = false;
+    segment_clock.add_to(report.t_segment, report.cpu_segment);
+    report.changes = std::move(changes);
+    apply(std::move(resegmentation), report);
+  }
+  track_unknown(update, first_version, report);
+}
+
+void CellPipeline::track_unknown(const OccupancyUpdate& update, bool first_version, SweepReport& report) {
+  if (!unknown_) return;
+  observed_since_check_ += update.newly_observed;
+  ++sweeps_since_check_;
+  const bool cover = first_version || (unknown_due_ && !settling_);
+  const bool check =
+      !settling_ && observed_since_check_ > 0 && sweeps_since_check_ >= config_.unknown.check_sweeps;
+  if (cover || check) {
+    const StageClock clock;
+    double cpu = 0;
+    report.unknown = cover ? unknown_->cover_all(map_, robot_body_C(), next_box_id_)
+                           : unknown_->shrink(map_, robot_body_C(), next_box_id_);
+    clock.add_to(report.t_unknown, cpu);
+    report.unknown_covered = cover;
+    unknown_due_ = false;
+    observed_since_check_ = 0;
+    sweeps_since_check_ = 0;
+  }
+  report.unknown_boxes = unknown_->boxes().size();
+}
+
+std::vector<Box> CellPipeline::robot_body_C() const {
+  std::vector<Box> body;
+  if (!robot_at_) return body;
+  for (std::size_t i = 0; i < robot_parts_.size(); ++i) {
+    if (robot_links_[i] >= robot_at_->X_CL.size()) continue;
+    const Eigen::Isometry3d X_CB = robot_at_->X_CL[robot_links_[i]] * robot_parts_[i].X_LB;
+    Box part;
+    part.center = X_CB.translation();
+    part.rotation = Eigen::Quaterniond(X_CB.rotation());
+    part.half_extents = robot_parts_[i].half_extents;
+    body.push_back(part);
+  }
+  return body;
+}
+
+const std::vector<Box>& CellPipeline::unknown_boxes() const {
+  static const std::vector<Box> kNone;
+  return unknown_ ? unknown_->boxes() : kNone;
+}
+
+std::vector<Box> CellPipeline::environment_boxes() const {
+  std::vector<Box> all = boxes_;
+  const std::vector<Box>& unknown = unknown_boxes();
+  all.insert(all.end(), unknown.begin(), unknown.end());
+  std::sort(all.begin(), all.end(), [](const Box& a, const Box& b) { return a.id < b.id; });
+  return all;
+}
+
+std::optional<UnknownCover> CellPipeline::unknown_cover() const {
+  if (!unknown_ || unknown_->last_cover().grid_volume <= 0) return std::nullopt;
+  return unknown_->last_cover();
 }
 
 void CellPipeline::update_viewpoint(const Sweep& sweep) {

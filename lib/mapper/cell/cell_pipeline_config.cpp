@@ -24,6 +24,7 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   YamlMap segment = root.child("segment");
   YamlMap reconcile = root.child("reconcile");
   YamlMap self_filter = root.child("self_filter");
+  YamlMap unknown = root.child("unknown");
   CellPipelineConfig c;
   c.occupancy = OccupancyConfig::from_yaml(occupancy);
   // settle_sweeps and gather_sweeps sit in the `change` section (where operators look for them) but are the
@@ -36,6 +37,8 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   c.cover_every_version = reconcile.get<bool>("cover_every_version", c.cover_every_version);
   c.reconcile = read_reconcile(reconcile);
   c.self_filter = SelfFilterConfig::from_yaml(self_filter);
+  c.unknown = UnknownSpaceConfig::from_yaml(unknown);
+  if (!c.unknown.workspace && c.segment.workspace) c.unknown.workspace = c.segment.workspace->bounds();
   return c;
 }
 

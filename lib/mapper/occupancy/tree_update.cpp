@@ -36,6 +36,7 @@ class BatchApplier {
       const octomap::OcTreeKey key = brick.key(first);
       words[std::size_t(first >> 6)] &= ~(std::uint64_t{1} << (first & 63));
       const octomap::OcTreeNode* node = tree_.updateNode(key, occupied, false);
+      ++out_.newly_observed;
       if (occupied && tree_.isNodeOccupied(node)) out_.appeared.push_back(key);
     }
     brick_ = &brick;
@@ -90,6 +91,7 @@ class BatchApplier {
   // Updates `node`, a leaf or a node without children standing for every voxel of the bit range, all of
   // which get the same update, and records the voxels that flipped.
   void update_block(octomap::OcTreeNode* node, bool created, bool occupied, int begin, int count) {
+    if (created) out_.newly_observed += static_cast<std::size_t>(count);
     const bool was_occupied = !created && tree_.isNodeOccupied(node);
     tree_.updateNodeLogOdds(node, occupied ? hit_ : miss_);
     const bool now_occupied = tree_.isNodeOccupied(node);

@@ -206,14 +206,15 @@ void join_boxes(std::vector<IndexBox>& boxes, const VoxelCounts& free, const Unk
   }
 }
 
-Box to_box(const IndexBox& box, const VoxelStateGrid& grid, const VoxelCounts& pocket) {
+Box to_box(const IndexBox& box, const VoxelStateGrid& grid, const VoxelCounts& unknown) {
   const double r = grid.resolution();
   Box out;
   const Eigen::Vector3d low = grid.origin() + box.low.cast<double>() * r;
   const Eigen::Vector3d high = grid.origin() + box.high.cast<double>() * r;
   out.center = 0.5 * (low + high);
   out.half_extents = 0.5 * (high - low);
-  out.points = static_cast<std::uint64_t>(pocket.in(box));
+  out.points = static_cast<std::uint64_t>(unknown.in(box));
+  out.space = BoxSpace::kUnknown;
   return out;
 }
 
@@ -321,11 +322,11 @@ UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& conf
   const double voxel_volume = std::pow(grid.resolution(), 3);
   const IndexBox whole{Eigen::Vector3i::Zero(), size};
   UnknownCover cover;
-  for (const IndexBox& box : boxes) cover.boxes.push_back(to_box(box, grid, counts.pocket));
+  for (const IndexBox& box : boxes) cover.boxes.push_back(to_box(box, grid, unknown));
   const auto [boxed, blocked_free] = boxed_voxels(boxes, grid);
   cover.grid_volume = static_cast<double>(whole.voxels()) * voxel_volume;
   cover.unknown_volume = static_cast<double>(unknown.in(whole)) * voxel_volume;
-  cover.ignored_volume = static_cast<double>(unknown.in(whole)-counts.pocket.in(whole)) * voxel_volume;
+  cover.ignored_volume = static_cast<double>(unknown.in(whole) - counts.pocket.in(whole)) * voxel_volume;
   cover.blocked_free_volume = static_cast<double>(blocked_free) * voxel_volume;
   cover.boxed_volume = static_cast<double>(boxed) * voxel_volume;
   return cover;

@@ -22,18 +22,21 @@
 #include "cellmap/segment/pipeline.hpp"
 #include "cellmap/self_filter/self_filter.hpp"
 #include "cellmap/sweep/sweep.hpp"
+#include "cellmap/unknown/unknown_boxes.hpp"
 
 namespace cellmap {
 
 class OccupiedVoxels;
 
-/// Everything the cell pipeline is configured with: five sections of a config file and the settling policy.
+/// Everything the cell pipeline is configured with: six sections of a config file and the settling policy.
 struct CellPipelineConfig final {
   OccupancyConfig occupancy;     ///< `occupancy` section
   ChangeConfig change;           ///< `change` section (change detection)
   SegmentConfig segment;         ///< `segment` section: the keys of config/segment.yaml
   ReconcileParams reconcile;     ///< `reconcile` section
   SelfFilterConfig self_filter;  ///< `self_filter` section (used once the pipeline knows the robot)
+  /// `unknown` section; its workspace defaults to the bounds of `segment.workspace`.
+  UnknownSpaceConfig unknown;
   /// Sweeps fused into an empty map before its first version (`change.settle_sweeps`, [0, 100000]; default
   /// 15). A fresh map keeps gaining voxels for a while (surfaces seen at grazing angles need several sweeps
   /// to collect two hits, flying pixels in unobserved space decay slowly), so the first version is one
@@ -56,8 +59,8 @@ struct CellPipelineConfig final {
   bool cover_every_version = true;
 
   /// Reads the sections `occupancy`, `change` (settle_sweeps and gather_sweeps included), `segment`,
-  /// `reconcile` (cover_every_version included) and `self_filter` of `root` and marks them read; absent keys
-  /// keep the defaults above.
+  /// `reconcile` (cover_every_version included), `self_filter` and `unknown` of `root` and marks them read;
+  /// absent keys keep the defaults above.
   /// @throws Error naming the key ("change.settle_sweeps: ...") for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static CellPipelineConfig from_yaml(YamlMap& root);
 };
@@ -86,7 +89,11 @@ struct SweepReport final {
   /// shared machine hides.
   double cpu_filter = 0, cpu_fuse = 0, cpu_update = 0, cpu_change = 0, cpu_segment = 0;
   ChangeSet changes;  ///< the change regions re-segmented in this sweep (gathered over gather_sweeps)
-  std::optional<Reconciled> change;  ///< set when the boxes changed (a new version is due)
+  std::optional<Reconciled> change;  ///< set when the obstacle boxes changed (a new version is due)
+  UnknownChange unknown;             ///< what changed among the unknown boxes (not empty: a version is due)
+  std::size_t unknown_boxes = 0;     ///< unknown boxes after the sweep
+  bool unknown_covered = false;      ///< the workspace's unknown space was covered afresh (unknown_cover())
+  double t_unknown = 0;              ///< seconds spent covering or shrinking unknown space
 };
 
 /// Boxes re-fitted to the occupied evidence of an area and reconciled with the current boxes.
@@ -104,7 +111,8 @@ struct Resegmentation final {
 /// next id of the counter. Not thread-safe; one instance per cell, driven by one thread.
 class CellPipeline final {
  public:
-  /// Starts from `boxes` and, if `map_state` is given, the map saved by map_state() with the flips that were
+  /// Starts from `boxes` (obstacle and unknown boxes; the unknown ones are dropped when unknown space is not
+  /// tracked, and covered again from the map when it is but none was kept) and, if `map_state` is given, the map saved by map_state() with the flips that were
   /// pending then (else an empty map, which settles first). A map state of the older layout without them
   /// starts with no flip pending. `next_box_id` must be above every id this cell ever handed out (not only
   /// the ids in `boxes`): it is where the counter goes on. A map state written by an older version that still
@@ -164,7 +172,15 @@ class CellPipeline final {
   /// box in scope. Also the anchor that shows what resegment() saves.
   [[nodiscard]] Resegmentation resegment_everything() const;
 
+  /// The obstacle boxes, sorted by id.
   [[nodiscard]] const std::vector<Box>& boxes() const { return boxes_; }
+  /// The unknown boxes, sorted by id (none when unknown space is not tracked, and before the first version).
+  [[nodiscard]] const std::vector<Box>& unknown_boxes() const;
+  /// What the cell publishes: the obstacle and the unknown boxes, sorted by id.
+  [[nodiscard]] std::vector<Box> environment_boxes() const;
+  /// The figures of the last cover of the whole workspace's unknown space, if unknown space is tracked and a
+  /// cover was made since the start.
+  [[nodiscard]] std::optional<UnknownCover> unknown_cover() const;
   /// The id the next new box gets: above every id this pipeline handed out or was started with.
   [[nodiscard]] std::uint64_t next_box_id() const { return next_box_id_; }
   [[nodiscard]] const OccupancyMap& map() const { return map_; }
@@ -204,6 +220,7 @@ class CellPipeline final {
   // Makes the boxes of `reconciled` hold every obstacle voxel of the map whole (coverage.hpp).
   void cover_the_rest(Reconciled& reconciled) const;
   void restore(const std::string& map_state);
+  void start_unknown(std::vector<Box>& boxes);
   void update_viewpoint(const Sweep& sweep);
   // Change detection and, when due, re-segmentation after the map took the sweep's update.
   void detect_and_resegment(const OccupancyUpdate& update, SweepReport& report);
@@ -212,6 +229,10 @@ class CellPipeline final {
   [[nodiscard]] bool resegmentation_due(ChangeSet& changes);
   void apply(Resegmentation resegmentation, SweepReport& report);
   void accept_unboxed_vanishes();
+  // Covers unknown space after the first version, then shrinks it as sweeps observe new voxels.
+  void track_unknown(const OccupancyUpdate& update, bool first_version, SweepReport& report);
+  // The robot's padded collision shapes as boxes in the cell frame, at the last robot pose a frame carried.
+  [[nodiscard]] std::vector<Box> robot_body_C() const;
 
   CellPipelineConfig config_;
   std::unique_ptr<SelfFilter> filter_;  // set by filter_robot()
@@ -226,6 +247,13 @@ class CellPipeline final {
   int settled_sweeps_ = 0;  // sweeps fused while settling
   ChangeSet gathered_;      // confirmed changes waiting to be published together
   int gather_wait_ = 0;     // sweeps the gathered changes still wait
+  std::optional<UnknownBoxes> unknown_;  // set when unknown space is tracked
+  bool unknown_due_ = false;             // a settled map without unknown boxes: cover at the next sweep
+  std::size_t observed_since_check_ = 0;  // voxels first observed since unknown space was last checked
+  int sweeps_since_check_ = 0;
+  std::vector<LinkBox> robot_parts_;   // the robot's collision shapes' bounding boxes, padded
+  std::vector<std::size_t> robot_links_;  // the index of each part's link in Robot::link_names()
+  std::optional<RobotAt> robot_at_;   // the robot at the last frame that carried its pose
 };
 
 }  // namespace cellmap

@@ -24,6 +24,7 @@ namespace cellmap {
 struct OccupancyUpdate final {
   std::size_t hit_voxels = 0;                ///< voxels that received a hit
   std::size_t free_voxels = 0;               ///< voxels that received free-space evidence
+  std::size_t newly_observed = 0;            ///< voxels that were unknown before (never hit nor crossed)
   std::vector<octomap::OcTreeKey> appeared;  ///< voxels occupied now that were free or unknown before
   std::vector<octomap::OcTreeKey> vanished;  ///< voxels free now that were occupied before
 };
