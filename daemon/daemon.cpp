@@ -78,7 +78,8 @@ std::vector<std::string> sensor_names(const DaemonConfig& config) {
 
 void describe_unknown_space(const UnknownSpaceConfig& unknown) {
   if (!unknown.enabled) {
-    spdlog::warn("unknown space off (unknown.enabled: false): planners take space no sensor has seen for free");
+    spdlog::warn(
+        "unknown space off (unknown.enabled: false): planners take space no sensor has seen for free");
   } else if (!unknown.workspace) {
     spdlog::warn(
         "unknown space not tracked: no workspace (set unknown.workspace or segment.workspace); planners take "

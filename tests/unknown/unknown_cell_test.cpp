@@ -11,6 +11,7 @@
 #include "cellmap/config/yaml_map.hpp"
 #include "cellmap/sim/default_scene.hpp"
 #include "cellmap/sim/simulator.hpp"
+#include "cellmap/transport/messages.hpp"
 #include "cellmap/unknown/unknown_space.hpp"
 
 namespace cellmap {
@@ -63,6 +64,124 @@ TEST(UnknownCellTest, TheDefaultCellsUnseenSpaceOverTheTableIsFewBoxesHoldingEve
     for (const Box& box : cover.boxes) boxed = boxed || box.contains(hidden);
     EXPECT_TRUE(boxed) << hidden.transpose();
   }
+}
+
+// The default cell with a shelf over pallet b: a plate 0.33 m above the pallet, and under it, where the
+// Kinect looking down from the gantry never sees (it would need to look 54° off its axis; its half field of
+// view is 35°), a 16 cm cube.
+const Eigen::Vector3d kHidden(2.2, 1.4, 0.974);
+
+sim::Scene scene_with_a_shelf() {
+  sim::Scene scene = sim::default_scene();
+  sim::Obstacle shelf;
+  shelf.name = "shelf";
+  shelf.shape = BoxShape{{0.35, 0.3, 0.02}};
+  shelf.X_CO.translation() = Eigen::Vector3d(2.2, 1.4, 1.25);
+  sim::Obstacle hidden;
+  hidden.name = "hidden";
+  hidden.shape = BoxShape{{0.08, 0.08, 0.08}};
+  hidden.X_CO.translation() = kHidden;
+  scene.obstacles.push_back(shelf);
+  scene.obstacles.push_back(hidden);
+  return scene;
+}
+
+// The default cell's pipeline with unknown space tracked over the table (the scene's workspace).
+struct TrackedCell {
+  CellPipelineConfig config;
+  sim::Simulator simulator;
+  CellPipeline pipeline;
+  int kinect;
+  std::uint64_t sweeps = 0;
+
+  explicit TrackedCell(sim::Scene scene)
+      : config(tracked_config(scene)),
+        simulator(std::move(scene), sim::SimOptions{true, 2}),
+        pipeline(config, {}, 1),
+        kinect(simulator.scene().find_sensor("kinect")) {}
+
+  static CellPipelineConfig tracked_config(const sim::Scene& scene) {
+    YamlMap root = YamlMap::load(CELLMAP_SOURCE_DIR "/config/cellmapd.yaml");
+    CellPipelineConfig config = CellPipelineConfig::from_yaml(root);
+    config.unknown.workspace = scene.workspace;
+    return config;
+  }
+
+  SweepReport sweep() {
+    std::vector<Frame> frames;
+    for (sim::SimFrame& f : simulator.sweep(kinect, sweeps++)) frames.push_back(std::move(f.frame));
+    return pipeline.process(merge_frames(frames));
+  }
+  void settle() {
+    for (int i = 0; i <= config.settle_sweeps; ++i) sweep();
+  }
+};
+
+bool any_holds(const std::vector<Box>& boxes, const Eigen::Vector3d& p_C) {
+  for (const Box& box : boxes) {
+    if (box.contains(p_C)) return true;
+  }
+  return false;
+}
+
+TEST(UnknownCellTest, AnObjectNoSensorSeesIsInAnUnknownBoxUntilItComesIntoViewInOneVersion) {
+  TrackedCell cell(scene_with_a_shelf());
+  cell.settle();
+  const CellPipeline& pipeline = cell.pipeline;
+  ASSERT_FALSE(pipeline.unknown_boxes().empty());
+  EXPECT_LE(pipeline.unknown_boxes().size(), 20U);
+  EXPECT_FALSE(any_holds(pipeline.boxes(), kHidden)) << "the hidden cube has an obstacle box";
+  EXPECT_TRUE(any_holds(pipeline.unknown_boxes(), kHidden)) << "the hidden cube's place is not unknown";
+  const std::optional<UnknownCover> cover = pipeline.unknown_cover();
+  ASSERT_TRUE(cover.has_value());
+  std::printf(
+      "first version: %zu obstacle boxes, %zu unknown boxes; %.2f of %.2f m³ unknown, %.2f m³ boxed, "
+      "%.2f m³ of it seen free\n",
+      pipeline.boxes().size(), pipeline.unknown_boxes().size(), cover->unknown_volume, cover->grid_volume,
+      cover->boxed_volume, cover->blocked_free_volume);
+
+  transport::SceneEdit take_away;
+  take_away.kind = transport::SceneEdit::Kind::kRemove;
+  take_away.name = "shelf";
+  cell.simulator.apply(take_away);
+  // Every version from now on holds the cube's place in a box of one space or the other, and the version
+  // in which it stops being unknown is the one in which its obstacle box appears.
+  int versions = 0, sweeps = 0;
+  for (; sweeps < 40 && !any_holds(pipeline.boxes(), kHidden); ++sweeps) {
+    const SweepReport report = cell.sweep();
+    if (!report.change && report.unknown.empty()) continue;
+    ++versions;
+    EXPECT_TRUE(any_holds(pipeline.boxes(), kHidden) || any_holds(pipeline.unknown_boxes(), kHidden))
+        << "sweep " << sweeps << " leaves the cube's place in no box";
+  }
+  ASSERT_TRUE(any_holds(pipeline.boxes(), kHidden)) << "the cube never got an obstacle box";
+  EXPECT_FALSE(any_holds(pipeline.unknown_boxes(), kHidden));
+  std::printf("the cube appeared %d sweeps after the shelf went, in version %d of them\n", sweeps, versions);
+}
+
+// A settled cell that nothing changes in: noise never brings unknown space back, and its unknown boxes
+// stop changing once every view of the sweep has been seen a few times.
+TEST(UnknownCellTest, UnknownSpaceNeverGrowsBackOverNoisySweepsOfASettledCell) {
+  TrackedCell cell(sim::default_scene());
+  cell.settle();
+  const int sweeps = 1000;
+  int unknown_versions = 0, obstacle_versions = 0;
+  double volume = 0;
+  for (const Box& box : cell.pipeline.unknown_boxes()) volume += box.volume();
+  for (int i = 0; i < sweeps; ++i) {
+    const SweepReport report = cell.sweep();
+    obstacle_versions += report.change ? 1 : 0;
+    if (report.unknown.empty()) continue;
+    ++unknown_versions;
+    EXPECT_TRUE(report.unknown.added.empty() || !report.unknown.modified.empty()) << "sweep " << i;
+    double now = 0;
+    for (const Box& box : cell.pipeline.unknown_boxes()) now += box.volume();
+    EXPECT_LE(now, volume + 1e-9) << "sweep " << i << ": unknown boxes grew";
+    volume = now;
+  }
+  std::printf("%d sweeps: %d versions from unknown space, %d from obstacles, %zu unknown boxes\n", sweeps,
+              unknown_versions, obstacle_versions, cell.pipeline.unknown_boxes().size());
+  EXPECT_EQ(unknown_versions, 0);
 }
 
 }  // namespace

@@ -21,7 +21,10 @@ namespace {
 constexpr std::string_view kStateMagicV1 = "cellmap-map-state 1";
 constexpr std::string_view kStateMagicV2 = "cellmap-map-state 2";
 constexpr std::string_view kStateMagicV3 = "cellmap-map-state 3";
-constexpr std::string_view kStateMagic = "cellmap-map-state 4";
+constexpr std::string_view kStateMagicV4 = "cellmap-map-state 4";
+constexpr std::string_view kStateMagic = "cellmap-map-state 5";
+constexpr std::string_view kUnknownCovered = "unknown-space covered";
+constexpr std::string_view kUnknownNotCovered = "unknown-space not-covered";
 
 // A box re-fits only when it lost a tenth of its voxels: the table losing the few voxels an object removed
 // from it shared with its top layer keeps its boxes (still covering all it holds) instead of being split
@@ -121,7 +124,7 @@ void CellPipeline::start_unknown(std::vector<Box>& boxes) {
   boxes.erase(std::remove_if(boxes.begin(), boxes.end(), is_unknown), boxes.end());
   if (!config_.unknown.active()) return;
   unknown_.emplace(config_.unknown, unknown);
-  unknown_due_ = !settling_ && unknown.empty();
+  unknown_due_ = !settling_ && !unknown_covered_;
 }
 
 CellPipeline::~CellPipeline() = default;
@@ -133,7 +136,8 @@ void CellPipeline::restore(const std::string& map_state) {
   std::istringstream in(map_state);
   std::string magic;
   std::getline(in, magic);
-  if (magic != kStateMagic && magic != kStateMagicV3 && magic != kStateMagicV2 && magic != kStateMagicV1)
+  if (magic != kStateMagic && magic != kStateMagicV4 && magic != kStateMagicV3 && magic != kStateMagicV2 &&
+      magic != kStateMagicV1)
     throw Error("map state: not a cellmap map state (bad header)");
   if (magic == kStateMagicV2 || magic == kStateMagicV1) {
     std::uint64_t legacy_next_id = 0;
@@ -149,12 +153,20 @@ void CellPipeline::restore(const std::string& map_state) {
     viewpoint_C_ = viewpoint;
   }
   try {
-    if (magic == kStateMagic) detector_.read(in);
+    if (magic == kStateMagic || magic == kStateMagicV4) detector_.read(in);
   } catch (const Error& e) {
     throw Error(std::string("map state: ") + e.what());
   }
+  if (magic == kStateMagic) read_unknown_line(in);
   map_.read(in);
   *occupied_ = OccupiedVoxels(map_);
+}
+
+void CellPipeline::read_unknown_line(std::istream& in) {
+  std::string line;
+  std::getline(in, line);
+  if (line != kUnknownCovered && line != kUnknownNotCovered) throw Error("map state: bad unknown-space line");
+  unknown_covered_ = line == kUnknownCovered;
 }
 
 std::string CellPipeline::map_state() const {
@@ -163,6 +175,7 @@ std::string CellPipeline::map_state() const {
   out.precision(17);
   out << viewpoint_C_.x() << " " << viewpoint_C_.y() << " " << viewpoint_C_.z() << "\n";
   detector_.write(out);
+  out << (unknown_covered_ ? kUnknownCovered : kUnknownNotCovered) << "\n";
   map_.write(out);
   return out.str();
 }
@@ -262,16 +275,20 @@ void CellPipeline::detect_and_resegment(const OccupancyUpdate& update, SweepRepo
     report.changes = std::move(changes);
     apply(std::move(resegmentation), report);
   }
-  track_unknown(update, first_version, report);
+  track_unknown(update, due, first_version, report);
 }
 
-void CellPipeline::track_unknown(const OccupancyUpdate& update, bool first_version, SweepReport& report) {
+// Unknown space shrinks as sweeps observe voxels never observed before. Those are checked together with the
+// next re-segmentation, so that an object coming into view with the space behind it (a crate taken away)
+// is one version; or check_sweeps sweeps after the first of them, when no change follows.
+void CellPipeline::track_unknown(const OccupancyUpdate& update, bool resegmented, bool first_version,
+                                 SweepReport& report) {
   if (!unknown_) return;
+  if (update.newly_observed > 0 || observed_since_check_ > 0) ++sweeps_since_observed_;
   observed_since_check_ += update.newly_observed;
-  ++sweeps_since_check_;
   const bool cover = first_version || (unknown_due_ && !settling_);
-  const bool check =
-      !settling_ && observed_since_check_ > 0 && sweeps_since_check_ >= config_.unknown.check_sweeps;
+  const bool check = !settling_ && observed_since_check_ > 0 &&
+                     (resegmented || sweeps_since_observed_ >= config_.unknown.check_sweeps);
   if (cover || check) {
     const StageClock clock;
     double cpu = 0;
@@ -279,9 +296,10 @@ void CellPipeline::track_unknown(const OccupancyUpdate& update, bool first_versi
                            : unknown_->shrink(map_, robot_body_C(), next_box_id_);
     clock.add_to(report.t_unknown, cpu);
     report.unknown_covered = cover;
+    unknown_covered_ = unknown_covered_ || cover;
     unknown_due_ = false;
     observed_since_check_ = 0;
-    sweeps_since_check_ = 0;
+    sweeps_since_observed_ = 0;
   }
   report.unknown_boxes = unknown_->boxes().size();
 }

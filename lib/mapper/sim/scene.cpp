@@ -646,6 +646,14 @@ Scene parse_scene(const std::string& yaml, const std::string& source, const std:
   }
   std::vector<Walker> walkers;
   if (root.has("walkers")) walkers = read_list(root, "walkers", read_walker);
+  std::optional<Region> workspace;
+  if (root.has("workspace")) {
+    YamlMap map = root.child("workspace");
+    workspace = Region{map.vector3("lower"), map.vector3("upper")};
+    if (!(workspace->min.array() < workspace->max.array()).all())
+      map.fail("upper", "must be above lower on every axis");
+    map.expect_all_read();
+  }
   root.expect_all_read();
 
   Scene scene{cell,
@@ -654,7 +662,8 @@ Scene parse_scene(const std::string& yaml, const std::string& source, const std:
               std::move(sensors),
               std::move(plan),
               std::move(motion),
-              std::move(walkers)};
+              std::move(walkers),
+              workspace};
   try {
     scene.validate();
   } catch (const Error& e) {

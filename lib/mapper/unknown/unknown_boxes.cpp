@@ -28,7 +28,8 @@ VoxelStateGrid grid_of(const OccupancyMap& map, const Region& region, const std:
     for (int z = low.z(); z < high.z(); ++z) {
       for (int y = low.y(); y < high.y(); ++y) {
         for (int x = low.x(); x < high.x(); ++x) {
-          const Eigen::Vector3d centre = grid.origin() + (Eigen::Vector3d(x, y, z).array() + 0.5).matrix() * r;
+          const Eigen::Vector3d centre =
+              grid.origin() + (Eigen::Vector3d(x, y, z).array() + 0.5).matrix() * r;
           if (grid.at(x, y, z) == VoxelState::unknown && part.contains(centre))
             grid.set(x, y, z, VoxelState::occupied);
         }
@@ -66,7 +67,8 @@ void sort_by_id(std::vector<Box>& boxes) {
 
 Region read_region(YamlMap section) {
   Region region{section.vector3("lower"), section.vector3("upper")};
-  if ((region.min.array() >= region.max.array()).any()) section.fail("upper", "must be > lower on every axis");
+  if ((region.min.array() >= region.max.array()).any())
+    section.fail("upper", "must be > lower on every axis");
   section.expect_all_read();
   return region;
 }
@@ -76,7 +78,8 @@ Region read_region(YamlMap section) {
 void UnknownSpaceConfig::validate() const {
   cover.validate();
   if (!(shrink_share > 0.0) || shrink_share > 1.0) {
-    throw Error("unknown.shrink_share: expected more than 0 and at most 1, got " + std::to_string(shrink_share));
+    throw Error("unknown.shrink_share: expected more than 0 and at most 1, got " +
+                std::to_string(shrink_share));
   }
   if (check_sweeps < 1 || check_sweeps > 1000) {
     throw Error("unknown.check_sweeps: expected 1 to 1000, got " + std::to_string(check_sweeps));

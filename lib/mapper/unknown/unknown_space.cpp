@@ -326,7 +326,7 @@ UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& conf
   const auto [boxed, blocked_free] = boxed_voxels(boxes, grid);
   cover.grid_volume = static_cast<double>(whole.voxels()) * voxel_volume;
   cover.unknown_volume = static_cast<double>(unknown.in(whole)) * voxel_volume;
-  cover.ignored_volume = static_cast<double>(unknown.in(whole) - counts.pocket.in(whole)) * voxel_volume;
+  cover.ignored_volume = static_cast<double>(unknown.in(whole)-counts.pocket.in(whole)) * voxel_volume;
   cover.blocked_free_volume = static_cast<double>(blocked_free) * voxel_volume;
   cover.boxed_volume = static_cast<double>(boxed) * voxel_volume;
   return cover;

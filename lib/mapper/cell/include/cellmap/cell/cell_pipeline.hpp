@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -112,11 +113,13 @@ struct Resegmentation final {
 class CellPipeline final {
  public:
   /// Starts from `boxes` (obstacle and unknown boxes; the unknown ones are dropped when unknown space is not
-  /// tracked, and covered again from the map when it is but none was kept) and, if `map_state` is given, the map saved by map_state() with the flips that were
+  /// tracked) and, if `map_state` is given, the map saved by map_state() with the flips that were
   /// pending then (else an empty map, which settles first). A map state of the older layout without them
-  /// starts with no flip pending. `next_box_id` must be above every id this cell ever handed out (not only
-  /// the ids in `boxes`): it is where the counter goes on. A map state written by an older version that still
-  /// carries the counter raises it to that counter if higher.
+  /// starts with no flip pending; one of a layout from before unknown space (or of a map whose unknown space
+  /// was never covered) has its unknown space covered at the first sweep, when it is tracked. `next_box_id`
+  /// must be above every id this cell ever handed out (not only the ids in `boxes`): it is where the counter
+  /// goes on. A map state written by an older version that still carries the counter raises it to that
+  /// counter if higher.
   /// @throws Error if the config is invalid or the map state is unreadable.
   explicit CellPipeline(const CellPipelineConfig& config, std::vector<Box> boxes = {},
                         std::uint64_t next_box_id = 1,
@@ -221,6 +224,7 @@ class CellPipeline final {
   void cover_the_rest(Reconciled& reconciled) const;
   void restore(const std::string& map_state);
   void start_unknown(std::vector<Box>& boxes);
+  void read_unknown_line(std::istream& in);
   void update_viewpoint(const Sweep& sweep);
   // Change detection and, when due, re-segmentation after the map took the sweep's update.
   void detect_and_resegment(const OccupancyUpdate& update, SweepReport& report);
@@ -229,8 +233,9 @@ class CellPipeline final {
   [[nodiscard]] bool resegmentation_due(ChangeSet& changes);
   void apply(Resegmentation resegmentation, SweepReport& report);
   void accept_unboxed_vanishes();
-  // Covers unknown space after the first version, then shrinks it as sweeps observe new voxels.
-  void track_unknown(const OccupancyUpdate& update, bool first_version, SweepReport& report);
+  // Covers unknown space at the first version, then shrinks it as sweeps observe new voxels.
+  void track_unknown(const OccupancyUpdate& update, bool resegmented, bool first_version,
+                     SweepReport& report);
   // The robot's padded collision shapes as boxes in the cell frame, at the last robot pose a frame carried.
   [[nodiscard]] std::vector<Box> robot_body_C() const;
 
@@ -243,17 +248,18 @@ class CellPipeline final {
   std::vector<Box> boxes_;
   std::uint64_t next_box_id_;
   Eigen::Vector3d viewpoint_C_ = Eigen::Vector3d::Zero();  // where normals are oriented towards
-  bool settling_ = true;    // an empty map that has not made its first version yet
-  int settled_sweeps_ = 0;  // sweeps fused while settling
-  ChangeSet gathered_;      // confirmed changes waiting to be published together
-  int gather_wait_ = 0;     // sweeps the gathered changes still wait
-  std::optional<UnknownBoxes> unknown_;  // set when unknown space is tracked
-  bool unknown_due_ = false;             // a settled map without unknown boxes: cover at the next sweep
+  bool settling_ = true;                  // an empty map that has not made its first version yet
+  int settled_sweeps_ = 0;                // sweeps fused while settling
+  ChangeSet gathered_;                    // confirmed changes waiting to be published together
+  int gather_wait_ = 0;                   // sweeps the gathered changes still wait
+  std::optional<UnknownBoxes> unknown_;   // set when unknown space is tracked
+  bool unknown_covered_ = false;          // this map's unknown space was covered (kept in the map state)
+  bool unknown_due_ = false;              // a settled map whose unknown space was never covered: cover it now
   std::size_t observed_since_check_ = 0;  // voxels first observed since unknown space was last checked
-  int sweeps_since_check_ = 0;
-  std::vector<LinkBox> robot_parts_;   // the robot's collision shapes' bounding boxes, padded
+  int sweeps_since_observed_ = 0;         // sweeps since the first of them
+  std::vector<LinkBox> robot_parts_;      // the robot's collision shapes' bounding boxes, padded
   std::vector<std::size_t> robot_links_;  // the index of each part's link in Robot::link_names()
-  std::optional<RobotAt> robot_at_;   // the robot at the last frame that carried its pose
+  std::optional<RobotAt> robot_at_;       // the robot at the last frame that carried its pose
 };
 
 }  // namespace cellmap

@@ -124,6 +124,9 @@ struct Scene final {
   std::optional<Motion>
       motion;  ///< the robot moving all the time (Simulator::window); none: sweeps stop by stop
   std::vector<Walker> walkers;  ///< people walking through while the robot moves
+  /// Where unknown space matters in this cell (`workspace: {lower, upper}`): cellmapd's `unknown.workspace`
+  /// when its config names none. None: the daemon's config decides.
+  std::optional<Region> workspace;
 
   /// The plan `sensor` follows: its own, or the scene's.
   [[nodiscard]] const SweepPlan& plan_for(const SensorSpec& sensor) const;

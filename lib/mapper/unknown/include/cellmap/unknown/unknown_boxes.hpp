@@ -29,10 +29,12 @@ struct UnknownSpaceConfig final {
   /// has been observed (`unknown.shrink_share`, (0, 1]; default 0.1): unknown space shrinks in steps worth a
   /// version, not voxel by voxel with every noisy sweep.
   double shrink_share = 0.1;
-  /// Sweeps between two looks at whether a box shrank, counted only while sweeps observe voxels never
-  /// observed before (`unknown.check_sweeps`, [1, 1000]; default 5). A look costs a pass over the unknown
-  /// boxes' voxels.
-  int check_sweeps = 5;
+  /// Sweeps that voxels never observed before wait to be checked for whether a box shrank, unless a change
+  /// is re-segmented first, which checks them with it (`unknown.check_sweeps`, [1, 1000]; default 8). Above
+  /// change.persist_sweeps + change.gather_sweeps, an object that comes into view together with the unknown
+  /// space behind it (a crate taken away) is one version. A check costs a pass over the unknown boxes'
+  /// voxels.
+  int check_sweeps = 8;
 
   [[nodiscard]] bool active() const { return enabled && workspace.has_value(); }
   /// @throws Error naming the key ("unknown.shrink_share: ...") if a value is out of range.

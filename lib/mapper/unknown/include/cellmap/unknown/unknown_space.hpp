@@ -73,9 +73,10 @@ class VoxelStateGrid final {
 
 /// Unknown space covered with boxes, and what the cover costs, all in m³.
 struct UnknownCover final {
-  /// Axis-aligned unknown boxes (space unknown, rotation identity, id 0: the caller numbers them) in the cell frame,
-  /// each spanning whole voxels; `points` is the number of unknown voxels it holds (ignored ones included). Every unknown voxel that is
-  /// not ignored lies in at least one box. Sorted by (min z, min y, min x) corner.
+  /// Axis-aligned unknown boxes (space unknown, rotation identity, id 0: the caller numbers them) in the cell
+  /// frame, each spanning whole voxels; `points` is the number of unknown voxels it holds (ignored ones
+  /// included). Every unknown voxel that is not ignored lies in at least one box. Sorted by (min z, min y,
+  /// min x) corner.
   std::vector<Box> boxes;
   double grid_volume = 0.0;          ///< the whole grid (the workspace, to whole voxels)
   double unknown_volume = 0.0;       ///< never observed
