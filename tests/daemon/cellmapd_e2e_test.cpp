@@ -103,6 +103,13 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
     before_kill = settled(planner, status, "e2e", test::kLongQuietSweeps);
   }
   const std::uint64_t last = before_kill->version();
+  // The default scene names a workspace over the table: its unseen space is published as unknown boxes,
+  // which survive the kill with the obstacle boxes (compared box by box below).
+  const auto unknown = [](const Environment& env) {
+    return std::count_if(env.boxes().begin(), env.boxes().end(),
+                         [](const Box& box) { return box.space == BoxSpace::kUnknown; });
+  };
+  ASSERT_GT(unknown(*before_kill), 0) << "no unknown boxes before the kill";
   daemon->signal(SIGKILL);
   daemon->wait();
 
@@ -128,6 +135,7 @@ TEST_P(CellmapdE2eTest, KilledDaemonResumesWithoutReusingVersionsAndLateJoinerGe
     ASSERT_NE(same, nullptr) << "box " << old.id << " vanished in the restart";
     EXPECT_TRUE(same_box(*same, old)) << "box " << old.id << " changed in the restart";
   }
+  EXPECT_EQ(unknown(resumed), unknown(*before_kill));
 
   EXPECT_FALSE(
       inject(domain, {"add-box", "--center", "0.5,1.5,0.95", "--half-extents", "0.08,0.08,0.2"}).empty());

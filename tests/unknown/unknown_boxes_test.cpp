@@ -135,19 +135,18 @@ TEST(UnknownBoxesTest, ConfigReadsEveryKeyAndNamesBadOnes) {
   const UnknownSpaceConfig c = UnknownSpaceConfig::from_yaml(
       YamlMap::parse(
           "unknown: {enabled: true, workspace: {lower: [0, 0, 0], upper: [1, 2, 3]}, min_size: 0.2, "
-          "max_free_share: 0.1, max_boxes: 5, shrink_share: 0.5, check_sweeps: 3}",
+          "max_free_share: 0.1, max_boxes: 5, check_sweeps: 3}",
           "c.yaml")
           .child("unknown"));
   ASSERT_TRUE(c.workspace.has_value());
   EXPECT_EQ(c.workspace->max, Eigen::Vector3d(1, 2, 3));
   EXPECT_DOUBLE_EQ(c.cover.min_size, 0.2);
   EXPECT_EQ(c.cover.max_boxes, 5);
-  EXPECT_DOUBLE_EQ(c.shrink_share, 0.5);
   EXPECT_EQ(c.check_sweeps, 3);
   EXPECT_TRUE(c.active());
   EXPECT_FALSE(UnknownSpaceConfig{}.active());  // no workspace: not tracked
   EXPECT_NE(error_of("unknown: {colour: grey}").find("unknown.colour: unknown key"), std::string::npos);
-  EXPECT_NE(error_of("unknown: {shrink_share: 0}").find("unknown.shrink_share"), std::string::npos);
+  EXPECT_NE(error_of("unknown: {check_sweeps: 0}").find("unknown.check_sweeps"), std::string::npos);
   EXPECT_NE(
       error_of("unknown: {workspace: {lower: [0, 0, 0], upper: [1, 0, 1]}}").find("unknown.workspace.upper"),
       std::string::npos);

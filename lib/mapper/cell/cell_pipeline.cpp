@@ -292,8 +292,10 @@ void CellPipeline::track_unknown(const OccupancyUpdate& update, bool resegmented
   if (cover || check) {
     const StageClock clock;
     double cpu = 0;
-    report.unknown = cover ? unknown_->cover_all(map_, robot_body_C(), next_box_id_)
-                           : unknown_->shrink(map_, robot_body_C(), next_box_id_);
+    std::vector<Box> held = robot_body_C();
+    held.insert(held.end(), boxes_.begin(), boxes_.end());
+    report.unknown =
+        cover ? unknown_->cover_all(map_, held, next_box_id_) : unknown_->shrink(map_, held, next_box_id_);
     clock.add_to(report.t_unknown, cpu);
     report.unknown_covered = cover;
     unknown_covered_ = unknown_covered_ || cover;

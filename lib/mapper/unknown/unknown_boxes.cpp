@@ -10,12 +10,12 @@
 namespace cellmap {
 namespace {
 
-// The voxels of `map` whose centres lie in `region`, the robot's body taken as needing no cover: marked
+// The voxels of `map` whose centres lie in `region`, those in `held_C` taken as needing no cover: marked
 // occupied where unknown, which cover_unknown neither covers nor charges for.
-VoxelStateGrid grid_of(const OccupancyMap& map, const Region& region, const std::vector<Box>& robot_C) {
+VoxelStateGrid grid_of(const OccupancyMap& map, const Region& region, const std::vector<Box>& held_C) {
   VoxelStateGrid grid = VoxelStateGrid::of(map, region);
   const double r = grid.resolution();
-  for (const Box& part : robot_C) {
+  for (const Box& part : held_C) {
     const Eigen::Vector3d reach = part.rotation.toRotationMatrix().cwiseAbs() * part.half_extents;
     const Eigen::Vector3i low =
         ((part.center - reach - grid.origin()) / r).array().floor().cast<int>().max(0).matrix();
@@ -56,11 +56,6 @@ std::uint64_t unknown_voxels(const VoxelStateGrid& grid) {
   return count;
 }
 
-bool same_extent(const Box& a, const Box& b) {
-  return (a.center - b.center).cwiseAbs().maxCoeff() < 1e-9 &&
-         (a.half_extents - b.half_extents).cwiseAbs().maxCoeff() < 1e-9;
-}
-
 void sort_by_id(std::vector<Box>& boxes) {
   std::sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) { return a.id < b.id; });
 }
@@ -77,10 +72,6 @@ Region read_region(YamlMap section) {
 
 void UnknownSpaceConfig::validate() const {
   cover.validate();
-  if (!(shrink_share > 0.0) || shrink_share > 1.0) {
-    throw Error("unknown.shrink_share: expected more than 0 and at most 1, got " +
-                std::to_string(shrink_share));
-  }
   if (check_sweeps < 1 || check_sweeps > 1000) {
     throw Error("unknown.check_sweeps: expected 1 to 1000, got " + std::to_string(check_sweeps));
   }
@@ -93,7 +84,6 @@ UnknownSpaceConfig UnknownSpaceConfig::from_yaml(YamlMap section) {
   c.cover.min_size = section.number("min_size", c.cover.min_size, 0.0, 10.0);
   c.cover.max_free_share = section.number("max_free_share", c.cover.max_free_share, 0.0, 0.5);
   c.cover.max_boxes = static_cast<int>(section.integer("max_boxes", c.cover.max_boxes, 1, 10000));
-  c.shrink_share = section.number("shrink_share", c.shrink_share, 0.001, 1.0);
   c.check_sweeps = static_cast<int>(section.integer("check_sweeps", c.check_sweeps, 1, 1000));
   section.expect_all_read();
   return c;
@@ -107,9 +97,9 @@ UnknownBoxes::UnknownBoxes(UnknownSpaceConfig config, std::vector<Box> boxes)
   sort_by_id(boxes_);
 }
 
-UnknownChange UnknownBoxes::cover_all(const OccupancyMap& map, const std::vector<Box>& robot_C,
+UnknownChange UnknownBoxes::cover_all(const OccupancyMap& map, const std::vector<Box>& held_C,
                                       std::uint64_t& next_id) {
-  last_cover_ = cover_unknown(grid_of(map, *config_.workspace, robot_C), config_.cover);
+  last_cover_ = cover_unknown(grid_of(map, *config_.workspace, held_C), config_.cover);
   UnknownChange change;
   for (const Box& old : boxes_) change.removed.push_back(old.id);
   boxes_.clear();
@@ -122,19 +112,18 @@ UnknownChange UnknownBoxes::cover_all(const OccupancyMap& map, const std::vector
   return change;
 }
 
-UnknownChange UnknownBoxes::shrink(const OccupancyMap& map, const std::vector<Box>& robot_C,
+UnknownChange UnknownBoxes::shrink(const OccupancyMap& map, const std::vector<Box>& held_C,
                                    std::uint64_t& next_id) {
   const double r = map.config().resolution;
   UnknownChange change;
   std::vector<Box> kept;
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
     const Box& box = boxes_[i];
-    const VoxelStateGrid grid = grid_of(map, voxels_of(box, r), robot_C);
+    const VoxelStateGrid grid = grid_of(map, voxels_of(box, r), held_C);
     const std::uint64_t left = unknown_voxels(grid);
     const auto counted = counted_.find(box.id);
-    const std::uint64_t before = counted != counted_.end() ? counted->second : box.points;
-    if (static_cast<double>(left) > (1.0 - config_.shrink_share) * static_cast<double>(before)) {
-      kept.push_back(box);
+    if (left >= (counted != counted_.end() ? counted->second : box.points)) {
+      kept.push_back(box);  // nothing observed in it since it was last looked at
       continue;
     }
     UnknownConfig within = config_.cover;
@@ -146,8 +135,8 @@ UnknownChange UnknownBoxes::shrink(const OccupancyMap& map, const std::vector<Bo
       counted_.erase(box.id);
       continue;
     }
-    if (parts.size() == 1 && same_extent(parts[0], box)) {
-      counted_[box.id] = left;  // observed inside, yet the same box still covers what is left
+    if (!frees_a_cube(grid, parts, config_.cover.min_size)) {
+      counted_[box.id] = left;  // observed inside, but nothing a limb could be in is free of it yet
       kept.push_back(box);
       continue;
     }

@@ -78,6 +78,11 @@ std::size_t mask_index(const Eigen::Vector3i& size, int x, int y, int z) {
   return (static_cast<std::size_t>(z) * size.y() + y) * size.x() + x;
 }
 
+// A length in whole voxels, at least one.
+int cube_edge(double length, double resolution) {
+  return std::max(1, static_cast<int>(std::ceil(length / resolution - 1e-9)));
+}
+
 // The unknown voxels that some all-unknown cube of `edge` voxels holds: the pockets worth covering.
 VoxelMask pockets(const VoxelStateGrid& grid, const VoxelCounts& unknown, int edge) {
   const Eigen::Vector3i& size = grid.size();
@@ -302,10 +307,34 @@ VoxelStateGrid VoxelStateGrid::of(const OccupancyMap& map, const Region& workspa
   return grid;
 }
 
+bool frees_a_cube(const VoxelStateGrid& grid, const std::vector<Box>& boxes, double edge_m) {
+  const Eigen::Vector3i& size = grid.size();
+  const int edge = cube_edge(edge_m, grid.resolution());
+  const auto centre = [&](int x, int y, int z) {
+    return Eigen::Vector3d(grid.origin() +
+                           (Eigen::Vector3d(x, y, z).array() + 0.5).matrix() * grid.resolution());
+  };
+  const VoxelCounts freed(size, [&](int x, int y, int z) {
+    const Eigen::Vector3d c = centre(x, y, z);
+    return std::none_of(boxes.begin(), boxes.end(), [&](const Box& box) { return box.contains(c); });
+  });
+  const long long full = static_cast<long long>(edge) * edge * edge;
+  const Eigen::Vector3i cube = Eigen::Vector3i::Constant(edge);
+  for (int z = 0; z + edge <= size.z(); ++z) {
+    for (int y = 0; y + edge <= size.y(); ++y) {
+      for (int x = 0; x + edge <= size.x(); ++x) {
+        const Eigen::Vector3i v(x, y, z);
+        if (freed.in({v, v + cube}) == full) return true;
+      }
+    }
+  }
+  return false;
+}
+
 UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& config) {
   config.validate();
   const Eigen::Vector3i& size = grid.size();
-  const int edge = std::max(1, static_cast<int>(std::ceil(config.min_size / grid.resolution() - 1e-9)));
+  const int edge = cube_edge(config.min_size, grid.resolution());
   const VoxelCounts unknown(size,
                             [&](int x, int y, int z) { return grid.at(x, y, z) == VoxelState::unknown; });
   const VoxelMask pocket = pockets(grid, unknown, edge);

@@ -25,10 +25,6 @@ struct UnknownSpaceConfig final {
   /// the bounds of `segment.workspace`; neither: unknown space is not tracked (active() is false).
   std::optional<Region> workspace;
   UnknownConfig cover;  ///< `unknown.min_size`, `unknown.max_free_share`, `unknown.max_boxes`
-  /// A box is covered again, within its own extent, once this share of the unknown voxels it was made with
-  /// has been observed (`unknown.shrink_share`, (0, 1]; default 0.1): unknown space shrinks in steps worth a
-  /// version, not voxel by voxel with every noisy sweep.
-  double shrink_share = 0.1;
   /// Sweeps that voxels never observed before wait to be checked for whether a box shrank, unless a change
   /// is re-segmented first, which checks them with it (`unknown.check_sweeps`, [1, 1000]; default 8). Above
   /// change.persist_sweeps + change.gather_sweeps, an object that comes into view together with the unknown
@@ -37,10 +33,10 @@ struct UnknownSpaceConfig final {
   int check_sweeps = 8;
 
   [[nodiscard]] bool active() const { return enabled && workspace.has_value(); }
-  /// @throws Error naming the key ("unknown.shrink_share: ...") if a value is out of range.
+  /// @throws Error naming the key ("unknown.check_sweeps: ...") if a value is out of range.
   void validate() const;
   /// Reads the `unknown` section (absent keys keep their defaults) and marks it read. Keys: enabled,
-  /// workspace {lower, upper}, min_size, max_free_share, max_boxes, shrink_share, check_sweeps.
+  /// workspace {lower, upper}, min_size, max_free_share, max_boxes, check_sweeps.
   /// @throws Error naming the key for unknown keys, wrong types or bad ranges.
   [[nodiscard]] static UnknownSpaceConfig from_yaml(YamlMap section);
 };
@@ -54,9 +50,11 @@ struct UnknownChange final {
 };
 
 /// The unknown boxes of one cell. Each box's `points` is the number of unknown voxels it held when it was
-/// made. Voxels inside the robot's body (`robot_C`, boxes in the cell frame) count as not needing a cover:
-/// the robot's own points are cut out of every frame, so the space it stands in is never observed, yet
-/// nothing can hide where the robot is, and a planner knows its robot. Not thread-safe.
+/// made. Unknown voxels inside `held_C` (boxes in the cell frame) need no unknown box:
+/// - the obstacle boxes: they block those voxels already (an object's inside is never observed);
+/// - the robot's body: its own points are cut out of every frame, so the space it stands in is never
+///   observed, yet nothing can hide where the robot is, and a planner has its robot's model.
+/// Not thread-safe.
 class UnknownBoxes final {
  public:
   /// Starts from the unknown boxes the cell published last (restored from its state), or none.
@@ -65,12 +63,13 @@ class UnknownBoxes final {
 
   /// Covers the workspace's unknown voxels from scratch (cover_unknown), replacing every box: for the first
   /// version of a map. New boxes take ids from `next_id` on, which is advanced.
-  UnknownChange cover_all(const OccupancyMap& map, const std::vector<Box>& robot_C, std::uint64_t& next_id);
-  /// Covers again, within its own extent, every box of which at least `shrink_share` of its unknown voxels
-  /// have been observed since it was made: the largest new box keeps the old id, the others take new ids
-  /// from `next_id`, and a box with nothing left to cover goes. Boxes never grow. The count of boxes stays
-  /// within `max_boxes` where the boxes left allow.
-  UnknownChange shrink(const OccupancyMap& map, const std::vector<Box>& robot_C, std::uint64_t& next_id);
+  UnknownChange cover_all(const OccupancyMap& map, const std::vector<Box>& held_C, std::uint64_t& next_id);
+  /// Covers again, within its own extent, every box in which voxels were observed since it was last looked
+  /// at, and takes the new cover when it frees a cube of `min_size` (space a limb could be in; a few voxels
+  /// seen at a box's side through noise free none): the largest new box keeps the old id, the others take
+  /// new ids from `next_id`, and a box with nothing left to cover goes. Boxes never grow. The count of boxes
+  /// stays within `max_boxes` where the boxes left allow.
+  UnknownChange shrink(const OccupancyMap& map, const std::vector<Box>& held_C, std::uint64_t& next_id);
 
   /// The current boxes, sorted by id.
   [[nodiscard]] const std::vector<Box>& boxes() const { return boxes_; }
@@ -81,8 +80,8 @@ class UnknownBoxes final {
  private:
   UnknownSpaceConfig config_;
   std::vector<Box> boxes_;
-  // Unknown voxels counted in a box whose cover came out the same box: the count the next shrink is measured
-  // from (else each box's `points`).
+  // Unknown voxels counted in a box when its new cover freed nothing: a box is looked at again once fewer are
+  // left (else once fewer than its `points` are).
   std::map<std::uint64_t, std::uint64_t> counted_;
   UnknownCover last_cover_;
 };

@@ -92,4 +92,10 @@ struct UnknownCover final {
 /// in the boxes grown). @throws Error if `config` is invalid.
 [[nodiscard]] UnknownCover cover_unknown(const VoxelStateGrid& grid, const UnknownConfig& config = {});
 
+/// Whether the voxels of `grid` whose centres no box of `boxes` holds include a whole cube of edge `edge_m`
+/// metres (rounded up to whole voxels, as UnknownConfig::min_size): whether covering the grid with `boxes`
+/// instead of with one box over all of it frees space a limb could be in. Cost: linear in the grid's voxels
+/// times the boxes.
+[[nodiscard]] bool frees_a_cube(const VoxelStateGrid& grid, const std::vector<Box>& boxes, double edge_m);
+
 }  // namespace cellmap
