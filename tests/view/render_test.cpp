@@ -221,7 +221,8 @@ TEST(RenderTest, UnknownBoxesAreFaintGreyOverWhatTheyHoldAndLeftOutWhenHidden) {
   }
   // Shown: a neutral grey over the white panel, and the obstacle inside seen through it in its own hue.
   expect_colour(shown, top_of_scene(2.85, 0.2), grey_over_white, "the unknown box's top");
-  expect_colour(shown, top_of_scene(2.4, 0.6), grey_over_held, "the obstacle inside, through the unknown box");
+  expect_colour(shown, top_of_scene(2.4, 0.6), grey_over_held,
+                "the obstacle inside, through the unknown box");
   expect_colour(shown, top_of_scene(0.3, 0.2), shaded(box_colour(1), kTopShade), "an obstacle box");
   // Hidden: the panel's white where the unknown box was, the obstacle inside as it is.
   expect_colour(hidden, top_of_scene(2.85, 0.2), {1, 1, 1}, "where the unknown box was");
@@ -234,8 +235,7 @@ TEST(RenderTest, UnknownBoxesAreFaintGreyOverWhatTheyHoldAndLeftOutWhenHidden) {
 TEST(RenderTest, UnknownFacesAreProjectedWithTheirSpace) {
   const std::vector<Face> faces = project(unknown_between_obstacles(), View::kTop, Panel{0, 0, 500, 100});
   ASSERT_EQ(faces.size(), 4u);
-  for (const Face& face : faces)
-    EXPECT_EQ(face.space == BoxSpace::kUnknown, face.box_id == 2) << face.box_id;
+  for (const Face& face : faces) EXPECT_EQ(face.space == BoxSpace::kUnknown, face.box_id == 2) << face.box_id;
 }
 
 // Every path of the SVG as its list of points ("M x y L x y ... Z").
@@ -349,8 +349,8 @@ TEST(RenderTest, CommandDrawsUnknownSpaceGreyUnlessHidden) {
   cairo_surface_destroy(shown);
   cairo_surface_destroy(hidden);
 
-  test::ChildProcess bad({CELLMAP_TOOL, "render", boxes.string(), "--unknown", "dim", "-o",
-                          (dir.path() / "x.png").string()});
+  test::ChildProcess bad(
+      {CELLMAP_TOOL, "render", boxes.string(), "--unknown", "dim", "-o", (dir.path() / "x.png").string()});
   const int status = bad.wait();
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << status;
 }

@@ -162,9 +162,10 @@ void add_render_command(CLI::App& app) {
                    "with --domain: seconds to wait for the environment and the robot")
       ->check(CLI::PositiveNumber);
   command
-      ->add_option("--unknown", options->unknown,
-                   "unknown boxes (space no sensor has observed): show (grey, translucent, dashed outlines; the "
-                   "default) or hide")
+      ->add_option(
+          "--unknown", options->unknown,
+          "unknown boxes (space no sensor has observed): show (grey, translucent, dashed outlines; the "
+          "default) or hide")
       ->check(CLI::IsMember({"show", "hide"}));
   command->add_option("-o,--output", options->output, "the picture: OUT.png or OUT.svg")->required();
   command->add_option("--width", options->render.width, "pixels (default 1600)")

@@ -57,7 +57,8 @@ struct RenderOptions final {
   bool unknown = true;
 };
 
-/// How opaque an unknown box's faces are painted: faint, since unknown boxes are large and may hold obstacles.
+/// How opaque an unknown box's faces are painted: faint, since unknown boxes are large and may hold
+/// obstacles.
 inline constexpr double kUnknownAlpha = 0.3;
 
 /// A solid drawn with the boxes: one of the robot's collision shapes, or a true obstacle of a simulated cell.
