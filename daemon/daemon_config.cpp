@@ -237,6 +237,7 @@ std::optional<ros2::TopicOutput> read_topic_output(YamlMap section) {
   output.topic = read_ros2_topic(section, "topic", "");
   output.frame_id = section.get<std::string>("frame_id", output.frame_id);
   if (output.frame_id.empty()) section.fail("frame_id", "must not be empty");
+  output.unknown_boxes = section.get<bool>("unknown_boxes", output.unknown_boxes);
   section.expect_all_read();
   return enabled ? std::optional(output) : std::nullopt;
 }

@@ -71,9 +71,10 @@ struct Ros2Config final {
   /// `joint_states`: a sensor_msgs/msg/JointState topic posing the robot instead of cellmap/robot_joints;
   /// empty = cellmap/robot_joints.
   std::string joint_states;
-  /// `collision_objects` (`enabled`, `topic`, `frame_id`): the boxes for MoveIt; nullopt = off.
+  /// `collision_objects` (`enabled`, `topic`, `frame_id`, `unknown_boxes`): the boxes for MoveIt; nullopt =
+  /// off.
   std::optional<ros2::TopicOutput> collision_objects;
-  /// `markers` (`enabled`, `topic`, `frame_id`): the boxes for RViz; nullopt = off.
+  /// `markers` (`enabled`, `topic`, `frame_id`, `unknown_boxes`): the boxes for RViz; nullopt = off.
   std::optional<ros2::TopicOutput> markers;
 };
 /// The text of config/cellmapd.yaml, embedded at build time: the built-in defaults.

@@ -9,7 +9,8 @@ namespace cellmap::daemon {
 namespace {
 
 std::string describe_output(const char* what, const ros2::TopicOutput& output) {
-  return std::string(what) + " on " + output.topic + " (frame " + output.frame_id + ")";
+  return std::string(what) + " on " + output.topic + " (frame " + output.frame_id +
+         (output.unknown_boxes ? ", unknown space too" : ", obstacles only") + ")";
 }
 
 }  // namespace

@@ -23,8 +23,8 @@ class Ros2Outputs final {
   /// Sends the current environment to MoveIt readers that matched since the last call; call often (the
   /// daemon: every 200 ms).
   void serve_new_readers();
-  /// "collision objects on /collision_object (frame world), markers on /cellmap/markers (frame world)", or
-  /// "" when none is enabled; for the start log line.
+  /// "MoveIt collision objects on /collision_object (frame world, unknown space too), RViz markers on
+  /// /cellmap/markers (frame world, obstacles only)", or "" when none is enabled; for the start log line.
   [[nodiscard]] std::string describe() const;
 
  private:

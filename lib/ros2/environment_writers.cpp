@@ -56,7 +56,7 @@ class CollisionObjectSample final {
  public:
   CollisionObjectSample(const std::string& cell, const Box& box, std::int64_t stamp_ns,
                         const std::string& frame_id, std::uint8_t operation)
-      : id_(collision_object_id(cell, box.id)),
+      : id_(collision_object_id(cell, box.id, box.space)),
         sizes_{2 * box.half_extents.x(), 2 * box.half_extents.y(), 2 * box.half_extents.z()},
         primitive_poses_{identity_pose()} {
     msg_.header = header(stamp_ns, frame_id);
@@ -109,9 +109,14 @@ visualization_msgs_msg_dds__Marker_ cube(const std_msgs_msg_dds__Header_& h, con
   m.action = visualization_msgs_msg_dds__Marker_Constants_ADD_;
   m.pose = pose_of(box);
   m.scale = {2 * box.half_extents.x(), 2 * box.half_extents.y(), 2 * box.half_extents.z()};
-  const std::array<double, 3> rgb = box_colour(box.id);
-  m.color = {float(rgb[0]), float(rgb[1]), float(rgb[2]), 0.6f};
+  const std::array<double, 3> rgb = box.space == BoxSpace::kUnknown ? kUnknownColour : box_colour(box.id);
+  m.color = {float(rgb[0]), float(rgb[1]), float(rgb[2]), marker_alpha(box.space)};
   return m;
+}
+
+// Whether `output` carries `box`.
+bool carries(const TopicOutput& output, const Box& box) {
+  return box.space != BoxSpace::kUnknown || output.unknown_boxes;
 }
 
 // KEEP_ALL: a version's burst of boxes must reach MoveIt whole.
@@ -129,8 +134,16 @@ dds::Qos marker_qos() {
 
 }  // namespace
 
-std::string collision_object_id(const std::string& cell, std::uint64_t box_id) {
-  return "cellmap/" + cell + "/box_" + std::to_string(box_id);
+std::string collision_object_id(const std::string& cell, std::uint64_t box_id, BoxSpace space) {
+  return "cellmap/" + cell + (space == BoxSpace::kUnknown ? "/unknown_" : "/box_") + std::to_string(box_id);
+}
+
+std::string marker_namespace(const std::string& cell, BoxSpace space) {
+  return space == BoxSpace::kUnknown ? cell + "/unknown" : cell;
+}
+
+float marker_alpha(BoxSpace space) {
+  return space == BoxSpace::kUnknown ? 0.3f : 0.6f;
 }
 
 CollisionObjectWriter::CollisionObjectWriter(const dds::Participant& participant, TopicOutput output)
@@ -140,19 +153,34 @@ CollisionObjectWriter::CollisionObjectWriter(const dds::Participant& participant
 
 void CollisionObjectWriter::write(const Environment& after, const EnvironmentDelta& delta) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  const Environment before = std::move(current_);
   current_ = after;
-  for (const Box& box : delta.added)
-    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id,
-                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
-  for (const Box& box : delta.modified)
-    write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id,
-                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
-  for (const std::uint64_t id : delta.removed) {
+  const auto send = [&](const Box& box, std::uint8_t operation) {
+    if (carries(output_, box))
+      write_object(writer_, after.cell(), box, after.stamp_ns(), output_.frame_id, operation);
+  };
+  // A box this writer never saw (none before the first write) may have been of either space.
+  const auto remove = [&](std::uint64_t id) {
     Box gone;
     gone.id = id;
-    write_object(writer_, after.cell(), gone, after.stamp_ns(), output_.frame_id,
-                 moveit_msgs_msg_dds__CollisionObject_Constants_REMOVE_);
+    if (const Box* known = before.find(id)) {
+      gone.space = known->space;
+      send(gone, moveit_msgs_msg_dds__CollisionObject_Constants_REMOVE_);
+      return;
+    }
+    for (const BoxSpace space : {BoxSpace::kOccupied, BoxSpace::kUnknown}) {
+      gone.space = space;
+      send(gone, moveit_msgs_msg_dds__CollisionObject_Constants_REMOVE_);
+    }
+  };
+  for (const Box& box : delta.added) send(box, moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+  for (const Box& box : delta.modified) {
+    // A box whose space changed has another object id: the old object goes.
+    const Box* known = before.find(box.id);
+    if (known != nullptr && known->space != box.space) remove(box.id);
+    send(box, moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
   }
+  for (const std::uint64_t id : delta.removed) remove(id);
 }
 
 bool CollisionObjectWriter::resend_if_new_readers() {
@@ -160,9 +188,11 @@ bool CollisionObjectWriter::resend_if_new_readers() {
   const std::uint32_t ever = writer_.matched_readers_ever();
   if (ever == readers_seen_) return false;
   readers_seen_ = ever;
-  for (const Box& box : current_.boxes())
-    write_object(writer_, current_.cell(), box, current_.stamp_ns(), output_.frame_id,
-                 moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+  for (const Box& box : current_.boxes()) {
+    if (carries(output_, box))
+      write_object(writer_, current_.cell(), box, current_.stamp_ns(), output_.frame_id,
+                   moveit_msgs_msg_dds__CollisionObject_Constants_ADD_);
+  }
   return true;
 }
 
@@ -173,12 +203,22 @@ MarkerWriter::MarkerWriter(const dds::Participant& participant, TopicOutput outp
 
 void MarkerWriter::write(const Environment& env) {
   const std_msgs_msg_dds__Header_ h = header(env.stamp_ns(), output_.frame_id);
+  // The namespaces outlive this function's markers: the samples point at their text.
+  const std::string namespaces[2] = {marker_namespace(env.cell(), BoxSpace::kOccupied),
+                                     marker_namespace(env.cell(), BoxSpace::kUnknown)};
   std::vector<visualization_msgs_msg_dds__Marker_> markers;
-  markers.reserve(env.boxes().size() + 1);
-  visualization_msgs_msg_dds__Marker_ clear = blank_marker(h, env.cell());
-  clear.action = visualization_msgs_msg_dds__Marker_Constants_DELETEALL_;
-  markers.push_back(clear);
-  for (const Box& box : env.boxes()) markers.push_back(cube(h, env.cell(), box));
+  markers.reserve(env.boxes().size() + 2);
+  // Unknown boxes' namespace is cleared even when they are not written: an RViz still showing them from an
+  // earlier cellmapd loses them.
+  for (const std::string& ns : namespaces) {
+    visualization_msgs_msg_dds__Marker_ clear = blank_marker(h, ns);
+    clear.action = visualization_msgs_msg_dds__Marker_Constants_DELETEALL_;
+    markers.push_back(clear);
+  }
+  for (const Box& box : env.boxes()) {
+    if (carries(output_, box))
+      markers.push_back(cube(h, namespaces[box.space == BoxSpace::kUnknown ? 1 : 0], box));
+  }
   visualization_msgs_msg_dds__MarkerArray_ msg{};
   msg.markers = sequence_of<dds_sequence_visualization_msgs_msg_dds__Marker_>(markers);
   writer_.write(&msg);

@@ -147,15 +147,17 @@ std::vector<Facet> facets(const Solid& solid, const std::array<double, 3>& rgb) 
   return out;
 }
 
-// The boxes and, as facets, the overlays: everything a picture's panels fit and draw.
+// The boxes drawn and, as facets, the overlays: everything a picture's panels fit and draw.
 struct Contents {
-  const std::vector<Box>& boxes;
+  std::vector<Box> boxes;
   std::vector<Facet> facets;
   bool translucent_boxes = false;
 };
 
-Contents contents_of(const std::vector<Box>& boxes, const Overlays& overlays) {
-  Contents contents{boxes, {}, !overlays.obstacles.empty()};
+Contents contents_of(const std::vector<Box>& boxes, const Overlays& overlays, bool unknown = true) {
+  Contents contents{{}, {}, !overlays.obstacles.empty()};
+  for (const Box& box : boxes)
+    if (unknown || box.space != BoxSpace::kUnknown) contents.boxes.push_back(box);
   for (const Solid& solid : overlays.obstacles)
     for (Facet& f : facets(solid, obstacle_colour())) contents.facets.push_back(std::move(f));
   for (const Solid& solid : overlays.robot)
@@ -296,6 +298,7 @@ std::vector<Face> project_faces(const std::vector<Box>& boxes, const Projection&
       if (!p.cam.faces(normal, centre)) continue;
       Face face;
       face.box_id = box.id;
+      face.space = box.space;
       for (int i = 0; i < 4; ++i) face.corners_px[i] = p.fit.pixel(p.cam.project(c[kFaces[f][i]]));
       face.depth = depth_of(p.cam, centre);
       face.shade = 0.45 + 0.55 * std::max(0.0, normal.dot(light));
@@ -313,25 +316,29 @@ struct Polygon {
   std::array<double, 3> rgb{};
   double alpha = 1;
   bool box_face = false;
+  bool unknown = false;  // an unknown box's face: grey, faint, a dashed grey outline
 };
 
 std::vector<Polygon> polygons(const Contents& contents, View view, const Panel& panel) {
   const Projection p = projection(contents, view, panel);
   std::vector<Polygon> out;
   for (const Face& face : project_faces(contents.boxes, p)) {
-    const std::array<double, 3> rgb = box_colour(face.box_id);
+    const bool unknown = face.space == BoxSpace::kUnknown;
+    const std::array<double, 3> rgb = unknown ? kUnknownColour : box_colour(face.box_id);
+    const double alpha = unknown ? kUnknownAlpha : contents.translucent_boxes ? 0.45 : 1.0;
     out.push_back({{face.corners_px.begin(), face.corners_px.end()},
                    face.depth,
                    {rgb[0] * face.shade, rgb[1] * face.shade, rgb[2] * face.shade},
-                   contents.translucent_boxes ? 0.45 : 1.0,
-                   true});
+                   alpha,
+                   true,
+                   unknown});
   }
   const Eigen::Vector3d light = light_of(p.cam);
   for (const Facet& facet : contents.facets) {
     if (!facet.two_sided && !p.cam.faces(facet.normal, facet.centre_C)) continue;
     const double lit = facet.normal.dot(light);
     const double shade = 0.45 + 0.55 * (facet.two_sided ? std::abs(lit) : std::max(0.0, lit));
-    Polygon polygon{{}, depth_of(p.cam, facet.centre_C), {}, 1.0, false};
+    Polygon polygon{{}, depth_of(p.cam, facet.centre_C), {}, 1.0, false, false};
     for (const Eigen::Vector3d& c : facet.corners_C)
       polygon.corners_px.push_back(p.fit.pixel(p.cam.project(c)));
     for (int i = 0; i < 3; ++i) polygon.rgb[i] = facet.rgb[i] * shade;
@@ -352,8 +359,16 @@ void draw_polygons(cairo_t* cr, const std::vector<Polygon>& polygons) {
     cairo_set_source_rgba(cr, polygon.rgb[0], polygon.rgb[1], polygon.rgb[2], polygon.alpha);
     cairo_fill_preserve(cr);
     cairo_set_line_width(cr, polygon.box_face ? 0.8 : 0.5);
-    if (polygon.box_face) cairo_set_source_rgba(cr, 0.1, 0.1, 0.15, 0.55);
+    if (polygon.unknown) {
+      // Dashed, in a darker grey: the outline says "unknown" even where the faint fill hardly shows.
+      static constexpr double kDash[] = {5.0, 3.0};
+      cairo_set_dash(cr, kDash, 2, 0);
+      cairo_set_source_rgba(cr, 0.42, 0.42, 0.42, 0.9);
+    } else if (polygon.box_face) {
+      cairo_set_source_rgba(cr, 0.1, 0.1, 0.15, 0.55);
+    }
     cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0);
   }
 }
 
@@ -397,10 +412,14 @@ void draw_panel(cairo_t* cr, const Contents& contents, View view, const Panel& p
   cairo_restore(cr);
 }
 
-std::string heading(const Environment& env) {
+std::string heading(const Environment& env, bool unknown_drawn) {
   std::ostringstream text;
   text << "cell " << env.cell() << " \xC2\xB7 version " << env.version() << " \xC2\xB7 " << env.boxes().size()
        << " boxes";
+  const auto unknown = std::count_if(env.boxes().begin(), env.boxes().end(),
+                                     [](const Box& box) { return box.space == BoxSpace::kUnknown; });
+  if (unknown > 0)
+    text << " (" << unknown << " unknown space" << (unknown_drawn ? ", grey" : ", not drawn") << ")";
   if (env.stamp_ns() > 0) {
     const std::time_t seconds = static_cast<std::time_t>(env.stamp_ns() / 1'000'000'000);
     std::tm utc{};
@@ -460,9 +479,9 @@ void render(const Environment& env, const std::filesystem::path& out, const Rend
   ContextPtr cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 0.95, 0.96, 0.97);
   cairo_paint(cr.get());
-  draw_text(cr.get(), 14, 29, 18, options.title.empty() ? heading(env) : options.title);
+  draw_text(cr.get(), 14, 29, 18, options.title.empty() ? heading(env, options.unknown) : options.title);
   const std::array<Panel, 3> panels = layout(options);
-  const Contents contents = contents_of(env.boxes(), overlays);
+  const Contents contents = contents_of(env.boxes(), overlays, options.unknown);
   draw_panel(cr.get(), contents, View::kTop, panels[0], "top (x right, y up)");
   draw_panel(cr.get(), contents, View::kSide, panels[1], "side (from -y: x right, z up)");
   draw_panel(cr.get(), contents, View::kPerspective, panels[2], "perspective");

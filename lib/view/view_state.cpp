@@ -20,6 +20,7 @@ json box_json(const Box& box, std::optional<std::uint64_t> changed_in) {
           {"half_extents", vector_json(box.half_extents)},
           {"rotation", json::array({box.rotation.w(), box.rotation.x(), box.rotation.y(), box.rotation.z()})},
           {"points", box.points},
+          {"space", space_name(box.space)},
           {"changed_in", changed_in ? json(*changed_in) : json(nullptr)}};
 }
 

@@ -260,6 +260,22 @@ TEST(DaemonConfigTest, Ros2CellIsFedByAPointCloud2TopicAndPublishesToMoveItAndRv
   EXPECT_TRUE(c.uses_ros2());
 }
 
+TEST(DaemonConfigTest, Ros2OutputsCarryUnknownSpaceUnlessSwitchedOff) {
+  const DaemonConfig shipped = DaemonConfig::load(CELLMAP_SOURCE_DIR "/config/ros2-cell.yaml");
+  ASSERT_TRUE(shipped.ros2.collision_objects && shipped.ros2.markers);
+  EXPECT_TRUE(shipped.ros2.collision_objects->unknown_boxes);
+  EXPECT_TRUE(shipped.ros2.markers->unknown_boxes);
+  const DaemonConfig c = DaemonConfig::parse(
+      "ros2:\n  collision_objects: {enabled: true, unknown_boxes: false}\n"
+      "  markers: {enabled: true, unknown_boxes: false}\n",
+      "off.yaml", ".");
+  ASSERT_TRUE(c.ros2.collision_objects && c.ros2.markers);
+  EXPECT_FALSE(c.ros2.collision_objects->unknown_boxes);
+  EXPECT_FALSE(c.ros2.markers->unknown_boxes);
+  EXPECT_NE(error_of("ros2: {markers: {enabled: true, unknown_boxes: some}}\n").find("unknown_boxes"),
+            std::string::npos);
+}
+
 TEST(DaemonConfigTest, Ros2IsOffByDefault) {
   const DaemonConfig c = DaemonConfig::parse("", "empty.yaml", ".");
   EXPECT_FALSE(c.ros2.collision_objects);

@@ -102,13 +102,16 @@ std::vector<std::pair<std::string, int>> objects(const test::Ros2Peer& peer, std
   return out;
 }
 
-std::string object_id(std::uint64_t box) {
-  return "cellmap/" + kCell + "/box_" + std::to_string(box);
+// Obstacle boxes are cellmap/<cell>/box_<id>, unknown boxes (space the camera cannot see)
+// cellmap/<cell>/unknown_<id>.
+std::string object_id(const Box& box) {
+  return "cellmap/" + kCell + (box.space == BoxSpace::kUnknown ? "/unknown_" : "/box_") +
+         std::to_string(box.id);
 }
 
 // The CollisionObject MoveIt got for `box` matches it: one BOX primitive of its full sizes at its pose.
 void expect_matches(const json& msg, const Box& box) {
-  EXPECT_EQ(msg["id"], object_id(box.id));
+  EXPECT_EQ(msg["id"], object_id(box));
   EXPECT_EQ(msg["header"]["frame_id"], "world");
   ASSERT_EQ(msg["primitives"].size(), 1u);
   EXPECT_EQ(msg["primitives"][0]["type"], 1);
@@ -156,11 +159,16 @@ TEST(Ros2CellE2eTest, ABoxInFrontOfTheCameraIsOneVersionAndOneCollisionObject) {
   // The first version: every box is one ADD on MoveIt's topic.
   const Environment first = test::settled(planner, status, kCell, test::kLongQuietSweeps);
   ASSERT_FALSE(first.boxes().empty());
+  // A fixed camera cannot see behind the table and the objects: that space arrives as unknown boxes, which
+  // MoveIt gets as objects of their own (on by default: it must not plan through them).
+  const auto unknown_boxes = std::count_if(first.boxes().begin(), first.boxes().end(),
+                                           [](const Box& box) { return box.space == BoxSpace::kUnknown; });
+  EXPECT_GT(unknown_boxes, 0);
   ASSERT_TRUE(peer.wait_until([&] { return world_of(peer, 0).size() == first.boxes().size(); }));
   for (const Box& box : first.boxes()) {
     const std::map<std::string, json> world = world_of(peer, 0);
-    ASSERT_EQ(world.count(object_id(box.id)), 1u) << box.id;
-    expect_matches(world.at(object_id(box.id)), box);
+    ASSERT_EQ(world.count(object_id(box)), 1u) << box.id;
+    expect_matches(world.at(object_id(box)), box);
   }
 
   // The box appears: one version adding one box that holds it, one ADD.
@@ -178,7 +186,7 @@ TEST(Ros2CellE2eTest, ABoxInFrontOfTheCameraIsOneVersionAndOneCollisionObject) {
   EXPECT_TRUE(visitor.contains(visitor_front, 0.02));
   ASSERT_TRUE(peer.wait_until([&] { return !objects(peer, mark).empty(); }));
   std::this_thread::sleep_for(1s);  // nothing more may come
-  ASSERT_EQ(objects(peer, mark), (std::vector<std::pair<std::string, int>>{{object_id(visitor.id), 0}}));
+  ASSERT_EQ(objects(peer, mark), (std::vector<std::pair<std::string, int>>{{object_id(visitor), 0}}));
   expect_matches(peer.received("/collision_object", mark)[0], visitor);
 
   // It leaves: one version removing it, one REMOVE.
@@ -190,7 +198,7 @@ TEST(Ros2CellE2eTest, ABoxInFrontOfTheCameraIsOneVersionAndOneCollisionObject) {
   EXPECT_EQ(diff(arrived, left).removed, std::vector<std::uint64_t>{visitor.id});
   ASSERT_TRUE(peer.wait_until([&] { return !objects(peer, mark).empty(); }));
   std::this_thread::sleep_for(1s);
-  EXPECT_EQ(objects(peer, mark), (std::vector<std::pair<std::string, int>>{{object_id(visitor.id), 1}}));
+  EXPECT_EQ(objects(peer, mark), (std::vector<std::pair<std::string, int>>{{object_id(visitor), 1}}));
 
   // A move_group that starts now gets every current box, and not the one that left.
   peer.command("unsub topic=/collision_object");
@@ -198,23 +206,38 @@ TEST(Ros2CellE2eTest, ABoxInFrontOfTheCameraIsOneVersionAndOneCollisionObject) {
   peer.subscribe("/collision_object", "moveit_msgs/msg/CollisionObject", false, 1024);
   ASSERT_TRUE(peer.wait_until([&] { return world_of(peer, mark).size() == left.boxes().size(); }));
   std::set<std::string> expected;
-  for (const Box& box : left.boxes()) expected.insert(object_id(box.id));
+  for (const Box& box : left.boxes()) expected.insert(object_id(box));
   std::set<std::string> got;
   for (const auto& [id, msg] : world_of(peer, mark)) got.insert(id);
   EXPECT_EQ(got, expected);
 
-  // RViz's last MarkerArray: DELETEALL, then a cube per box of the current version.
+  // RViz's last MarkerArray: DELETEALL in the obstacles' and the unknown space's namespaces, then a cube per
+  // box of the current version: obstacles in their own hues, unknown space grey in its own namespace.
   ASSERT_TRUE(peer.wait_until([&] {
     const std::vector<json> arrays = peer.received("/cellmap/markers");
-    return !arrays.empty() && arrays.back()["markers"].size() == left.boxes().size() + 1;
+    return !arrays.empty() && arrays.back()["markers"].size() == left.boxes().size() + 2;
   }));
   const json markers = peer.received("/cellmap/markers").back()["markers"];
   EXPECT_EQ(markers[0]["action"], 3);
+  EXPECT_EQ(markers[0]["ns"], kCell);
+  EXPECT_EQ(markers[1]["action"], 3);
+  EXPECT_EQ(markers[1]["ns"], kCell + "/unknown");
+  int grey_markers = 0;
   for (std::size_t i = 0; i < left.boxes().size(); ++i) {
-    EXPECT_EQ(markers[i + 1]["type"], 1);
-    EXPECT_EQ(markers[i + 1]["id"], left.boxes()[i].id);
-    EXPECT_EQ(markers[i + 1]["ns"], kCell);
+    const Box& box = left.boxes()[i];
+    const json& marker = markers[i + 2];
+    EXPECT_EQ(marker["type"], 1);
+    EXPECT_EQ(marker["id"], box.id);
+    const bool unknown = box.space == BoxSpace::kUnknown;
+    EXPECT_EQ(marker["ns"], unknown ? kCell + "/unknown" : kCell);
+    const std::array<double, 3> rgb = unknown ? kUnknownColour : box_colour(box.id);
+    EXPECT_FLOAT_EQ(marker["color"]["r"].get<float>(), float(rgb[0])) << box.id;
+    EXPECT_FLOAT_EQ(marker["color"]["g"].get<float>(), float(rgb[1])) << box.id;
+    EXPECT_FLOAT_EQ(marker["color"]["b"].get<float>(), float(rgb[2])) << box.id;
+    EXPECT_FLOAT_EQ(marker["color"]["a"].get<float>(), unknown ? 0.3f : 0.6f) << box.id;
+    grey_markers += unknown ? 1 : 0;
   }
+  EXPECT_GT(grey_markers, 0);
 }
 
 }  // namespace

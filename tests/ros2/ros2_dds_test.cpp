@@ -384,18 +384,161 @@ TEST_F(Ros2DdsTest, AnRvizThatStartsLaterGetsTheLastMarkerArray) {
   }
   ASSERT_EQ(arrays.size(), 1u);  // the last one only (KEEP_LAST 1)
   const auto& markers = arrays[0];
-  ASSERT_EQ(markers.size(), 3u);
-  EXPECT_EQ(markers[0].action, 3);  // DELETEALL
-  EXPECT_EQ(markers[1].type, 1);    // CUBE
-  EXPECT_EQ(markers[1].id, 7);
-  EXPECT_EQ(markers[2].id, 9);
-  EXPECT_EQ(namespaces[2], "arm");
-  EXPECT_DOUBLE_EQ(markers[2].scale.x, 0.6);
-  EXPECT_DOUBLE_EQ(markers[2].scale.z, 0.2);
-  EXPECT_EQ(markers[2].pose.position.z, 0.5);
+  ASSERT_EQ(markers.size(), 4u);
+  EXPECT_EQ(markers[0].action, 3);  // DELETEALL, obstacle boxes' namespace
+  EXPECT_EQ(namespaces[0], "arm");
+  EXPECT_EQ(markers[1].action, 3);  // DELETEALL, unknown boxes' namespace
+  EXPECT_EQ(namespaces[1], "arm/unknown");
+  EXPECT_EQ(markers[2].type, 1);  // CUBE
+  EXPECT_EQ(markers[2].id, 7);
+  EXPECT_EQ(markers[3].id, 9);
+  EXPECT_EQ(namespaces[3], "arm");
+  EXPECT_DOUBLE_EQ(markers[3].scale.x, 0.6);
+  EXPECT_DOUBLE_EQ(markers[3].scale.z, 0.2);
+  EXPECT_EQ(markers[3].pose.position.z, 0.5);
   const std::array<double, 3> rgb = box_colour(9);
-  EXPECT_FLOAT_EQ(markers[2].color.r, float(rgb[0]));
-  EXPECT_FLOAT_EQ(markers[2].color.a, 0.6f);
+  EXPECT_FLOAT_EQ(markers[3].color.r, float(rgb[0]));
+  EXPECT_FLOAT_EQ(markers[3].color.a, 0.6f);
+}
+
+Box unknown_box(std::uint64_t id, Eigen::Vector3d center, Eigen::Vector3d half_extents) {
+  Box b = box(id, center, half_extents);
+  b.space = BoxSpace::kUnknown;
+  return b;
+}
+
+TEST_F(Ros2DdsTest, UnknownBoxesAreCollisionObjectsOfTheirOwnUnlessSwitchedOff) {
+  dds::Participant daemon(test::domain::kRos2UnknownObjects);
+  dds::Participant move_group(test::domain::kRos2UnknownObjects);
+  CollisionObjectWriter with_unknown(daemon, {"/collision_object", "world"});
+  CollisionObjectWriter obstacles_only(daemon, {"/obstacles_only", "world", false});
+  const dds::Topic topic(move_group, &moveit_msgs_msg_dds__CollisionObject__desc, "rt/collision_object");
+  const dds::Topic obstacles_topic(move_group, &moveit_msgs_msg_dds__CollisionObject__desc,
+                                   "rt/obstacles_only");
+  const dds::Reader reader(move_group, topic, moveit_qos());
+  const dds::Reader obstacles_reader(move_group, obstacles_topic, moveit_qos());
+  for (CollisionObjectWriter* writer : {&with_unknown, &obstacles_only}) {
+    const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+    while (!writer->resend_if_new_readers() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(10ms);
+  }
+
+  // Version 1: an obstacle and the space behind it nobody has seen (2 × 1 × 1 m).
+  const Environment v0("arm");
+  const Environment v1("arm", 1, 1'700'000'000'000'000'000,
+                       {box(1, {1, 0, 0.5}, {0.1, 0.1, 0.1}), unknown_box(2, {2, 0, 0.5}, {1.0, 0.5, 0.5})});
+  // Version 2: the unknown space was seen (its box goes), another obstacle came.
+  const Environment v2("arm", 2, 1'700'000'001'000'000'000,
+                       {box(1, {1, 0, 0.5}, {0.1, 0.1, 0.1}), box(3, {2, 0, 0.2}, {0.2, 0.2, 0.2})});
+  // Version 3: one more obstacle, after which nothing of version 2 can still be on its way.
+  const Environment v3("arm", 3, 1'700'000'002'000'000'000,
+                       {box(1, {1, 0, 0.5}, {0.1, 0.1, 0.1}), box(3, {2, 0, 0.2}, {0.2, 0.2, 0.2}),
+                        box(4, {0, 1, 0.2}, {0.2, 0.2, 0.2})});
+  for (CollisionObjectWriter* writer : {&with_unknown, &obstacles_only}) {
+    writer->write(v1, diff(v0, v1));
+    writer->write(v2, diff(v1, v2));
+    writer->write(v3, diff(v2, v3));
+  }
+
+  std::vector<SeenObject> seen = take_objects(reader, 5);
+  ASSERT_EQ(seen.size(), 5u);
+  EXPECT_EQ(seen[0].id, "cellmap/arm/box_1");
+  EXPECT_EQ(seen[1].id, "cellmap/arm/unknown_2");
+  EXPECT_EQ(seen[1].operation, 0);  // ADD
+  EXPECT_EQ(seen[1].dimensions, (std::vector<double>{2.0, 1.0, 1.0}));
+  EXPECT_EQ(seen[1].position[0], 2.0);
+  EXPECT_EQ(seen[2].id, "cellmap/arm/box_3");
+  EXPECT_EQ(seen[3].id, "cellmap/arm/unknown_2");
+  EXPECT_EQ(seen[3].operation, 1);  // REMOVE, under the unknown box's id
+  EXPECT_EQ(seen[4].id, "cellmap/arm/box_4");
+
+  // Switched off: the obstacles alone, neither the unknown box's ADD nor its REMOVE.
+  seen = take_objects(obstacles_reader, 3);
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(seen[0].id, "cellmap/arm/box_1");
+  EXPECT_EQ(seen[1].id, "cellmap/arm/box_3");
+  EXPECT_EQ(seen[2].id, "cellmap/arm/box_4");
+
+  // A box whose space changed is removed under its old id and added under its new one.
+  Box now_unknown = box(4, {0, 1, 0.2}, {0.2, 0.2, 0.2});
+  now_unknown.space = BoxSpace::kUnknown;
+  const Environment v4(
+      "arm", 4, 1'700'000'003'000'000'000,
+      {box(1, {1, 0, 0.5}, {0.1, 0.1, 0.1}), box(3, {2, 0, 0.2}, {0.2, 0.2, 0.2}), now_unknown});
+  with_unknown.write(v4, diff(v3, v4));
+  seen = take_objects(reader, 2);
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_EQ(seen[0].id, "cellmap/arm/box_4");
+  EXPECT_EQ(seen[0].operation, 1);
+  EXPECT_EQ(seen[1].id, "cellmap/arm/unknown_4");
+  EXPECT_EQ(seen[1].operation, 0);
+
+  // A move_group that starts now gets the unknown box too.
+  const dds::Reader late(move_group, topic, moveit_qos());
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (!with_unknown.resend_if_new_readers() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(10ms);
+  seen = take_objects(late, 3);
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(seen[2].id, "cellmap/arm/unknown_4");
+}
+
+// The markers of the last MarkerArray on `topic` and their namespaces.
+struct SeenMarkers {
+  std::vector<visualization_msgs_msg_dds__Marker_> markers;
+  std::vector<std::string> namespaces;
+};
+SeenMarkers last_marker_array(const dds::Participant& rviz, const char* topic_name) {
+  const dds::Topic topic(rviz, &visualization_msgs_msg_dds__MarkerArray__desc, topic_name);
+  const dds::Reader reader(rviz, topic, dds::Qos::make(true, 1));
+  SeenMarkers seen;
+  bool got = false;
+  const auto deadline = std::chrono::steady_clock::now() + test::kPatience;
+  while (!got && std::chrono::steady_clock::now() < deadline) {
+    reader.take_all([&](const void* sample, const dds_sample_info_t&) {
+      const auto& msg = *static_cast<const visualization_msgs_msg_dds__MarkerArray_*>(sample);
+      seen.markers.assign(msg.markers._buffer, msg.markers._buffer + msg.markers._length);
+      seen.namespaces.clear();
+      for (const auto& m : seen.markers) seen.namespaces.emplace_back(m.ns);
+      got = true;
+    });
+    std::this_thread::sleep_for(10ms);
+  }
+  for (auto& m : seen.markers) m.ns = nullptr;  // the sample's memory is gone; the names were copied
+  return seen;
+}
+
+TEST_F(Ros2DdsTest, UnknownBoxesAreGreyMarkersInANamespaceOfTheirOwnUnlessSwitchedOff) {
+  dds::Participant daemon(test::domain::kRos2UnknownMarkers);
+  dds::Participant rviz(test::domain::kRos2UnknownMarkers);
+  MarkerWriter with_unknown(daemon, {"/cellmap/markers", "world"});
+  MarkerWriter obstacles_only(daemon, {"/obstacles_only", "world", false});
+  const Environment env("arm", 1, 5,
+                        {box(7, {1, 1, 1}, {0.1, 0.1, 0.1}), unknown_box(8, {2, 0, 0.5}, {1, 0.5, 0.5})});
+  with_unknown.write(env);
+  obstacles_only.write(env);
+
+  const SeenMarkers all = last_marker_array(rviz, "rt/cellmap/markers");
+  ASSERT_EQ(all.markers.size(), 4u);
+  EXPECT_EQ(all.namespaces, (std::vector<std::string>{"arm", "arm/unknown", "arm", "arm/unknown"}));
+  EXPECT_EQ(all.markers[0].action, 3);  // DELETEALL
+  EXPECT_EQ(all.markers[1].action, 3);
+  const auto& unknown = all.markers[3];
+  EXPECT_EQ(unknown.type, 1);  // CUBE
+  EXPECT_EQ(unknown.id, 8);
+  EXPECT_DOUBLE_EQ(unknown.scale.x, 2.0);
+  EXPECT_DOUBLE_EQ(unknown.pose.position.x, 2.0);
+  for (const float c : {unknown.color.r, unknown.color.g, unknown.color.b}) EXPECT_FLOAT_EQ(c, 0.55f);
+  EXPECT_FLOAT_EQ(unknown.color.a, 0.3f);
+  const std::array<double, 3> rgb = box_colour(7);
+  EXPECT_FLOAT_EQ(all.markers[2].color.g, float(rgb[1]));
+  EXPECT_FLOAT_EQ(all.markers[2].color.a, 0.6f);
+
+  // Switched off: the unknown namespace is still cleared, and holds nothing.
+  const SeenMarkers obstacles = last_marker_array(rviz, "rt/obstacles_only");
+  ASSERT_EQ(obstacles.markers.size(), 3u);
+  EXPECT_EQ(obstacles.namespaces, (std::vector<std::string>{"arm", "arm/unknown", "arm"}));
+  EXPECT_EQ(obstacles.markers[2].id, 7);
 }
 
 }  // namespace

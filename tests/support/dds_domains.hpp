@@ -126,6 +126,8 @@ inline constexpr int kRos2LaserScan = 66;
 inline constexpr int kRos2JointStates = 67;
 inline constexpr int kRos2CollisionObjects = 68;
 inline constexpr int kRos2Markers = 69;
+inline constexpr int kRos2UnknownObjects = 74;
+inline constexpr int kRos2UnknownMarkers = 75;
 
 // ros2_e2e_test: cellmapd with a ROS 2 node of another vendor (tests/ros2/peer).
 inline constexpr int kRos2Cell = 71;

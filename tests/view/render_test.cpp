@@ -182,6 +182,62 @@ TEST(RenderTest, TrueObstaclesShowThroughTranslucentBoxes) {
   cairo_surface_destroy(image);
 }
 
+// An unknown box (x 2..3) between two obstacle boxes (x 0..1 and 4..5), holding a small obstacle box: the
+// scene spans x 0..5, y 0..1, z 0..1 whether the unknown box is drawn or not, so both pictures share pixels.
+std::vector<Box> unknown_between_obstacles() {
+  Box unknown = aabb(2, {2.5, 0.5, 0.5}, {0.5, 0.5, 0.5});
+  unknown.space = BoxSpace::kUnknown;
+  return {aabb(1, {0.5, 0.5, 0.5}, {0.5, 0.5, 0.5}), unknown, aabb(3, {2.5, 0.5, 0.2}, {0.2, 0.2, 0.2}),
+          aabb(4, {4.5, 0.5, 0.5}, {0.5, 0.5, 0.5})};
+}
+
+// Where the top panel shows (x, y) of unknown_between_obstacles(): clear of the 0.5 m grid lines.
+Eigen::Vector2d top_of_scene(double x, double y) {
+  return top_pixel({x, y, 0}, 0, 5, 0, 1);
+}
+
+std::array<double, 3> shaded(std::array<double, 3> rgb, double shade) {
+  for (double& c : rgb) c *= shade;
+  return rgb;
+}
+
+TEST(RenderTest, UnknownBoxesAreFaintGreyOverWhatTheyHoldAndLeftOutWhenHidden) {
+  test::TempDir dir;
+  const Environment env("cell-1", 1, 0, unknown_between_obstacles());
+  render(env, dir.path() / "shown.png");
+  RenderOptions hide;
+  hide.unknown = false;
+  render(env, dir.path() / "hidden.png", hide);
+  cairo_surface_t* shown = cairo_image_surface_create_from_png((dir.path() / "shown.png").c_str());
+  cairo_surface_t* hidden = cairo_image_surface_create_from_png((dir.path() / "hidden.png").c_str());
+  ASSERT_EQ(cairo_surface_status(shown), CAIRO_STATUS_SUCCESS);
+  ASSERT_EQ(cairo_surface_status(hidden), CAIRO_STATUS_SUCCESS);
+  const std::array<double, 3> grey = shaded(kUnknownColour, kTopShade);
+  const std::array<double, 3> held = shaded(box_colour(3), kTopShade);
+  std::array<double, 3> grey_over_white{}, grey_over_held{};
+  for (int i = 0; i < 3; ++i) {
+    grey_over_white[i] = kUnknownAlpha * grey[i] + (1 - kUnknownAlpha);
+    grey_over_held[i] = kUnknownAlpha * grey[i] + (1 - kUnknownAlpha) * held[i];
+  }
+  // Shown: a neutral grey over the white panel, and the obstacle inside seen through it in its own hue.
+  expect_colour(shown, top_of_scene(2.85, 0.2), grey_over_white, "the unknown box's top");
+  expect_colour(shown, top_of_scene(2.4, 0.6), grey_over_held,
+                "the obstacle inside, through the unknown box");
+  expect_colour(shown, top_of_scene(0.3, 0.2), shaded(box_colour(1), kTopShade), "an obstacle box");
+  // Hidden: the panel's white where the unknown box was, the obstacle inside as it is.
+  expect_colour(hidden, top_of_scene(2.85, 0.2), {1, 1, 1}, "where the unknown box was");
+  expect_colour(hidden, top_of_scene(2.4, 0.6), held, "the obstacle that was inside");
+  expect_colour(hidden, top_of_scene(0.3, 0.2), shaded(box_colour(1), kTopShade), "an obstacle box");
+  cairo_surface_destroy(shown);
+  cairo_surface_destroy(hidden);
+}
+
+TEST(RenderTest, UnknownFacesAreProjectedWithTheirSpace) {
+  const std::vector<Face> faces = project(unknown_between_obstacles(), View::kTop, Panel{0, 0, 500, 100});
+  ASSERT_EQ(faces.size(), 4u);
+  for (const Face& face : faces) EXPECT_EQ(face.space == BoxSpace::kUnknown, face.box_id == 2) << face.box_id;
+}
+
 // Every path of the SVG as its list of points ("M x y L x y ... Z").
 std::vector<std::vector<Eigen::Vector2d>> svg_paths(const std::string& svg) {
   std::vector<std::vector<Eigen::Vector2d>> paths;
@@ -236,6 +292,67 @@ TEST(RenderTest, CommandDrawsABoxesFile) {
   test::ChildProcess bad({CELLMAP_TOOL, "render", boxes.string(), "-o", (dir.path() / "out.gif").string()});
   const int status = bad.wait();
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status;
+}
+
+// The number of pixels within 2 of `rgb` (0–1) in every channel in the rectangle of `image` between the
+// pixels `a` and `b`.
+int pixels_of_colour(cairo_surface_t* image, const std::array<double, 3>& rgb, const Eigen::Vector2d& a,
+                     const Eigen::Vector2d& b) {
+  int count = 0;
+  for (int y = int(std::min(a.y(), b.y())); y <= int(std::max(a.y(), b.y())); ++y) {
+    for (int x = int(std::min(a.x(), b.x())); x <= int(std::max(a.x(), b.x())); ++x) {
+      const auto got = pixel(image, x, y);
+      bool near = true;
+      for (int i = 0; i < 3; ++i) near = near && std::abs(got[i] - 255 * rgb[i]) <= 2.0;
+      count += near ? 1 : 0;
+    }
+  }
+  return count;
+}
+
+TEST(RenderTest, CommandDrawsUnknownSpaceGreyUnlessHidden) {
+  test::TempDir dir;
+  const std::filesystem::path boxes = dir.path() / "boxes.json";
+  write_box_file(boxes, BoxSet{6, "cell", unknown_between_obstacles()});
+  const auto run = [&](const std::string& name, std::vector<std::string> extra) {
+    const std::filesystem::path png = dir.path() / name;
+    std::vector<std::string> argv{CELLMAP_TOOL, "render", boxes.string(), "-o", png.string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    test::ChildProcess tool(argv);
+    const std::string line = tool.read_line(std::chrono::seconds(60)).value_or("");
+    EXPECT_EQ(tool.wait(), 0);
+    return std::make_pair(line, png);
+  };
+  const auto [shown_line, shown_png] = run("shown.png", {});
+  EXPECT_EQ(shown_line, "wrote " + shown_png.string() + ": cell boxes, version 6, 4 boxes (1 unknown)");
+  const auto [hidden_line, hidden_png] = run("hidden.png", {"--unknown", "hide"});
+  EXPECT_EQ(hidden_line,
+            "wrote " + hidden_png.string() + ": cell boxes, version 6, 4 boxes (1 unknown, not drawn)");
+
+  // The unknown box's top in the top view (x 2..3, y 0..1), faint grey over the white panel where the
+  // obstacle inside is not: there when shown, nowhere when hidden.
+  std::array<double, 3> top_grey{};
+  for (int i = 0; i < 3; ++i)
+    top_grey[i] = kUnknownAlpha * kUnknownColour[i] * kTopShade + (1 - kUnknownAlpha);
+  cairo_surface_t* shown = cairo_image_surface_create_from_png(shown_png.c_str());
+  cairo_surface_t* hidden = cairo_image_surface_create_from_png(hidden_png.c_str());
+  ASSERT_EQ(cairo_surface_status(shown), CAIRO_STATUS_SUCCESS);
+  ASSERT_EQ(cairo_surface_status(hidden), CAIRO_STATUS_SUCCESS);
+  expect_colour(shown, top_of_scene(2.85, 0.2), top_grey, "the unknown box's top, shown");
+  expect_colour(hidden, top_of_scene(2.85, 0.2), {1, 1, 1}, "where the unknown box is, hidden");
+  const Eigen::Vector2d from = top_of_scene(2.02, 0.02), to = top_of_scene(2.98, 0.98);
+  const int grey_shown = pixels_of_colour(shown, top_grey, from, to);
+  const int grey_hidden = pixels_of_colour(hidden, top_grey, from, to);
+  // About 110 × 110 pixels, less the obstacle inside (a sixth), the grid lines and the dashed outline.
+  EXPECT_GT(grey_shown, 7000);
+  EXPECT_EQ(grey_hidden, 0);
+  cairo_surface_destroy(shown);
+  cairo_surface_destroy(hidden);
+
+  test::ChildProcess bad(
+      {CELLMAP_TOOL, "render", boxes.string(), "--unknown", "dim", "-o", (dir.path() / "x.png").string()});
+  const int status = bad.wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << status;
 }
 
 }  // namespace

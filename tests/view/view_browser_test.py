@@ -44,6 +44,11 @@ NEW_BOX = ['add-box', '--center', '2.12,0.45,0.9', '--half-extents', '0.1,0.1,0.
 NEW_BOX_TOP = (2.12, 0.45, 1.05)
 NEW_BOX_CENTER = (2.12, 0.45, 0.9)
 ARM_BASE = (1.5, -0.45, 0.5)  # where config/scenes/arm_cell.yaml stands the arm's base_link
+# Unknown space is tracked under the table's front edge only, where no camera of the gantry looks (the table top
+# is between them and it) and the page's camera sees it below the table's edge: one unknown box, clear of every
+# obstacle box.
+UNKNOWN_LOWER = (1.0, 0.1, 0.1)
+UNKNOWN_UPPER = (2.0, 0.6, 0.6)
 
 ARGS = None
 
@@ -148,7 +153,8 @@ class ViewTest(unittest.TestCase):
         with open(config, 'w') as f:
             # Exact depths fill the map in two sweeps: a short settling is enough.
             f.write(text or 'cell: cell-view\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {noise: false}\n'
-                            'change: {settle_sweeps: 4}\n')
+                            'change: {settle_sweeps: 4}\n'
+                            f'unknown: {{workspace: {{lower: {list(UNKNOWN_LOWER)}, upper: {list(UNKNOWN_UPPER)}}}}}\n')
         daemon = Process([ARGS.cellmapd, '--config', config, '--domain', str(LIVE_DOMAIN), '--state-dir',
                           os.path.join(self.dir, f'{name}-state')], os.path.join(self.dir, f'{name}.log'))
         self.processes.append(daemon)
@@ -185,7 +191,7 @@ class ViewTest(unittest.TestCase):
         """(version, boxes) of the daemon's current snapshot, read by `cellmap render --domain`."""
         out = run_tool('render', '--domain', str(LIVE_DOMAIN), '--no-robot', '--timeout', '60', '-o',
                        os.path.join(self.dir, 'render.png'))
-        match = re.match(r'^wrote .*: cell cell-view, version (\d+), (\d+) boxes$', out)
+        match = re.match(r'^wrote .*: cell cell-view, version (\d+), (\d+) boxes(?: \(\d+ unknown\))?$', out)
         self.assertIsNotNone(match, out)
         return int(match.group(1)), int(match.group(2))
 
@@ -227,6 +233,7 @@ class ViewTest(unittest.TestCase):
         self.assertEqual(self.notice(), '')
         self.assertEqual(wait_for(self.daemon_state, 'the daemon state'), 'running')
         self.check_screenshot()
+        self.check_unknown()
         rounds = int(os.environ.get('CELLMAP_BROWSER_ROUNDS', '1'))
         for round_number in range(rounds):
             daemon, view = self.round(daemon, view, port, round_number)
@@ -290,6 +297,44 @@ class ViewTest(unittest.TestCase):
                  'the page to show the boxes again')
         self.log(f'round {round_number + 1}: box {new_id} added and removed, daemon and viewer restarted')
         return daemon, view
+
+    def check_unknown(self):
+        """The unknown box under the table is drawn grey where nothing is in front of it (its front face, seen
+        below the table's edge), goes when "unknown space" is unticked and comes back with the key U."""
+        ids = wait_for(lambda: self.js('cellmapView.unknownIds()'), 'an unknown box on the page')
+        self.assertEqual(len(ids), 1, ids)
+        box = self.js(f'cellmapView.box({ids[0]})')
+        self.assertEqual(box['space'], 'unknown')
+        self.assertIn('unknown', self.browser.find_element(By.ID, 'help').text)
+        self.assertIn('1 of them unknown space', self.browser.find_element(By.TAG_NAME, 'header').text)
+        lower = [c - h for c, h in zip(box['center'], box['half_extents'])]
+        upper = [c + h for c, h in zip(box['center'], box['half_extents'])]
+        for lo, hi, want_lo, want_hi in zip(lower, upper, UNKNOWN_LOWER, UNKNOWN_UPPER):
+            self.assertTrue(want_lo - 0.05 <= lo < hi <= want_hi + 0.05, box)  # the workspace, to a voxel or two
+        # Points on the front face (y = lower y), away from its dashed edges and the table above.
+        front = [(lower[0] + fx * (upper[0] - lower[0]), lower[1], lower[2] + fz * (upper[2] - lower[2]))
+                 for fx in (0.2, 0.35, 0.5, 0.65, 0.8) for fz in (0.2, 0.35, 0.5, 0.65)]
+        samples = self.pixels(front)
+        checkbox = self.browser.find_element(By.ID, 'show-unknown')
+        self.assertTrue(checkbox.is_selected())
+
+        def greyed(shown, hidden):
+            """How many samples are a neutral grey, darker than the same pixel without the unknown box."""
+            return sum(1 for x, y in samples if is_unknown_grey(shown.getpixel((x, y)), hidden.getpixel((x, y))))
+
+        shown = self.screenshot()
+        checkbox.click()
+        wait_for(lambda: self.js('cellmapView.unknownShown().length === 0'), 'the unknown box hidden')
+        hidden = wait_for(lambda: (lambda h: h if greyed(shown, h) >= 0.8 * len(samples) else None)(
+            self.screenshot()), 'the unknown box to go from the canvas')
+        self.log(f'{greyed(shown, hidden)} of {len(samples)} points of the unknown box\'s front face drawn grey, '
+                 'gone when unticked')
+        ActionChains(self.browser).send_keys('u').perform()
+        wait_for(lambda: self.js('cellmapView.unknownShown().length === 1'), 'the key U to show it again')
+        self.assertTrue(checkbox.is_selected())
+        again = wait_for(lambda: (lambda a: a if greyed(a, hidden) >= 0.8 * len(samples) else None)(
+            self.screenshot()), 'the unknown box drawn again')
+        self.log(f'{greyed(again, hidden)} of {len(samples)} points grey again after the key U')
 
     def check_click(self, box_id):
         """A click on the new box's top shows its details."""
@@ -477,6 +522,12 @@ def colour_near(before, after, x, y, is_colour, radius=2):
             if is_colour(after.getpixel(p)) and after.getpixel(p) != before.getpixel(p):
                 return True
     return False
+
+
+def is_unknown_grey(shown, hidden):
+    """Unknown space's grey (kUnknownColour, faint over what is behind): a neutral grey, every channel at least
+    15 darker than the same pixel with the unknown box hidden (the light background, or a grid line)."""
+    return max(shown) - min(shown) <= 10 and all(h - s >= 15 for s, h in zip(shown, hidden))
 
 
 def is_region_colour(pixel):

@@ -94,6 +94,21 @@ TEST(ViewStateTest, BoxesOfALateJoinersFirstCopyHaveNoKnownVersion) {
   EXPECT_EQ(box_in(cell, 5)["changed_in"], 8);
 }
 
+TEST(ViewStateTest, EveryBoxSaysWhichSpaceItHolds) {
+  // The page draws unknown boxes grey and lets them be hidden: it learns which they are from "space".
+  ViewState state(0, "");
+  Box unknown = make_box(2, 1.0);
+  unknown.space = BoxSpace::kUnknown;
+  const Environment v1("cell-a", 1, 100, {make_box(1, 0.0), unknown});
+  const json first = step(state, Environment("cell-a"), v1);
+  ASSERT_EQ(first["added"].size(), 2u);
+  EXPECT_EQ(first["added"][0]["space"], "occupied");
+  EXPECT_EQ(first["added"][1]["space"], "unknown");
+  const json cell = json::parse(state.state())["cells"][0];
+  EXPECT_EQ(box_in(cell, 1)["space"], "occupied");
+  EXPECT_EQ(box_in(cell, 2)["space"], "unknown");
+}
+
 TEST(ViewStateTest, TimelineKeepsTheNewestVersions) {
   ViewState state(0, "", 3);
   Environment env("cell-a");

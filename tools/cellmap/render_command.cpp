@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// `cellmap render ENV.json|--domain N [--cell C] [--scene S] -o OUT.png|OUT.svg`: a still picture of a cell's
-// boxes (top, side and perspective views) from a boxes file or a saved version, or from the live environment
-// on DDS with the robot where the daemon last saw it; a simulated cell's true obstacles drawn under the
-// boxes.
+// `cellmap render ENV.json|--domain N [--cell C] [--scene S] [--unknown show|hide] -o OUT.png|OUT.svg`: a
+// still picture of a cell's boxes (top, side and perspective views) from a boxes file or a saved version, or
+// from the live environment on DDS with the robot where the daemon last saw it; a simulated cell's true
+// obstacles drawn under the boxes; unknown space grey and translucent, or left out.
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -28,6 +29,7 @@ struct RenderCommandOptions {
   std::string scene;
   double timeout = 10;
   std::string output;
+  std::string unknown = "show";
   view::RenderOptions render;
   SecurityOptions security;
 };
@@ -121,9 +123,14 @@ void run_render(const RenderCommandOptions& options) {
   } else {
     env = environment_from_file(options.input);
   }
-  view::render(*env, options.output, options.render, overlays);
+  view::RenderOptions render = options.render;
+  render.unknown = options.unknown == "show";
+  view::render(*env, options.output, render, overlays);
   std::cout << "wrote " << options.output << ": cell " << env->cell() << ", version " << env->version()
             << ", " << env->boxes().size() << " boxes";
+  const auto unknown = std::count_if(env->boxes().begin(), env->boxes().end(),
+                                     [](const Box& box) { return box.space == BoxSpace::kUnknown; });
+  if (unknown > 0) std::cout << " (" << unknown << " unknown" << (render.unknown ? "" : ", not drawn") << ")";
   if (!overlays.robot.empty()) std::cout << ", the robot (" << overlays.robot.size() << " shapes)";
   if (!overlays.obstacles.empty()) std::cout << ", " << overlays.obstacles.size() << " true obstacles";
   std::cout << std::endl;
@@ -154,6 +161,12 @@ void add_render_command(CLI::App& app) {
       ->add_option("--timeout", options->timeout,
                    "with --domain: seconds to wait for the environment and the robot")
       ->check(CLI::PositiveNumber);
+  command
+      ->add_option(
+          "--unknown", options->unknown,
+          "unknown boxes (space no sensor has observed): show (grey, translucent, dashed outlines; the "
+          "default) or hide")
+      ->check(CLI::IsMember({"show", "hide"}));
   command->add_option("-o,--output", options->output, "the picture: OUT.png or OUT.svg")->required();
   command->add_option("--width", options->render.width, "pixels (default 1600)")
       ->check(CLI::Range(200, 20000));

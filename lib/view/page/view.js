@@ -11,6 +11,11 @@ const GHOST_MS = 3000;
 const FADE_MS = 1500;
 const TIMELINE_SHOWN = 200;
 const BOX_OPACITY = 0.88;
+// Unknown boxes (space no sensor has observed) are large and may hold obstacles: a faint grey fill that never
+// hides what is inside or behind it, and dashed edges, so they never read as an obstacle.
+const UNKNOWN_COLOUR = new THREE.Color(0.55, 0.55, 0.55);  // kUnknownColour in cellmap/boxes/box.hpp
+const UNKNOWN_OPACITY = 0.3;
+const UNKNOWN_EDGE_COLOUR = 0x6b6b6b;
 const FADE_STEP_MS = 250;
 
 const $ = (id) => document.getElementById(id);
@@ -68,20 +73,44 @@ function boxColour(id) {
   return new THREE.Color().setHSL(hue, 0.62, 0.66);
 }
 
+function isUnknown(box) {
+  return box.space === 'unknown';
+}
+
+// The fill of a box: its id's hue, or the one grey of unknown space.
+function fillColour(box) {
+  return isUnknown(box) ? UNKNOWN_COLOUR.clone() : boxColour(box.id);
+}
+
+function boxOpacity(box) {
+  if (isUnknown(box)) return UNKNOWN_OPACITY;
+  return $('layer-voxels').checked ? 0.25 : BOX_OPACITY;
+}
+
+function edgeColour(box) {
+  return isUnknown(box) ? UNKNOWN_EDGE_COLOUR : 0x2a3440;
+}
+
 function makeBoxObject(box) {
   const size = box.half_extents.map((h) => Math.max(2 * h, 1e-4));
   const geometry = new THREE.BoxBufferGeometry(size[0], size[1], size[2]);
-  const material = new THREE.MeshLambertMaterial({ color: boxColour(box.id), transparent: true,
-                                                    opacity: $('layer-voxels').checked ? 0.25 : BOX_OPACITY });
+  const unknown = isUnknown(box);
+  // An unknown box writes no depth, so obstacles inside or behind it are drawn whatever the order.
+  const material = new THREE.MeshLambertMaterial({ color: fillColour(box), transparent: true,
+                                                    opacity: boxOpacity(box), depthWrite: !unknown });
   const mesh = new THREE.Mesh(geometry, material);
-  const edges = new THREE.LineSegments(new THREE.EdgesGeometry(geometry),
-                                       new THREE.LineBasicMaterial({ color: 0x2a3440 }));
+  const edges = new THREE.LineSegments(
+    new THREE.EdgesGeometry(geometry),
+    unknown ? new THREE.LineDashedMaterial({ color: edgeColour(box), dashSize: 0.06, gapSize: 0.04 })
+            : new THREE.LineBasicMaterial({ color: edgeColour(box) }));
+  if (unknown) edges.computeLineDistances();
   mesh.add(edges);
+  mesh.visible = !unknown || $('show-unknown').checked;
   mesh.position.set(box.center[0], box.center[1], box.center[2]);
   const [w, x, y, z] = box.rotation;
   mesh.quaternion.set(x, y, z, w);
   mesh.userData.id = box.id;
-  return { mesh, edges };
+  return { mesh, edges, box };
 }
 
 function disposeObject(object) {
@@ -166,11 +195,13 @@ function applyHighlights(now) {
     const left = until ? strength(until) : 0;
     const selected = id === selectedBox;
     entry.glow = left;
-    entry.mesh.material.color.copy(boxColour(id)).lerp(highlightColour, left);
+    // An unknown box keeps its grey fill (a glow would give it an obstacle's hue); its edges glow.
+    const glowFill = isUnknown(entry.box) ? 0 : left;
+    entry.mesh.material.color.copy(fillColour(entry.box)).lerp(highlightColour, glowFill);
     // A glowing box stays orange when selected; its blue edges show the selection.
-    entry.mesh.material.emissive.copy(left > 0 ? highlightColour : selectedColour)
-      .multiplyScalar(left > 0 ? 0.35 * left : selected ? 0.45 : 0);
-    entry.edges.material.color.set(selected ? 0x1565c0 : left > 0 ? 0xd35400 : 0x2a3440);
+    entry.mesh.material.emissive.copy(glowFill > 0 ? highlightColour : selectedColour)
+      .multiplyScalar(glowFill > 0 ? 0.35 * glowFill : selected ? 0.45 : 0);
+    entry.edges.material.color.set(selected ? 0x1565c0 : left > 0 ? 0xd35400 : edgeColour(entry.box));
   }
   for (const [id, until] of highlights) if (until <= now) highlights.delete(id);
   for (let i = ghosts.length - 1; i >= 0; --i) {
@@ -237,7 +268,11 @@ canvas.addEventListener('pointerup', (e) => {
   const ndc = new THREE.Vector2(((e.clientX - rect.left) / rect.width) * 2 - 1,
                                 -((e.clientY - rect.top) / rect.height) * 2 + 1);
   raycaster.setFromCamera(ndc, camera);
-  const hit = raycaster.intersectObjects([...meshes.values()].map((m) => m.mesh), false)[0];
+  // An obstacle inside or behind an unknown box is what a click there means; an unknown box only where no
+  // obstacle is hit. Hidden boxes are not clickable.
+  const shown = [...meshes.values()].filter((m) => m.mesh.visible);
+  const hitOf = (entries) => raycaster.intersectObjects(entries.map((m) => m.mesh), false)[0];
+  const hit = hitOf(shown.filter((m) => !isUnknown(m.box))) || hitOf(shown.filter((m) => isUnknown(m.box)));
   selectBox(hit ? hit.object.userData.id : null);
 });
 
@@ -273,12 +308,13 @@ function showSelection() {
   }
   const size = box.half_extents.map((h) => fmt(2 * h));
   const [roll, pitch, yaw] = eulerDegrees(box.rotation);
-  panel.innerHTML = `<h3>box ${box.id}</h3><table>
+  const what = isUnknown(box) ? ' <span class="unknown-tag">unknown space</span>' : '';
+  panel.innerHTML = `<h3>box ${box.id}${what}</h3><table>
     <tr><td>size</td><td>${size.join(' × ')} m</td></tr>
     <tr><td>centre</td><td>${box.center.map((c) => fmt(c)).join(', ')} m</td></tr>
     <tr><td>rotation</td><td>[${box.rotation.map((q) => fmt(q, 4)).join(', ')}]<br>
         roll ${roll}° pitch ${pitch}° yaw ${yaw}°</td></tr>
-    <tr><td>points</td><td>${box.points}</td></tr>
+    <tr><td>${isUnknown(box) ? 'unknown voxels' : 'points'}</td><td>${box.points}</td></tr>
     <tr><td>changed in</td><td>${changedIn(cell, box)}</td></tr></table>`;
   panel.hidden = false;
 }
@@ -295,6 +331,9 @@ function updateHeader() {
   $('version').textContent = cell && cell.version > 0 ? cell.version : '–';
   $('stamp').textContent = cell && cell.stamp_ns ? stampText(cell.stamp_ns) : '';
   $('box-count').textContent = cell ? cell.boxes.size : 0;
+  const unknown = cell ? [...cell.boxes.values()].filter(isUnknown).length : 0;
+  $('unknown-count').textContent = unknown;
+  $('unknown-figure').hidden = unknown === 0;
   const select = $('cell-select');
   const names = [...cells.keys()].sort();
   if (select.options.length !== names.length || names.some((n, i) => select.options[i].value !== n)) {
@@ -353,14 +392,19 @@ let tableShown = '';
 function updateBoxTable(force) {
   const cell = cells.get(selectedCell);
   const boxes = cell ? [...cell.boxes.values()].sort((a, b) => a.id - b.id) : [];
-  const key = boxes.map((b) => `${b.id}:${b.changed_in}:${highlights.has(b.id)}`).join(',') + '|' + selectedBox;
+  const key = boxes.map((b) => `${b.id}:${b.changed_in}:${highlights.has(b.id)}`).join(',') + '|' + selectedBox +
+              '|' + $('show-unknown').checked;
   if (!force && key === tableShown) return;
   tableShown = key;
   $('boxes').tBodies[0].innerHTML = boxes.map((b) => {
     const size = b.half_extents.map((h) => Math.round(200 * h)).join('×');
-    const classes = [highlights.has(b.id) ? 'changed' : '', b.id === selectedBox ? 'selected' : ''].join(' ');
-    const swatch = `<span class="swatch" style="background:#${boxColour(b.id).getHexString()}"></span>`;
-    return `<tr data-id="${b.id}" class="${classes.trim()}"><td>${swatch}${b.id}</td><td>${size}</td>` +
+    const classes = [highlights.has(b.id) ? 'changed' : '', b.id === selectedBox ? 'selected' : '',
+                     isUnknown(b) ? 'unknown' : '', isUnknown(b) && !$('show-unknown').checked ? 'hidden-box' : '']
+      .join(' ');
+    const swatch = `<span class="swatch${isUnknown(b) ? ' unknown' : ''}" ` +
+                   `style="background:#${fillColour(b).getHexString()}"></span>`;
+    return `<tr data-id="${b.id}" class="${classes.replace(/ +/g, ' ').trim()}"><td>${swatch}${b.id}</td>` +
+           `<td>${size}${isUnknown(b) ? ' <span class="unknown-tag">unknown</span>' : ''}</td>` +
            `<td>${b.points}</td><td>${b.changed_in ?? '≤ ' + cell.joined_at}</td></tr>`;
   }).join('');
 }
@@ -522,7 +566,9 @@ function rebuildLayers() {
   const cell = cells.get(selectedCell);
   if (!cell) return;
   const voxels = $('layer-voxels').checked && cell.voxels;
-  for (const entry of meshes.values()) entry.mesh.material.opacity = voxels ? 0.25 : BOX_OPACITY;
+  for (const entry of meshes.values()) {
+    entry.mesh.material.opacity = isUnknown(entry.box) ? UNKNOWN_OPACITY : voxels ? 0.25 : BOX_OPACITY;
+  }
   if (voxels) layerGroup.add(voxelObject(cell.voxels));
   if ($('layer-regions').checked && cell.regions) layerGroup.add(regionObject(cell.regions));
   if ($('layer-sensors').checked && cell.sensors) layerGroup.add(sensorObject(cell.sensors));
@@ -647,6 +693,28 @@ function sendLayers() {
 }
 for (const name of ['voxels', 'regions', 'sensors', 'robot']) $(`layer-${name}`).addEventListener('change', sendLayers);
 
+// ---- unknown space: shown or hidden in this page only (the daemon publishes it either way) ----
+function showUnknown() {
+  const shown = $('show-unknown').checked;
+  for (const entry of meshes.values()) if (isUnknown(entry.box)) entry.mesh.visible = shown;
+  if (!shown && selectedBox !== null && meshes.has(selectedBox) && isUnknown(meshes.get(selectedBox).box)) {
+    selectBox(null);
+  }
+  updateBoxTable(true);
+  requestRender();
+}
+$('show-unknown').addEventListener('change', showUnknown);
+// The key U does what the checkbox does (the help line says so), unless typing goes somewhere else.
+window.addEventListener('keydown', (e) => {
+  if (e.key !== 'u' && e.key !== 'U') return;
+  const target = e.target;
+  const typing = target.isContentEditable || ['SELECT', 'TEXTAREA'].includes(target.tagName) ||
+                 (target.tagName === 'INPUT' && target.type !== 'checkbox');
+  if (e.ctrlKey || e.metaKey || e.altKey || typing) return;
+  $('show-unknown').checked = !$('show-unknown').checked;
+  showUnknown();
+});
+
 // ---- the WebSocket: reconnects by itself, and the server sends the whole state on each connection ----
 let retryMs = 500;
 
@@ -691,6 +759,12 @@ window.cellmapView = {
   cell: () => selectedCell,
   version: () => (cells.get(selectedCell) || { version: 0 }).version,
   boxIds: () => [...meshes.keys()].sort((a, b) => a - b),
+  // The unknown boxes in the scene, and those of them shown (not hidden by the checkbox or the key U).
+  unknownIds: () => [...meshes.keys()].filter((id) => isUnknown(meshes.get(id).box)).sort((a, b) => a - b),
+  unknownShown: () => [...meshes.keys()].filter((id) => isUnknown(meshes.get(id).box) && meshes.get(id).mesh.visible)
+    .sort((a, b) => a - b),
+  // A box as the page holds it (id, center, half_extents, rotation, points, space, changed_in), or null.
+  box: (id) => { const entry = meshes.get(id); return entry ? entry.box : null; },
   highlighted: () => [...meshes.keys()].filter((id) => meshes.get(id).glow > 0),  // as in the last frame drawn
   voxelRuns: () => layerGroup.children.filter((o) => o.isInstancedMesh).reduce((n, o) => n + o.count, 0),
   // The sweep of the latest layer ("voxels", "regions", "sensors" or "robot") of the shown cell, or null.

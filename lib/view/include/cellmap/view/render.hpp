@@ -35,6 +35,7 @@ struct Panel final {
 /// and its brightness (0–1, Lambert shading from a light over the camera's shoulder).
 struct Face final {
   std::uint64_t box_id = 0;
+  BoxSpace space = BoxSpace::kOccupied;  ///< an unknown box's faces are painted grey and translucent
   std::array<Eigen::Vector2d, 4> corners_px;
   double depth = 0;
   double shade = 0;
@@ -50,7 +51,15 @@ struct RenderOptions final {
   int width = 1600;  ///< pixels (SVG: points)
   int height = 1000;
   std::string title;  ///< the heading; default: cell, version, box count
+  /// Whether unknown boxes (space no sensor has observed) are drawn: in kUnknownColour, translucent
+  /// (kUnknownAlpha) with dashed outlines, so the obstacles inside and behind them show. Hidden, they are
+  /// left out of the picture and of the scene its panels fit.
+  bool unknown = true;
 };
+
+/// How opaque an unknown box's faces are painted: faint, since unknown boxes are large and may hold
+/// obstacles.
+inline constexpr double kUnknownAlpha = 0.3;
 
 /// A solid drawn with the boxes: one of the robot's collision shapes, or a true obstacle of a simulated cell.
 struct Solid final {

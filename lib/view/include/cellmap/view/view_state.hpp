@@ -19,8 +19,9 @@
 //    (cylinder, axis along its z), "radius" (sphere), "vertices":[x,y,z, ...] (0.1 mm), "triangles":[i,j,k,
 //    ...] (mesh)}...]}  (the shape's frame in the cell frame; vertices in the shape's frame)
 // CELL = {"cell", "version", "stamp_ns", "boxes":[BOX...], "timeline":[ENTRY...], "status":STATUS|null}
-// BOX = {"id", "center", "half_extents", "rotation" [w,x,y,z], "points", "changed_in"} where changed_in is
-//   the version that added or last modified the box, null if that was before the viewer joined
+// BOX = {"id", "center", "half_extents", "rotation" [w,x,y,z], "points", "space", "changed_in"} where space
+//   is "occupied" (an obstacle box) or "unknown" (space no sensor has observed) and changed_in is the version
+//   that added or last modified the box, null if that was before the viewer joined
 // ENTRY = {"from_version", "to_version", "stamp_ns", "received_ns", "added", "modified", "removed"} (counts)
 // STATUS = {"cell", "daemon" (false once it is gone), "state", "reason", "sensors":[{"name","state"}...],
 //   "last_sweep_ns", "sweeps", "dropped_frames", "refused_inputs", "boxes", "version"}
