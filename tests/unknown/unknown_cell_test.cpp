@@ -71,7 +71,7 @@ TEST(UnknownCellTest, TheDefaultCellsUnseenSpaceOverTheTableIsFewBoxesHoldingEve
 // Kinect looking down from the gantry never sees (it would need to look 54° off its axis; its half field of
 // view is 35°), a 16 cm cube.
 const Eigen::Vector3d kHidden(2.2, 1.4, 0.974);
-const Eigen::Vector3d kBesideHidden(2.4, 1.55, 1.1);  // under the shelf too
+const Eigen::Vector3d kBesideHidden(2.0, 1.25, 1.12);  // under the shelf too
 
 sim::Scene scene_with_a_shelf() {
   sim::Scene scene = sim::default_scene();

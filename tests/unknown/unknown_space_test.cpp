@@ -26,6 +26,13 @@ Region region_of(const Eigen::Vector3i& low, const Eigen::Vector3i& high) {
   return {low.cast<double>() * kVoxel, high.cast<double>() * kVoxel};
 }
 
+Box box_over(const Region& region) {
+  Box box;
+  box.center = 0.5 * (region.min + region.max);
+  box.half_extents = 0.5 * (region.max - region.min);
+  return box;
+}
+
 void expect_box_spans(const Box& box, const Region& expected) {
   EXPECT_TRUE(box.center.isApprox(0.5 * (expected.min + expected.max), 1e-9)) << box.center.transpose();
   EXPECT_TRUE(box.half_extents.isApprox(0.5 * (expected.max - expected.min), 1e-9))
@@ -204,6 +211,21 @@ TEST(UnknownSpaceTest, BadConfigsAndGridsAreRefusedByName) {
   EXPECT_THROW(VoxelStateGrid({1024, 1024, 1024}, kVoxel, Eigen::Vector3d::Zero()), Error);
   const OccupancyMap map;
   EXPECT_THROW((void)VoxelStateGrid::of(map, Region{{0, 0, 0}, {0, 0, 0}}), Error);
+}
+
+TEST(UnknownSpaceTest, FreesACubeOnlyWhereNoBoxHoldsOneWholeCube) {
+  const VoxelStateGrid grid({30, 20, 20}, kVoxel, Eigen::Vector3d::Zero());
+  // Two boxes over the grid's x ends leave a slab of `gap` voxels between them.
+  const auto ends_apart = [&](int gap) {
+    const int left = (30 - gap) / 2;
+    return std::vector<Box>{box_over(region_of({0, 0, 0}, {left, 20, 20})),
+                            box_over(region_of({left + gap, 0, 0}, {30, 20, 20}))};
+  };
+  const double edge = 10 * kVoxel;
+  EXPECT_TRUE(frees_a_cube(grid, ends_apart(10), edge));
+  EXPECT_FALSE(frees_a_cube(grid, ends_apart(9), edge));  // a 9-voxel slab holds no 10-voxel cube
+  EXPECT_FALSE(frees_a_cube(grid, {box_over(region_of({0, 0, 0}, {30, 20, 20}))}, edge));
+  EXPECT_TRUE(frees_a_cube(grid, {}, edge));
 }
 
 }  // namespace

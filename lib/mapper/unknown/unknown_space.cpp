@@ -188,8 +188,8 @@ void drop_boxes_held_by_others(std::vector<IndexBox>& boxes) {
   boxes = std::move(kept);
 }
 
-// Joins the pair that adds the least seen free space while that is within max_free_share of the joined
-// box, or while there are more than max_boxes.
+// Joins the pair that adds the least seen free space while that is within max_free_share of the space the
+// join adds, or while there are more than max_boxes.
 void join_boxes(std::vector<IndexBox>& boxes, const VoxelCounts& free, const UnknownConfig& config) {
   drop_boxes_held_by_others(boxes);
   while (boxes.size() > 1) {
@@ -201,9 +201,13 @@ void join_boxes(std::vector<IndexBox>& boxes, const VoxelCounts& free, const Unk
         if (cost < best_cost) best_cost = cost, best_i = i, best_j = j;
       }
     }
-    const IndexBox joined = boxes[best_i].joined(boxes[best_j]);
-    const bool cheap =
-        static_cast<double>(best_cost) <= config.max_free_share * static_cast<double>(joined.voxels());
+    const IndexBox& a = boxes[best_i];
+    const IndexBox& b = boxes[best_j];
+    const IndexBox joined = a.joined(b);
+    // Measured against the space the join adds, as a layer's growth is: against the joined box, two large
+    // boxes would take in a free gap between them that a limb could be in.
+    const long long added = joined.voxels() - a.voxels() - b.voxels() + a.overlap(b).voxels();
+    const bool cheap = static_cast<double>(best_cost) <= config.max_free_share * static_cast<double>(added);
     if (!cheap && static_cast<int>(boxes.size()) <= config.max_boxes) break;
     boxes[best_i] = joined;
     boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(best_j));

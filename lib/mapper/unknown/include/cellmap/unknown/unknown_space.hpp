@@ -26,8 +26,8 @@ struct UnknownConfig final {
   /// blocks nothing a planner could use.
   double max_free_share = 0.2;
   /// Boxes are joined, cheapest join first (the least seen free space added), until at most this many
-  /// remain, [1, 10000] (default 20); joins that add no more seen free space than `max_free_share` of the
-  /// joined box are made whatever the count.
+  /// remain, [1, 10000] (default 20); joins whose added space (the joined box less the two) is at most
+  /// `max_free_share` seen free space are made whatever the count.
   int max_boxes = 20;
 
   /// @throws Error naming the field if a value is out of range or not finite.
