@@ -77,8 +77,8 @@ struct Blocking final {
   std::uint64_t box_id = 0;
   /// Whether an obstacle or an unknown box blocks; checked against bare Obbs every box counts as occupied.
   BoxSpace space = BoxSpace::kOccupied;
-  /// Cell frame: the point of the blocking box closest to (or deepest in) the robot box, where the path runs
-  /// into it (SignedDistance::point_b).
+  /// Cell frame: the blocking box's witness point (SignedDistance::point_b), where the robot box comes
+  /// closest to it or, overlapping, meets it along the shortest separation: where the path runs into the box.
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
 };
 
