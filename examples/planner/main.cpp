@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // An example planner built on cellmap's client library (cellmap::client): it holds one path, follows a cell's
 // environment over DDS, re-checks the path with the collision library on every new version, and prints one
-// line each time the path's state changes ("path free", or "path blocked by box <id> at ...").
+// line each time the path's state changes ("path free", "path blocked by box <id> at ...", or "path blocked
+// by unknown region <id> at ..." when space no sensor has observed is in the way).
 //
 // The path is that of a box the robot carries (a gripper with its part): a cubic B-spline over control points
 // of the box centre in the cell frame C (it starts at the first and ends at the last). It is modelled as a
@@ -9,8 +10,8 @@
 // applies unchanged; a planner with a real robot builds its RobotBoxes from its URDF instead.
 //
 //   cellmap_example_planner [--domain N] [--cell ID] [--control-points "x,y,z;x,y,z;..."]
-//                           [--half-extents A,B,C] [--margin M] [--checkpoints N] [--json] [--every]
-//                           [--security DIR [--role planner]]
+//                           [--half-extents A,B,C] [--margin M] [--checkpoints N] [--ignore-unknown]
+//                           [--json] [--every] [--security DIR [--role planner]]
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
@@ -20,7 +21,6 @@
 #include <optional>
 #include <sstream>
 
-#include "cellmap/collision/box_tree.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/common/text.hpp"
 #include "cellmap/planning/path_check.hpp"
@@ -36,6 +36,7 @@ using cellmap::Error;
 struct PathState {
   bool blocked = false;
   std::uint64_t box = 0;  // id of the first environment box closer than the margin
+  cellmap::BoxSpace space = cellmap::BoxSpace::kOccupied;  // an obstacle box, or an unknown box
   int checkpoint = -1;
   double t = 0.0;                                  // path parameter of that checkpoint, [0, 1]
   Eigen::Vector3d p_CB = Eigen::Vector3d::Zero();  // where the carried box's centre is then
@@ -58,25 +59,27 @@ std::vector<Eigen::VectorXd> parse_points(const std::string& text, const std::st
 class PathWatch {
  public:
   PathWatch(const std::vector<Eigen::VectorXd>& control_points, const Eigen::Vector3d& half_extents,
-            double margin, int checkpoints)
-      : robot_(carried_box(half_extents)), path_(control_points), margin_(margin), checkpoints_(checkpoints) {
+            double margin, int checkpoints, cellmap::planning::PathCheckOptions options)
+      : robot_(carried_box(half_extents)),
+        path_(control_points),
+        margin_(margin),
+        checkpoints_(checkpoints),
+        options_(options) {
     if (!(margin >= 0.0)) throw Error("--margin: must be >= 0");
     if (checkpoints < 2) throw Error("--checkpoints: must be >= 2");
   }
 
   [[nodiscard]] PathState check(const Environment& environment) const {
-    std::vector<cellmap::collision::Obb> boxes;
-    boxes.reserve(environment.boxes().size());
-    for (const cellmap::Box& box : environment.boxes()) boxes.push_back(cellmap::collision::to_obb(box));
-    const cellmap::collision::BoxTree tree(boxes);
+    const cellmap::planning::PathEnvironment boxes(environment.boxes(), options_);
     const cellmap::planning::Blocking blocking =
-        cellmap::planning::path_blocked(robot_, path_, checkpoints_, boxes, tree, margin_);
+        cellmap::planning::path_blocked(robot_, path_, checkpoints_, boxes, margin_);
     PathState state;
     if (!blocking.blocked) return state;
     state.blocked = true;
-    state.box = environment.boxes()[static_cast<std::size_t>(blocking.env_box)].id;
+    state.box = blocking.box_id;
+    state.space = blocking.space;
     state.checkpoint = blocking.checkpoint;
-    state.t = static_cast<double>(blocking.checkpoint) / (checkpoints_ - 1);
+    state.t = blocking.t;
     state.p_CB = path_.at(state.t);
     state.distance = blocking.distance;
     return state;
@@ -97,6 +100,7 @@ class PathWatch {
   cellmap::planning::BSplinePath path_;
   double margin_;
   int checkpoints_;
+  cellmap::planning::PathCheckOptions options_;
 };
 
 std::string describe(const PathState& state, const Environment& env, const EnvironmentDelta& delta,
@@ -112,6 +116,7 @@ std::string describe(const PathState& state, const Environment& env, const Envir
                            {"state", state.blocked ? "blocked" : "free"}};
     if (state.blocked) {
       line["box"] = state.box;
+      line["space"] = cellmap::space_name(state.space);
       line["checkpoint"] = state.checkpoint;
       line["t"] = state.t;
       line["position"] = {state.p_CB.x(), state.p_CB.y(), state.p_CB.z()};
@@ -128,7 +133,8 @@ std::string describe(const PathState& state, const Environment& env, const Envir
     char where[160];
     std::snprintf(where, sizeof where, "checkpoint %d (t %.3f, x %.3f y %.3f z %.3f), distance %.3f m",
                   state.checkpoint, state.t, state.p_CB.x(), state.p_CB.y(), state.p_CB.z(), state.distance);
-    line << "path blocked by box " << state.box << " at " << where;
+    const bool unknown = state.space == cellmap::BoxSpace::kUnknown;
+    line << "path blocked by " << (unknown ? "unknown region " : "box ") << state.box << " at " << where;
   }
   return line.str();
 }
@@ -142,6 +148,7 @@ struct Options {
   std::string half_extents = "0.05,0.05,0.05";
   double margin = 0.02;
   int checkpoints = 50;
+  bool ignore_unknown = false;
   bool json = false;
   bool every = false;
   std::string security_dir;  // DDS Security credentials (`cellmap security init`); empty: off
@@ -157,6 +164,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--half-extents", o.half_extents, "half extents A,B,C of the carried box (m)");
   app.add_option("--margin", o.margin, "safety margin: closer than this counts as blocked (m)");
   app.add_option("--checkpoints", o.checkpoints, "checkpoints along the path");
+  app.add_flag("--ignore-unknown", o.ignore_unknown,
+               "take unknown regions (space no sensor has observed) for free; by default they block the path "
+               "as obstacles do");
   app.add_flag("--json", o.json, "one JSON object per line instead of text");
   app.add_flag("--every", o.every, "one line per new version, not only when the path's state changes");
   auto* security_option =
@@ -172,12 +182,13 @@ void follow(const Options& o, const sigset_t& stop_signals) {
   if (extents.size() != 1 || (extents[0].array() < 0.0).any())
     throw Error("--half-extents: expected one A,B,C >= 0");
   const PathWatch watch(parse_points(o.control_points, "--control-points"), extents[0], o.margin,
-                        o.checkpoints);
+                        o.checkpoints, cellmap::planning::PathCheckOptions{o.ignore_unknown});
 
   std::optional<PathState> last;  // touched only by the subscriber's thread
   const auto on_change = [&](const Environment& env, const EnvironmentDelta& delta) {
     const PathState state = watch.check(env);
-    const bool changed = !last || last->blocked != state.blocked || last->box != state.box;
+    const bool changed =
+        !last || last->blocked != state.blocked || last->box != state.box || last->space != state.space;
     last = state;
     if (changed || o.every)
       std::cout << describe(state, env, delta, o.json) << std::endl;  // flushed: read by scripts

@@ -2,12 +2,14 @@
 // The example planner (examples/planner) as a real process against cellmapd on the simulated cell: a box
 // injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
 // by it; removing the box frees the path again; a clean daemon restart does not read as "all removed". Plain
-// and with DDS Security on every process and participant.
+// and with DDS Security on every process and participant. Unknown boxes (published by the test itself, with
+// known answers) block the path as "unknown region" unless the planner is told to ignore unknown space.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "cellmap/transport/environment_publisher.hpp"
 #include "daemon/service_e2e.hpp"
 #include "support/dds_domains.hpp"
 
@@ -112,6 +114,84 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_EQ(planner.wait(), 0);
   daemon->signal(SIGTERM);
   EXPECT_EQ(daemon->wait(), 0);
+}
+
+Box cube(std::uint64_t id, const Eigen::Vector3d& center, double half, BoxSpace space) {
+  Box box;
+  box.id = id;
+  box.center = center;
+  box.half_extents = Eigen::Vector3d::Constant(half);
+  box.space = space;
+  return box;
+}
+
+// The test publishes the environments itself, so every distance is a known answer. The planner's default path
+// runs straight from y = 0.1 to 0.8 at x 2.12, z 1.0, checkpoint k (of 50) at y = 0.1 + 0.7 k / 49, carrying
+// a cube of half 0.05 with a margin of 0.02: it is blocked from the first checkpoint whose cube comes within
+// 0.02 of a box's face at y = f, 0.1 + 0.7 k / 49 + 0.05 > f − 0.02.
+TEST(PlannerUnknownSpaceTest, UnknownRegionBlocksThePathUnlessIgnored) {
+  test::use_loopback();
+  const int domain = test::domain::kPlannerUnknown;
+  const std::string cell = "planner-unknown";
+  const dds::Participant daemon(static_cast<std::uint32_t>(domain));
+  transport::EnvironmentPublisher publisher(daemon, cell);
+  // Version 1: an unknown box across the path (face at y = 0.35: checkpoint 13, y 0.286, 0.014 m short of
+  // it) and an obstacle off the path.
+  const Box unknown = cube(5, Eigen::Vector3d(2.12, 0.45, 1.0), 0.1, BoxSpace::kUnknown);
+  const Box aside = cube(3, Eigen::Vector3d(0.5, 1.5, 0.85), 0.1, BoxSpace::kOccupied);
+  const Environment first(cell, 1, 1'000, {aside, unknown});
+  publisher.publish(first);
+
+  // `cellmap echo` shows the unknown box's space; the obstacle's line stays as it was (no "space").
+  test::ChildProcess echo({CELLMAP_TOOL, "echo", "--domain", std::to_string(domain), "--cell", cell,
+                           "--count", "1", "--timeout", "60"});
+  const nlohmann::json echoed = nlohmann::json::parse(echo.read_line(test::kDaemonPatience).value_or("{}"));
+  EXPECT_EQ(echo.wait(), 0);
+  const nlohmann::json& boxes = echoed.contains("boxes") ? echoed["boxes"] : echoed["added"];
+  ASSERT_EQ(boxes.size(), 2u) << echoed.dump();
+  EXPECT_EQ(boxes[0].value("id", 0), 3) << echoed.dump();
+  EXPECT_FALSE(boxes[0].contains("space")) << echoed.dump();
+  EXPECT_EQ(boxes[1].value("id", 0), 5) << echoed.dump();
+  EXPECT_EQ(boxes[1].value("space", ""), "unknown") << echoed.dump();
+
+  const std::vector<std::string> planner_argv{CELLMAP_PLANNER, "--domain", std::to_string(domain), "--cell",
+                                              cell};
+  test::ChildProcess careful(planner_argv);
+  std::vector<std::string> ignoring_argv = planner_argv;
+  ignoring_argv.insert(ignoring_argv.end(), {"--ignore-unknown", "--json"});
+  test::ChildProcess ignoring(ignoring_argv);
+
+  EXPECT_EQ(
+      careful.read_line(test::kDaemonPatience).value_or(""),
+      "version 1 (+2 ~0 -0): path blocked by unknown region 5 at checkpoint 13 (t 0.265, x 2.120 y 0.286 "
+      "z 1.000), distance 0.014 m");
+  EXPECT_EQ(next_state(ignoring).value("state", ""), "free");
+
+  // Version 2: an obstacle on the path behind the unknown box (face at y = 0.6: checkpoint 31, y 0.543,
+  // 0.007 m short of it). The unknown box still blocks first, so the careful planner prints nothing new.
+  const Box behind = cube(8, Eigen::Vector3d(2.12, 0.65, 1.0), 0.05, BoxSpace::kOccupied);
+  const Environment second(cell, 2, 2'000, {aside, unknown, behind});
+  publisher.publish(second, diff(first, second));
+  const nlohmann::json blocked = next_state(ignoring);
+  EXPECT_EQ(blocked.value("state", ""), "blocked") << blocked.dump();
+  EXPECT_EQ(blocked.value("version", 0), 2) << blocked.dump();
+  EXPECT_EQ(blocked.value("box", 0), 8) << blocked.dump();
+  EXPECT_EQ(blocked.value("space", ""), "occupied") << blocked.dump();
+  EXPECT_EQ(blocked.value("checkpoint", 0), 31) << blocked.dump();
+  EXPECT_NEAR(blocked.value("distance", 1.0), 0.6 - (0.1 + 0.7 * 31 / 49 + 0.05), 1e-9) << blocked.dump();
+
+  // Version 3: the unknown box goes (the sensors looked there): now the obstacle blocks the careful planner.
+  const Environment third(cell, 3, 3'000, {aside, behind});
+  publisher.publish(third, diff(second, third));
+  EXPECT_EQ(
+      careful.read_line(test::kDaemonPatience).value_or(""),
+      "version 3 (+0 ~0 -1): path blocked by box 8 at checkpoint 31 (t 0.633, x 2.120 y 0.543 z 1.000), "
+      "distance 0.007 m");
+
+  for (test::ChildProcess* planner : {&careful, &ignoring}) {
+    planner->signal(SIGTERM);
+    EXPECT_EQ(planner->wait(), 0);
+  }
 }
 
 TEST(PlannerCommandLineTest, BadPathIsRefusedWithOneLine) {

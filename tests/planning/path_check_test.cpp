@@ -97,5 +97,78 @@ TEST(PathCheckTest, BlockedPathReportsTheFirstCheckpoint) {
                Error);
 }
 
+Box cube_at(std::uint64_t id, const Vector3d& center, BoxSpace space) {
+  Box box;
+  box.id = id;
+  box.center = center;
+  box.half_extents = Vector3d(0.2, 0.2, 0.2);
+  box.space = space;
+  return box;
+}
+
+// The scene's gantry on the straight line x = 1 from y = 0 to y = 4, checkpoint k at y = 0.1 k: its cube
+// (half 0.1) first overlaps a box whose near face is at y = c − 0.2 at the checkpoint with 0.1 k + 0.1 > c −
+// 0.2. An unknown box (id 7) sits at y = 2, an obstacle (id 9) behind it at y = 3.05, listed first.
+struct UnknownScene {
+  Scene scene;
+  BSplinePath path{{v3(1, 0, 0), v3(1, 4, 0)}};
+  std::vector<Box> boxes{cube_at(9, Vector3d(1, 3.05, 0), BoxSpace::kOccupied),
+                         cube_at(7, Vector3d(1, 2, 0), BoxSpace::kUnknown)};
+};
+
+TEST(PathCheckTest, UnknownBoxBlocksByDefaultAndSaysSo) {
+  const UnknownScene s;
+  const PathEnvironment environment(s.boxes);
+  EXPECT_EQ(environment.obbs().size(), 2u);
+  EXPECT_EQ(environment.ignored(), 0u);
+  const Blocking blocking = path_blocked(s.scene.robot, s.path, 41, environment, 0.0);
+  ASSERT_TRUE(blocking.blocked);
+  EXPECT_EQ(blocking.box_id, 7u);
+  EXPECT_EQ(blocking.space, BoxSpace::kUnknown);
+  EXPECT_EQ(blocking.env_box, 1);
+  EXPECT_EQ(blocking.checkpoint, 18);  // y = 1.8: the cube reaches 1.9, 0.1 into the box's face at 1.8
+  EXPECT_DOUBLE_EQ(blocking.t, 18.0 / 40.0);
+  EXPECT_NEAR(blocking.distance, -0.1, 1e-12);
+  // The path runs into the unknown box's near face.
+  EXPECT_NEAR(blocking.point.y(), 1.8, 1e-12);
+  EXPECT_TRUE(s.boxes[1].contains(blocking.point, 1e-12));
+}
+
+TEST(PathCheckTest, IgnoringUnknownSpaceFreesThePathButObstaclesStillBlock) {
+  const UnknownScene s;
+  const PathEnvironment only_unknown({s.boxes[1]}, PathCheckOptions{true});
+  EXPECT_TRUE(only_unknown.obbs().empty());
+  EXPECT_EQ(only_unknown.ignored(), 1u);
+  EXPECT_FALSE(path_blocked(s.scene.robot, s.path, 41, only_unknown, 0.0).blocked);
+  // The margin reaches no further than the boxes' faces either.
+  EXPECT_FALSE(path_blocked(s.scene.robot, s.path, 41, only_unknown, 0.5).blocked);
+
+  // Past the ignored unknown box, the obstacle behind it blocks: first at y = 2.8 (cube up to 2.9, 0.05 past
+  // the face at 2.85).
+  const PathEnvironment both(s.boxes, PathCheckOptions{true});
+  const Blocking blocking = path_blocked(s.scene.robot, s.path, 41, both, 0.0);
+  ASSERT_TRUE(blocking.blocked);
+  EXPECT_EQ(blocking.box_id, 9u);
+  EXPECT_EQ(blocking.space, BoxSpace::kOccupied);
+  EXPECT_EQ(blocking.env_box, 0);
+  EXPECT_EQ(blocking.checkpoint, 28);
+  EXPECT_DOUBLE_EQ(blocking.t, 0.7);
+  EXPECT_NEAR(blocking.distance, -0.05, 1e-12);
+  EXPECT_NEAR(blocking.point.y(), 2.85, 1e-12);
+
+  // The constraint vector leaves the ignored box out too: one environment box.
+  EXPECT_EQ(path_constraints(s.scene.robot, s.path, 41, both.obbs()).n_env, 1);
+}
+
+TEST(PathCheckTest, BareBoxesBlockAsObstaclesWithoutAnId) {
+  const Scene scene;
+  const Blocking blocking = path_blocked(scene.robot, BSplinePath({v3(1, 0, 0), v3(1, 4, 0)}), 41,
+                                         scene.environment, scene.tree, 0.0);
+  ASSERT_TRUE(blocking.blocked);
+  EXPECT_EQ(blocking.box_id, 0u);
+  EXPECT_EQ(blocking.space, BoxSpace::kOccupied);
+  EXPECT_DOUBLE_EQ(blocking.t, 0.45);
+}
+
 }  // namespace
 }  // namespace cellmap::planning

@@ -64,6 +64,7 @@ inline constexpr int kStatusCommand = 206;
 inline constexpr int kPlanner = 170;
 inline constexpr int kKill = 171;
 inline constexpr int kSecurePlanner = 192;
+inline constexpr int kPlannerUnknown = 217;  // environments published by the test, unknown boxes in them
 
 // camera_e2e_test.
 inline constexpr int kUnplugged = 162;

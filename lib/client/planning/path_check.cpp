@@ -25,6 +25,26 @@ collision::ConstraintSet path_constraints(const collision::RobotBoxes& robot, co
   return collision::constraints(place_along(robot, path, n_checkpoints), environment);
 }
 
+PathEnvironment::PathEnvironment(const std::vector<Box>& boxes, PathCheckOptions options)
+    : tree_(keep(boxes, options)) {}
+
+const std::vector<collision::Obb>& PathEnvironment::keep(const std::vector<Box>& boxes,
+                                                         PathCheckOptions options) {
+  obbs_.reserve(boxes.size());
+  ids_.reserve(boxes.size());
+  spaces_.reserve(boxes.size());
+  for (const Box& box : boxes) {
+    if (options.ignore_unknown && box.space == BoxSpace::kUnknown) {
+      ++ignored_;
+      continue;
+    }
+    obbs_.push_back(collision::to_obb(box));
+    ids_.push_back(box.id);
+    spaces_.push_back(box.space);
+  }
+  return obbs_;
+}
+
 Blocking path_blocked(const collision::RobotBoxes& robot, const BSplinePath& path, int n_checkpoints,
                       const std::vector<collision::Obb>& environment, const collision::BoxTree& tree,
                       double margin) {
@@ -39,12 +59,32 @@ Blocking path_blocked(const collision::RobotBoxes& robot, const BSplinePath& pat
       tree.query(box.center, box.aabb_half_extents(), margin, &near);
       for (const int e : near) {
         if (!collision::overlap(box, environment[e], margin)) continue;  // separated by >= margin on an axis
-        const double distance = collision::signed_distance(box, environment[e]).distance;
-        if (distance < margin) return {true, k, r, e, distance};
+        const collision::SignedDistance pair = collision::signed_distance(box, environment[e]);
+        if (pair.distance >= margin) continue;
+        Blocking blocking;
+        blocking.blocked = true;
+        blocking.checkpoint = k;
+        blocking.robot_box = r;
+        blocking.env_box = e;
+        blocking.distance = pair.distance;
+        blocking.t = n_checkpoints == 1 ? 0.0 : static_cast<double>(k) / (n_checkpoints - 1);
+        blocking.point = pair.point_b;
+        return blocking;
       }
     }
   }
   return {};
+}
+
+Blocking path_blocked(const collision::RobotBoxes& robot, const BSplinePath& path, int n_checkpoints,
+                      const PathEnvironment& environment, double margin) {
+  Blocking blocking =
+      path_blocked(robot, path, n_checkpoints, environment.obbs(), environment.tree(), margin);
+  if (blocking.blocked) {
+    blocking.box_id = environment.id(blocking.env_box);
+    blocking.space = environment.space(blocking.env_box);
+  }
+  return blocking;
 }
 
 }  // namespace cellmap::planning
