@@ -41,7 +41,8 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
   transport::StatusReader status(participant,
                                  service.cell());  // tells when the stopped daemon's writers are gone
-  // The planner's default path runs 0.25 m above the table at x = 2.12 from y = 0.1 to 0.8.
+  // The planner's default path runs 0.15 m above the table at x = 2.12 from y = 0.38 to 0.8, clear of the
+  // unknown space at the table's front edge.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");
   test::ChildProcess planner(planner_argv);
@@ -52,7 +53,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment before = test::settled(observer, status, "planner", test::kLongQuietSweeps);
 
   const std::string name =
-      service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+      service.inject(domain, {"add-box", "--center", "2.12,0.6,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kDaemonPatience))
       << "the box never arrived";
@@ -61,14 +62,14 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_TRUE(added.modified.empty());
   EXPECT_TRUE(added.removed.empty());
   const Box box = added.added[0];
-  EXPECT_TRUE(box.contains(Eigen::Vector3d(2.12, 0.45, 0.9)));
+  EXPECT_TRUE(box.contains(Eigen::Vector3d(2.12, 0.6, 0.9)));
 
   const nlohmann::json blocked = next_state(planner);
   EXPECT_EQ(blocked.value("state", ""), "blocked") << blocked.dump();
   EXPECT_EQ(blocked.value("box", std::uint64_t{0}), box.id) << blocked.dump();
   EXPECT_EQ(blocked.value("version", std::uint64_t{0}), added.to_version) << blocked.dump();
   EXPECT_EQ(blocked.value("added", 0), 1) << blocked.dump();
-  // The path first comes within the margin (0.02) of the box's side at y = 0.45 − 0.1 − 0.05 − margin.
+  // The path first comes within the margin (0.02) of the box's side at y = 0.6 − 0.1 − 0.05 − margin.
   ASSERT_TRUE(blocked.contains("position"));
   EXPECT_NEAR(blocked["position"][0].get<double>(), 2.12, 1e-9);
   EXPECT_GT(blocked["position"][1].get<double>(), box.center.y() - box.half_extents.y() - 0.1);
@@ -101,7 +102,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_EQ(*observer.environment(), last);
   daemon = service.start_daemon(domain);
   const std::string again =
-      service.inject(domain, {"add-box", "--center", "2.12,0.45,0.9", "--half-extents", "0.1,0.1,0.15"});
+      service.inject(domain, {"add-box", "--center", "2.12,0.6,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kDaemonPatience))
       << "nothing after the restart";
   const nlohmann::json blocked_again = next_state(planner);
@@ -125,8 +126,8 @@ Box cube(std::uint64_t id, const Eigen::Vector3d& center, double half, BoxSpace 
   return box;
 }
 
-// The test publishes the environments itself, so every distance is a known answer. The planner's default path
-// runs straight from y = 0.1 to 0.8 at x 2.12, z 1.0, checkpoint k (of 50) at y = 0.1 + 0.7 k / 49, carrying
+// The test publishes the environments itself, so every distance is a known answer. The planner's path runs
+// straight from y = 0.1 to 0.8 at x 2.12, z 1.0, checkpoint k (of 50) at y = 0.1 + 0.7 k / 49, carrying
 // a cube of half 0.05 with a margin of 0.02: it is blocked from the first checkpoint whose cube comes within
 // 0.02 of a box's face at y = f, 0.1 + 0.7 k / 49 + 0.05 > f − 0.02.
 TEST(PlannerUnknownSpaceTest, UnknownRegionBlocksThePathUnlessIgnored) {
@@ -154,8 +155,9 @@ TEST(PlannerUnknownSpaceTest, UnknownRegionBlocksThePathUnlessIgnored) {
   EXPECT_EQ(boxes[1].value("id", 0), 5) << echoed.dump();
   EXPECT_EQ(boxes[1].value("space", ""), "unknown") << echoed.dump();
 
-  const std::vector<std::string> planner_argv{CELLMAP_PLANNER, "--domain", std::to_string(domain), "--cell",
-                                              cell};
+  const std::vector<std::string> planner_argv{
+      CELLMAP_PLANNER, "--domain", std::to_string(domain), "--cell", cell, "--control-points",
+      "2.12,0.1,1.0;2.12,0.45,1.0;2.12,0.8,1.0"};
   test::ChildProcess careful(planner_argv);
   std::vector<std::string> ignoring_argv = planner_argv;
   ignoring_argv.insert(ignoring_argv.end(), {"--ignore-unknown", "--json"});
