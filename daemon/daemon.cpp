@@ -11,6 +11,7 @@
 #include "cellmap/common/parallel.hpp"
 #include "cellmap/common/wall_clock.hpp"
 #include "reload.hpp"
+#include "simulated_cell.hpp"
 
 namespace cellmap::daemon {
 namespace {
@@ -108,7 +109,7 @@ void log_unknown_space(const SweepReport& report, const std::optional<UnknownCov
 }  // namespace
 
 Daemon::Daemon(DaemonConfig config, RunOptions options)
-    : config_(std::move(config)),
+    : config_(with_scene_workspace(std::move(config))),
       options_(std::move(options)),
       store_(config_.state_dir, config_.cell),
       participant_(static_cast<std::uint32_t>(config_.domain), security_of(config_)),

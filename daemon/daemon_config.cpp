@@ -252,15 +252,6 @@ Ros2Config read_ros2(YamlMap section) {
   return c;
 }
 
-// A simulated cell's scene says where unknown space matters when the config names no workspace.
-void take_scene_workspace(DaemonConfig& c) {
-  UnknownSpaceConfig& unknown = c.pipeline.unknown;
-  if (!unknown.enabled || unknown.workspace || c.sources.empty() || !c.simulated()) return;
-  const SourceConfig& source = c.sources.front();
-  unknown.workspace =
-      (source.scene.empty() ? sim::default_scene() : sim::load_scene(source.scene.string())).workspace;
-}
-
 }  // namespace
 
 const char* to_string(SourceKind kind) {
@@ -337,7 +328,6 @@ DaemonConfig DaemonConfig::read(const std::string& yaml, const std::string& sour
   c.sources = read_sources(root, *user, defaults, c.sweep_period, base_dir, problems);
   problems.read([&] { c.robot = read_daemon_robot(root, base_dir); });
   problems.read([&] { c.pipeline = CellPipelineConfig::from_yaml(root); });
-  problems.read([&] { take_scene_workspace(c); });
   problems.read([&] { c.security = read_security(root.child("security"), base_dir); });
   problems.read([&] { c.ros2 = read_ros2(root.child("ros2")); });
   problems.read([&] {

@@ -28,6 +28,16 @@ constexpr std::size_t kSimSamples = 16384;
 
 }  // namespace
 
+DaemonConfig with_scene_workspace(DaemonConfig config) {
+  UnknownSpaceConfig& unknown = config.pipeline.unknown;
+  if (!unknown.enabled || unknown.workspace || config.sources.empty() || !config.simulated()) return config;
+  try {
+    unknown.workspace = load(config.sources.front()).workspace;
+  } catch (const Error&) {
+  }
+  return config;
+}
+
 SimulatedCell::SimulatedCell(const std::vector<SourceConfig>& sources, const std::optional<Robot>& robot)
     : simulator_(load(sources.front()), sim::SimOptions{sources.front().noise, 2}),
       joints_(model_for(simulator_.scene(), robot, scene_name(sources.front())),

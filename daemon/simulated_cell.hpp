@@ -17,6 +17,11 @@
 
 namespace cellmap::daemon {
 
+/// `config` with `pipeline.unknown.workspace` taken from its simulated scene's `workspace` when the config
+/// names none (a simulated cell's scene knows where unknown space matters). A scene that does not load leaves
+/// the config as it is: the simulated cell reports it when it loads the scene.
+[[nodiscard]] DaemonConfig with_scene_workspace(DaemonConfig config);
+
 /// Renders sweeps of the configured scene and applies scene edits between them. Not thread-safe: the
 /// acquisition thread owns it.
 class SimulatedCell final {

@@ -145,7 +145,7 @@ struct Options {
   // Defaults fit the simulated cell (config/cell.yaml): 0.15 m above the table, between the fixture and the
   // drum, clear of every obstacle and of the unknown space the gantry's camera never sees at the table's
   // front edge (below z = 1.02 only within y < 0.26).
-  std::string control_points = "2.12,0.38,0.9;2.12,0.59,0.9;2.12,0.8,0.9";
+  std::string control_points = "2.12,0.45,0.9;2.12,0.62,0.9;2.12,0.8,0.9";
   std::string half_extents = "0.05,0.05,0.05";
   double margin = 0.02;
   int checkpoints = 50;

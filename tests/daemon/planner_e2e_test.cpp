@@ -41,7 +41,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   transport::EnvironmentSubscriber observer(participant, "planner", std::ref(recorder));
   transport::StatusReader status(participant,
                                  service.cell());  // tells when the stopped daemon's writers are gone
-  // The planner's default path runs 0.15 m above the table at x = 2.12 from y = 0.38 to 0.8, clear of the
+  // The planner's default path runs 0.15 m above the table at x = 2.12 from y = 0.45 to 0.8, clear of the
   // unknown space at the table's front edge.
   std::vector<std::string> planner_argv = service.planner(domain);
   planner_argv.push_back("--json");
@@ -53,7 +53,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   const Environment before = test::settled(observer, status, "planner", test::kLongQuietSweeps);
 
   const std::string name =
-      service.inject(domain, {"add-box", "--center", "2.12,0.6,0.9", "--half-extents", "0.1,0.1,0.15"});
+      service.inject(domain, {"add-box", "--center", "2.12,0.65,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_FALSE(name.empty());
   ASSERT_TRUE(observer.wait_for_version(before.version() + 1, test::kDaemonPatience))
       << "the box never arrived";
@@ -62,14 +62,14 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_TRUE(added.modified.empty());
   EXPECT_TRUE(added.removed.empty());
   const Box box = added.added[0];
-  EXPECT_TRUE(box.contains(Eigen::Vector3d(2.12, 0.6, 0.9)));
+  EXPECT_TRUE(box.contains(Eigen::Vector3d(2.12, 0.65, 0.9)));
 
   const nlohmann::json blocked = next_state(planner);
   EXPECT_EQ(blocked.value("state", ""), "blocked") << blocked.dump();
   EXPECT_EQ(blocked.value("box", std::uint64_t{0}), box.id) << blocked.dump();
   EXPECT_EQ(blocked.value("version", std::uint64_t{0}), added.to_version) << blocked.dump();
   EXPECT_EQ(blocked.value("added", 0), 1) << blocked.dump();
-  // The path first comes within the margin (0.02) of the box's side at y = 0.6 − 0.1 − 0.05 − margin.
+  // The path first comes within the margin (0.02) of the box's side at y = 0.65 − 0.1 − 0.05 − margin.
   ASSERT_TRUE(blocked.contains("position"));
   EXPECT_NEAR(blocked["position"][0].get<double>(), 2.12, 1e-9);
   EXPECT_GT(blocked["position"][1].get<double>(), box.center.y() - box.half_extents.y() - 0.1);
@@ -102,7 +102,7 @@ TEST_P(PlannerE2eTest, InjectedBoxBlocksThePathAndItsRemovalFreesIt) {
   EXPECT_EQ(*observer.environment(), last);
   daemon = service.start_daemon(domain);
   const std::string again =
-      service.inject(domain, {"add-box", "--center", "2.12,0.6,0.9", "--half-extents", "0.1,0.1,0.15"});
+      service.inject(domain, {"add-box", "--center", "2.12,0.65,0.9", "--half-extents", "0.1,0.1,0.15"});
   ASSERT_TRUE(observer.wait_for_version(last.version() + 1, test::kDaemonPatience))
       << "nothing after the restart";
   const nlohmann::json blocked_again = next_state(planner);
