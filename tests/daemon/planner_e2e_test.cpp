@@ -3,12 +3,16 @@
 // injected into its path arrives as a delta adding exactly that box and the planner reports the path blocked
 // by it; removing the box frees the path again; a clean daemon restart does not read as "all removed". Plain
 // and with DDS Security on every process and participant. Unknown boxes (published by the test itself, with
-// known answers) block the path as "unknown region" unless the planner is told to ignore unknown space.
+// known answers) block the path as "unknown region" unless the planner is told to ignore unknown space; an
+// object no sensor sees blocks it as unknown space until the sensors see it and its own box blocks it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
 #include "daemon/service_e2e.hpp"
 #include "support/dds_domains.hpp"
@@ -155,9 +159,13 @@ TEST(PlannerUnknownSpaceTest, UnknownRegionBlocksThePathUnlessIgnored) {
   EXPECT_EQ(boxes[1].value("id", 0), 5) << echoed.dump();
   EXPECT_EQ(boxes[1].value("space", ""), "unknown") << echoed.dump();
 
-  const std::vector<std::string> planner_argv{
-      CELLMAP_PLANNER, "--domain", std::to_string(domain), "--cell", cell, "--control-points",
-      "2.12,0.1,1.0;2.12,0.45,1.0;2.12,0.8,1.0"};
+  const std::vector<std::string> planner_argv{CELLMAP_PLANNER,
+                                              "--domain",
+                                              std::to_string(domain),
+                                              "--cell",
+                                              cell,
+                                              "--control-points",
+                                              "2.12,0.1,1.0;2.12,0.45,1.0;2.12,0.8,1.0"};
   test::ChildProcess careful(planner_argv);
   std::vector<std::string> ignoring_argv = planner_argv;
   ignoring_argv.insert(ignoring_argv.end(), {"--ignore-unknown", "--json"});
@@ -194,6 +202,68 @@ TEST(PlannerUnknownSpaceTest, UnknownRegionBlocksThePathUnlessIgnored) {
     planner->signal(SIGTERM);
     EXPECT_EQ(planner->wait(), 0);
   }
+}
+
+// The default cell with a shelf over pallet b, 0.33 m above it, and under the shelf, where the Kinect looking
+// down from the gantry never sees, a 16 cm cube (tests/unknown/unknown_cell_test.cpp has the geometry).
+std::string scene_with_a_hidden_cube() {
+  std::string scene = read_file(std::string(CELLMAP_SOURCE_DIR) + "/config/cell.yaml");
+  const std::string list = "\nobstacles:\n";
+  const std::size_t at = scene.find(list);
+  EXPECT_NE(at, std::string::npos) << "config/cell.yaml has no obstacles list";
+  scene.insert(at + list.size(),
+               "  - {name: shelf, box: {half_extents: [0.35, 0.3, 0.02]}, center: [2.2, 1.4, 1.25]}\n"
+               "  - {name: hidden, box: {half_extents: [0.08, 0.08, 0.08]}, center: [2.2, 1.4, 0.974]}\n");
+  return scene;
+}
+
+// cellmapd on the noisy default cell with an object no sensor sees; the example planner's path runs under the
+// shelf through the object. The path is blocked by unknown space from the first version on and never free;
+// once the shelf is taken away the object's box blocks it, and the unknown box there went in that version.
+TEST(PlannerUnknownSpaceTest, AnObjectNoSensorSeesBlocksThePathAsUnknownUntilItsOwnBoxDoes) {
+  const int domain = test::domain::kPlannerHidden;
+  const test::ServiceFixture service("planner-hidden");
+  const std::filesystem::path scene = service.config_file().parent_path() / "scene.yaml";
+  write_file_atomically(scene, scene_with_a_hidden_cube());
+  std::ofstream(service.config_file()) << "cell: planner-hidden\nsweep_period: 0.2\nstatus_period: 0.5\n"
+                                       << "source: {scene: " << scene.string() << "}\n";
+  auto daemon = service.start_daemon(domain);
+  const dds::Participant participant = service.participant(domain);
+  transport::EnvironmentSubscriber observer(participant, service.cell());
+  std::vector<std::string> planner_argv = service.planner(domain);
+  planner_argv.insert(planner_argv.end(),
+                      {"--json", "--control-points", "1.95,1.4,1.1;2.2,1.4,1.1;2.45,1.4,1.1"});
+  test::ChildProcess planner(planner_argv);
+
+  const nlohmann::json first = next_state(planner);
+  EXPECT_EQ(first.value("state", ""), "blocked") << first.dump();
+  EXPECT_EQ(first.value("space", ""), "unknown") << first.dump();
+  ASSERT_TRUE(observer.wait_for_version(first.value("version", std::uint64_t{1}), test::kDaemonPatience));
+  const Eigen::Vector3d hidden(2.2, 1.4, 0.974);
+  const auto holding = [&](BoxSpace space) {
+    const std::optional<Environment> env = observer.environment();
+    return std::count_if(env->boxes().begin(), env->boxes().end(),
+                         [&](const Box& box) { return box.space == space && box.contains(hidden); });
+  };
+  EXPECT_EQ(holding(BoxSpace::kOccupied), 0) << "the hidden cube has an obstacle box";
+  EXPECT_GT(holding(BoxSpace::kUnknown), 0) << "the hidden cube's place is not unknown";
+
+  service.inject(domain, {"remove", "--name", "shelf"});
+  nlohmann::json state = first;
+  while (state.value("space", "") != "occupied" || state.value("box", std::uint64_t{0}) == 0) {
+    state = next_state(planner);
+    ASSERT_EQ(state.value("state", ""), "blocked") << "the path was free: " << state.dump();
+  }
+  ASSERT_TRUE(observer.wait_for_version(state.value("version", std::uint64_t{0}), test::kDaemonPatience));
+  EXPECT_EQ(holding(BoxSpace::kOccupied), 1) << "no obstacle box holds the cube";
+  EXPECT_EQ(holding(BoxSpace::kUnknown), 0) << "the cube's place is still unknown";
+  std::cout << "hidden cube: version " << first.value("version", 0) << " blocked by unknown region "
+            << first.value("box", 0) << ", version " << state.value("version", 0) << " by box "
+            << state.value("box", 0) << "\n";
+  planner.signal(SIGTERM);
+  EXPECT_EQ(planner.wait(), 0);
+  daemon->signal(SIGTERM);
+  EXPECT_EQ(daemon->wait(), 0);
 }
 
 TEST(PlannerCommandLineTest, BadPathIsRefusedWithOneLine) {

@@ -152,8 +152,8 @@ TEST_F(WorkingCellE2eTest, ArmInViewOfTheFixedCameraChangesNoObstacleBoxAndPutsN
   }
   std::cout << "arm cell, fixed camera, self filter on: " << sweeps << " sweeps, "
             << versions.back().version() << " version(s), " << obstacle_boxes(versions.back()).size()
-            << " obstacle boxes, unknown space boxed " << unknown_volume(versions.front()) << " m³ in the first, "
-            << unknown_volume(versions.back()) << " m³ in the last\n";
+            << " obstacle boxes, unknown space boxed " << unknown_volume(versions.front())
+            << " m³ in the first, " << unknown_volume(versions.back()) << " m³ in the last\n";
 }
 
 TEST_F(WorkingCellE2eTest, WithoutTheSelfFilterTheMovingArmMakesVersionsAndBoxesOnItself) {

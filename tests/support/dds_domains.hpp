@@ -65,6 +65,7 @@ inline constexpr int kPlanner = 170;
 inline constexpr int kKill = 171;
 inline constexpr int kSecurePlanner = 192;
 inline constexpr int kPlannerUnknown = 217;  // environments published by the test, unknown boxes in them
+inline constexpr int kPlannerHidden = 227;   // cellmapd: an object under a shelf, then in view
 
 // camera_e2e_test.
 inline constexpr int kUnplugged = 162;
