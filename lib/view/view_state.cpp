@@ -10,6 +10,10 @@ namespace {
 
 using nlohmann::json;
 
+// Network text is made valid UTF-8 where it arrives (single_line); this keeps a string that slipped by from
+// making the writer throw.
+constexpr json::error_handler_t kReplaceInvalidUtf8 = json::error_handler_t::replace;
+
 json vector_json(const Eigen::Vector3d& v) {
   return json::array({v.x(), v.y(), v.z()});
 }
@@ -168,7 +172,7 @@ struct LayerJson {
 }  // namespace
 
 std::string status_json(const transport::CellStatus& status) {
-  return status_object(status).dump();
+  return status_object(status).dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 const char* layer_name(transport::Layer layer) {
@@ -226,7 +230,7 @@ std::string ViewState::on_version(const Environment& env, const EnvironmentDelta
               {"added", added},
               {"modified", boxes_json(delta.modified, delta.to_version)},
               {"removed", delta.removed}}
-      .dump();
+      .dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::string ViewState::on_status(const transport::CellStatus& status) {
@@ -237,7 +241,7 @@ std::string ViewState::on_status(const transport::CellStatus& status) {
   cell.daemon = true;
   json message = status_json(status, true);
   message["type"] = "status";
-  return message.dump();
+  return message.dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::string ViewState::on_daemon_gone(const std::string& cell_name) {
@@ -249,14 +253,14 @@ std::string ViewState::on_daemon_gone(const std::string& cell_name) {
   last.cell = cell_name;
   json message = status_json(last, false);
   message["type"] = "status";
-  return message.dump();
+  return message.dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::string ViewState::on_layer(const transport::LayerMessage& layer) {
   const std::string& cell_name =
       std::visit([](const auto& l) -> const std::string& { return l.cell; }, layer);
   if (!followed(cell_name)) return "";
-  std::string message = std::visit(LayerJson{}, layer).dump();
+  std::string message = std::visit(LayerJson{}, layer).dump(-1, ' ', false, kReplaceInvalidUtf8);
   const std::lock_guard<std::mutex> lock(mutex_);
   cells_[cell_name].layers[transport::layer_of(layer)] = message;
   return message;
@@ -291,7 +295,7 @@ std::string ViewState::state() const {
                      {"timeline", timeline},
                      {"status", cell.status ? status_json(*cell.status, cell.daemon) : json(nullptr)}});
   }
-  return json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}}.dump();
+  return json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}}.dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::vector<std::string> ViewState::layers(transport::Layer layer) const {

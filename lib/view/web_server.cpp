@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "cellmap/view/web_server.hpp"
 
+#include <arpa/inet.h>
 #include <civetweb.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "cellmap/common/error.hpp"
@@ -23,8 +25,8 @@ int on_request(mg_connection* conn, void*) {
   return server_of(conn).handle_request(conn);
 }
 
-int on_socket_connect(const mg_connection*, void*) {
-  return 0;  // accept every page
+int on_socket_connect(const mg_connection* conn, void*) {
+  return server_of(conn).page_allowed(conn) ? 0 : 1;
 }
 
 void on_socket_ready(mg_connection* conn, void*) {
@@ -55,6 +57,20 @@ std::filesystem::path three_dir_checked(const std::filesystem::path& dir) {
                   " is missing (install Debian's libjs-three, or give --three DIR)");
   }
   return std::filesystem::canonical(dir);
+}
+
+// The host name of a Host header ("127.0.0.1:8080", "[::1]:8080", "localhost").
+std::string host_name(const std::string& host) {
+  if (!host.empty() && host.front() == '[') return host.substr(1, host.find(']') - 1);
+  return host.substr(0, host.find(':'));
+}
+
+// Whether `name` can only mean this machine as the browser reached it: an address, or localhost. A DNS
+// name could be rebound to this address by another site.
+bool names_this_machine(const std::string& name) {
+  unsigned char address[sizeof(in6_addr)];
+  return name == "localhost" || ::inet_pton(AF_INET, name.c_str(), address) == 1 ||
+         ::inet_pton(AF_INET6, name.c_str(), address) == 1;
 }
 
 }  // namespace
@@ -111,6 +127,18 @@ WebServer::~WebServer() {
   queued_.notify_all();
   sender_.join();
   mg_exit_library();
+}
+
+bool WebServer::page_allowed(const mg_connection* conn) const {
+  const char* origin = mg_get_header(conn, "Origin");
+  if (origin == nullptr) return true;
+  const std::vector<std::string>& allowed = options_.allowed_origins;
+  if (std::find(allowed.begin(), allowed.end(), origin) != allowed.end()) return true;
+  const char* host = mg_get_header(conn, "Host");
+  if (host != nullptr && origin == "http://" + std::string(host) && names_this_machine(host_name(host)))
+    return true;
+  if (callbacks_.on_refused) callbacks_.on_refused(origin);
+  return false;
 }
 
 int WebServer::handle_request(mg_connection* conn) {

@@ -97,7 +97,9 @@ TEST(ParallelTest, HelpersAreKeptOffTheCallersCpu) {
   for (int call = 0; call < 20; ++call) {
     cpu_set_t helper{};
     parallel_for(2, 2, [&](int t) {
-      if (t == 1) ASSERT_EQ(::pthread_getaffinity_np(::pthread_self(), sizeof helper, &helper), 0);
+      if (t == 1) {
+        ASSERT_EQ(::pthread_getaffinity_np(::pthread_self(), sizeof helper, &helper), 0);
+      }
     });
     EXPECT_EQ(CPU_COUNT(&helper), CPU_COUNT(&allowed) - 1);
     cpu_set_t both;

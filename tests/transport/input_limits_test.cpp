@@ -104,10 +104,57 @@ TEST_F(SceneEditRulesTest, ANameWithAControlCharacterIsRefusedOnOneLine) {
   msg_.name = name_.data();
   EXPECT_EQ(
       refusal(),
-      "cellmap/sim/scene_edits 'c?2026-12-02T06:00:00.000 info forged': name: holds a control character");
+      "cellmap/sim/scene_edits 'c?2026-12-02T06:00:00.000 info forged': name: not UTF-8, or holding a control character");
   name_ = "tab\there";
   msg_.name = name_.data();
-  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'tab?here': name: holds a control character");
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'tab?here': name: not UTF-8, or holding a control character");
+}
+
+TEST_F(SceneEditRulesTest, ANameThatIsNotUtf8OrReordersTextIsRefused) {
+  name_ = "c\xffx";
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'c?x': name: not UTF-8, or holding a control character");
+  name_ = "box\u202e1-xob";  // right-to-left override: shown as "boxbox-1"
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box?1-xob': name: not UTF-8, or holding a control character");
+  name_ = "Kiste-\u00e4";
+  msg_.name = name_.data();
+  EXPECT_EQ(refusal(), "");
+}
+
+// Every text a sample carries reaches logs, JSON writers (cellmap echo, view) and the page: a cell id that is not
+// clean refuses the sample; text only shown (states, sensor names, reasons) is made clean.
+TEST(NetworkTextTest, AnUncleanCellRefusesTheSampleAndShownTextIsMadeClean) {
+  std::string cell = "c\xffx";
+  cellmap_msg_Environment environment{};
+  environment.cell = cell.data();
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(environment); }),
+            "cellmap/environment 'c?x': cell: longer than 128 bytes, not UTF-8, or holding a control character");
+  cell = std::string(129, 'c');
+  environment.cell = cell.data();
+  EXPECT_NE(test::error_of([&] { (void)wire::from_wire(environment); }).find("longer than 128 bytes"),
+            std::string::npos);
+  cell = "cell\n2026-12-02T06:00:00.000 info forged";
+  cellmap_msg_Status status{};
+  status.cell = cell.data();
+  EXPECT_NE(test::error_of([&] { (void)wire::from_wire(status); }), "");
+
+  cell = "cell-1";
+  std::string state = "run\xffning<img src=x>", sensor = "post\u2028", reason = "gone\u202e";
+  cellmap_msg_SensorState sensors[1]{};
+  sensors[0].name = sensor.data();
+  sensors[0].state = state.data();
+  status.cell = cell.data();
+  status.state = state.data();
+  status.reason = reason.data();
+  status.sensors._buffer = sensors;
+  status.sensors._length = status.sensors._maximum = 1;
+  const CellStatus read = wire::from_wire(status);
+  EXPECT_EQ(read.cell, "cell-1");
+  EXPECT_EQ(read.state, "run?ning<img src=x>");  // markup is the page's to escape
+  EXPECT_EQ(read.sensors.at(0).name, "post?");
+  EXPECT_EQ(read.sensors.at(0).state, "run?ning<img src=x>");
+  EXPECT_EQ(read.reason, "gone?");
 }
 
 class RobotStateRulesTest : public ::testing::Test {

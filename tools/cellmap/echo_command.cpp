@@ -71,7 +71,7 @@ void run_echo(const EchoOptions& options) {
     }
     for (const transport::EnvironmentMessage& message :
          monitor.take(std::min(left, std::chrono::nanoseconds(1'000'000'000)))) {
-      std::cout << message_json(message).dump() << std::endl;  // one line per message, flushed for pipes
+      std::cout << message_json(message).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;  // one line per message, flushed for pipes
       if (++printed == options.count) break;
     }
     if (monitor.rejected() > rejected) {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR] [--security DIR [--role R]]`:
+// `cellmap view [--domain N] [--cell C] [--bind ADDR] [--port P] [--three DIR] [--allow-origin O]...
+// [--security DIR [--role R]]`:
 // follows the cell(s) over DDS as a planner does (with a planner's credentials under DDS Security) and serves
 // a live 3D view of them at http://ADDR:P/ until SIGINT or SIGTERM.
 #include <csignal>
@@ -10,6 +11,7 @@
 #include <set>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
 #include "cellmap/view/cell_follower.hpp"
 #include "cellmap/view/web_server.hpp"
 #include "commands.hpp"
@@ -100,6 +102,10 @@ void run_view(const ViewOptions& options) {
       for (std::string& message : state.layers(layer)) server->send(page, std::move(message));
   };
   callbacks.on_close = [&layers](view::PageId page) { layers.forget(page); };
+  callbacks.on_refused = [](const std::string& origin) {
+    std::cerr << "cellmap view: refused a page from " << single_line(origin, 256)
+              << ": not this viewer's origin (--allow-origin lets one in)" << std::endl;
+  };
 
   const auto publish = [&](std::string message) {
     const std::lock_guard<std::mutex> lock(server_mutex);
@@ -136,6 +142,9 @@ void add_view_command(CLI::App& app) {
   command->add_option("--port", options->server.port, "TCP port (default 8080)")->check(CLI::Range(1, 65535));
   command->add_option("--three", options->server.three_dir,
                       "folder of three.js (default: Debian's libjs-three, /usr/share/javascript/three)");
+  command->add_option("--allow-origin", options->server.allowed_origins,
+                      "an origin whose pages may connect besides the viewer's own, e.g. http://cellpc:8080 when "
+                      "browsers reach it by that name (repeatable)");
   add_security_options(command, options->security, security::Role::kPlanner);
   command->callback([options] { run_view(*options); });
 }

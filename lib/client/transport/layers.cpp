@@ -7,6 +7,8 @@
 #include <memory>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "wire.hpp"
 
 namespace cellmap::transport {
@@ -264,7 +266,7 @@ ChangeRegionLayer from_wire(const cellmap_msg_ChangeRegionLayer& msg) {
 
 SensorView from_wire(const cellmap_msg_SensorView& msg, const std::string& where) {
   SensorView view;
-  view.sensor = msg.sensor != nullptr ? msg.sensor : "";
+  view.sensor = msg.sensor != nullptr ? single_line(msg.sensor, kMaxNameLength) : "";
   view.X_CS = pose_of(msg.position, msg.orientation, where);
   if (!std::isfinite(msg.max_range)) throw Error(where + ": not a finite number");
   if (msg.outline._length % 3 != 0) throw Error(where + ": outline: not x, y, z triples");

@@ -4,6 +4,8 @@
 #include <algorithm>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/common/text.hpp"
+#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/topics.hpp"
 #include "wire.hpp"
 
@@ -42,7 +44,7 @@ std::vector<CellStatus> StatusReader::take(std::chrono::nanoseconds timeout) {
       },
       [&](const void* key_sample) {
         const char* cell = static_cast<const cellmap_msg_Status*>(key_sample)->cell;
-        if (cell == nullptr || *cell == '\0') return;
+        if (cell == nullptr || *cell == '\0' || single_line(cell, kMaxNameLength) != cell) return;
         forget(cell);
         departed_.emplace_back(cell);
       });

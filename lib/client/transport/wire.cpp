@@ -93,15 +93,25 @@ std::int32_t kind_on_the_wire(const cellmap_msg_SceneEdit& msg) {
   return kind;
 }
 
+// Text a status carries only to be shown: made safe to show, whatever a writer put in it.
+constexpr std::size_t kMaxReasonLength = 1024;
+std::string shown(const char* text, std::size_t max_bytes = kMaxNameLength) {
+  return text == nullptr ? std::string() : single_line(text, max_bytes);
+}
+
 }  // namespace
 
 std::string cell_of(const char* cell, const char* topic) {
   if (cell == nullptr || *cell == '\0') throw Error(std::string(topic) + ": cell: must not be empty");
+  if (single_line(cell, kMaxNameLength) != cell) {
+    throw Error(std::string(topic) + " " + quote_input(cell) + ": cell: longer than " +
+                std::to_string(kMaxNameLength) + " bytes, not UTF-8, or holding a control character");
+  }
   return cell;
 }
 
 std::string quote_input(const std::string& text) {
-  return "'" + single_line(text.substr(0, kMaxNameLength)) + "'";
+  return "'" + single_line(text, kMaxNameLength) + "'";
 }
 
 std::string sample_name(const char* topic, const std::string& cell, std::int64_t stamp_ns) {
@@ -205,17 +215,17 @@ EnvironmentDelta from_wire(const cellmap_msg_EnvironmentDelta& msg) {
 CellStatus from_wire(const cellmap_msg_Status& msg) {
   CellStatus status;
   status.cell = cell_of(msg.cell, kStatusTopic);
-  status.state = msg.state ? msg.state : "";
+  status.state = shown(msg.state);
   for (uint32_t i = 0; i < msg.sensors._length; ++i) {
     const cellmap_msg_SensorState& s = msg.sensors._buffer[i];
-    status.sensors.push_back({s.name ? s.name : "", s.state ? s.state : ""});
+    status.sensors.push_back({shown(s.name), shown(s.state)});
   }
   status.last_sweep_ns = msg.last_sweep_ns;
   status.sweeps = msg.sweeps;
   status.dropped_frames = msg.dropped_frames;
   status.boxes = msg.boxes;
   status.version = msg.version;
-  status.reason = msg.reason ? msg.reason : "";
+  status.reason = shown(msg.reason, kMaxReasonLength);
   status.refused_inputs = msg.refused_inputs;
   return status;
 }
@@ -223,7 +233,7 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
 SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   const std::string where = edit_name(msg.name ? msg.name : "");
   SceneEdit edit;
-  edit.cell = msg.cell ? msg.cell : "";
+  edit.cell = msg.cell == nullptr || *msg.cell == '\0' ? "" : cell_of(msg.cell, kSceneEditTopic);
   switch (kind_on_the_wire(msg)) {
     case cellmap_msg_SCENE_EDIT_ADD_BOX:
       edit.kind = SceneEdit::Kind::kAddBox;
@@ -240,7 +250,9 @@ SceneEdit from_wire(const cellmap_msg_SceneEdit& msg) {
   edit.name = msg.name ? msg.name : "";
   if (edit.name.empty()) throw Error(where + ": name: must not be empty");
   // Names go to logs and scene files one per line.
-  if (single_line(edit.name) != edit.name) throw Error(where + ": name: holds a control character");
+  if (single_line(edit.name) != edit.name) {
+    throw Error(where + ": name: not UTF-8, or holding a control character");
+  }
   require_finite(msg.center, 3, where + ": center");
   require_finite(msg.half_extents, 3, where + ": half_extents");
   require_finite(&msg.yaw, 1, where + ": yaw");

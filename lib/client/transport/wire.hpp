@@ -84,7 +84,8 @@ class RobotJointsSample {
 /// number is not finite, a payload half extent is negative or its rotation is not orthonormal.
 void validate(const RobotJoints& joints);
 
-/// The cell of an incoming sample. @throws Error naming the topic if it is empty.
+/// The cell of an incoming sample. @throws Error naming the topic if it is empty, longer than kMaxNameLength
+/// bytes, not UTF-8 or holding a control character (single_line would change it).
 [[nodiscard]] std::string cell_of(const char* cell, const char* topic);
 /// Text from the network as a refusal quotes it: in single quotes, on one line (single_line), cut at
 /// kMaxNameLength bytes.

@@ -320,6 +320,11 @@ function showSelection() {
 }
 
 // ---- the side bar and the header ----
+// Text from the network (cell ids, states, sensor names) as HTML text, never as markup.
+function escapeHtml(text) {
+  return String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+}
+
 function stampText(ns) {
   if (!ns) return '';
   const d = new Date(ns / 1e6);
@@ -337,7 +342,7 @@ function updateHeader() {
   const select = $('cell-select');
   const names = [...cells.keys()].sort();
   if (select.options.length !== names.length || names.some((n, i) => select.options[i].value !== n)) {
-    select.innerHTML = names.map((n) => `<option value="${n}">${n}</option>`).join('');
+    select.innerHTML = names.map((n) => `<option value="${escapeHtml(n)}">${escapeHtml(n)}</option>`).join('');
   }
   select.value = selectedCell || '';
   select.hidden = names.length < 2;
@@ -356,11 +361,11 @@ function updateStatus() {
   badge.hidden = false;
   badge.textContent = status.daemon ? `cellmapd ${status.state}` : 'no cellmapd';
   badge.className = 'badge ' + (!status.daemon ? 'bad' : status.state === 'running' ? 'ok' : 'warn');
-  const sensors = status.sensors.map((s) => `${s.name}: ${s.state}`).join('<br>') || '–';
+  const sensors = status.sensors.map((s) => `${escapeHtml(s.name)}: ${escapeHtml(s.state)}`).join('<br>') || '–';
   const lastSweep = status.last_sweep_ns ? stampText(status.last_sweep_ns) : '–';
   list.innerHTML = `
-    <dt>daemon</dt><dd id="daemon-state">${status.daemon ? status.state : 'gone (last: ' + status.state + ')'}</dd>
-    <dt>cell</dt><dd>${status.cell}</dd>
+    <dt>daemon</dt><dd id="daemon-state">${escapeHtml(status.daemon ? status.state : `gone (last: ${status.state})`)}</dd>
+    <dt>cell</dt><dd>${escapeHtml(status.cell)}</dd>
     <dt>sensors</dt><dd>${sensors}</dd>
     <dt>sweeps</dt><dd id="sweeps">${status.sweeps}</dd>
     <dt>last sweep</dt><dd>${lastSweep}</dd>

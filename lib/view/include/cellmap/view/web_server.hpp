@@ -43,6 +43,11 @@ struct WebServerOptions final {
   int port = 8080;
   std::filesystem::path three_dir = kDefaultThreeDir;  ///< served under /three/
   std::vector<PageFile> files = page_files();          ///< served at their paths
+  /// Origins ("http://cellpc:8080") whose pages may open the WebSocket besides the viewer's own. The own
+  /// origin is the one whose host is the request's Host and names this machine by address or "localhost":
+  /// a page from any other site (or a DNS name rebound to this address) is refused, so a web page open in a
+  /// browser here cannot read the cell. Requests without an Origin (not from a browser) are served.
+  std::vector<std::string> allowed_origins;
 };
 
 /// Thread-safe. Messages to pages go through one sending thread in the order given, so a slow page never
@@ -54,6 +59,7 @@ class WebServer final {
     std::function<std::string()> state;                               ///< the first message for a new page
     std::function<void(PageId, const std::string& text)> on_message;  ///< a text frame from a page
     std::function<void(PageId)> on_close;                             ///< a page went away
+    std::function<void(const std::string& origin)> on_refused;  ///< a page of another origin was refused
   };
 
   /// Starts listening. @throws Error if three.js is missing from `options.three_dir` (naming the Debian
@@ -78,6 +84,7 @@ class WebServer final {
 
   // civetweb's callbacks (C functions) enter through these; not for other use.
   int handle_request(mg_connection* conn);
+  [[nodiscard]] bool page_allowed(const mg_connection* conn) const;
   void page_opened(mg_connection* conn);
   int page_data(mg_connection* conn, int bits, const char* data, std::size_t size);
   void page_closed(const mg_connection* conn);
