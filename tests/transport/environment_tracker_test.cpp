@@ -112,5 +112,43 @@ TEST(EnvironmentTrackerTest, ContradictingDeltaWaitsForSnapshot) {
   EXPECT_FALSE(tracker.needs_snapshot());
 }
 
+// A snapshot forged far ahead (or a publisher whose state was wiped, starting again at version 1) must not
+// freeze the copy: once the publisher's snapshots go on below the local version, the copy follows them.
+TEST(EnvironmentTrackerTest, ACopyAheadOfThePublisherFollowsItsSnapshotsBack) {
+  const History h(6);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[1]);
+  const Environment forged("cell-a", UINT64_MAX - 1, 0, {});  // no boxes: "the cell is empty"
+  ASSERT_EQ(tracker.on_snapshot(forged).size(), 1u);
+  // In sync, a subscriber reads deltas only: the publisher's next ones arrive below the local version.
+  EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty());
+  EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty()) << "a duplicate counts once";
+  EXPECT_TRUE(tracker.on_delta(h.deltas[2]).empty());
+  EXPECT_FALSE(tracker.needs_snapshot());
+  EXPECT_TRUE(tracker.on_delta(h.deltas[3]).empty());
+  EXPECT_TRUE(tracker.needs_snapshot()) << "three versions below the local one";
+  const auto updates = tracker.on_snapshot(h.versions[4]);
+  ASSERT_EQ(updates.size(), 1u);
+  EXPECT_TRUE(updates[0].from_snapshot);
+  EXPECT_EQ(updates[0].delta.from_version, UINT64_MAX - 1);
+  EXPECT_EQ(updates[0].delta.to_version, 4u);
+  EXPECT_EQ(updates[0].delta.added.size(), h.versions[4].boxes().size());
+  EXPECT_EQ(*tracker.environment(), h.versions[4]);
+  EXPECT_EQ(tracker.stats().went_back, 1u);
+  // From there on deltas apply as usual.
+  ASSERT_EQ(tracker.on_delta(h.deltas[4]).size(), 1u);
+  EXPECT_EQ(*tracker.environment(), h.versions[5]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+}
+
+TEST(EnvironmentTrackerTest, OldSnapshotsArrivingLateDoNotTurnTheCopyBack) {
+  const History h(6);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[5]);
+  for (int v : {1, 2, 5, 3, 4, 6, 2, 3}) (void)tracker.on_snapshot(h.versions[static_cast<std::size_t>(v)]);
+  EXPECT_EQ(*tracker.environment(), h.versions[6]);
+  EXPECT_EQ(tracker.stats().went_back, 0u);
+}
+
 }  // namespace
 }  // namespace cellmap::transport

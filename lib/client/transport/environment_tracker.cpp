@@ -20,19 +20,39 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment
     ++stats_.other_cells;
     return updates;
   }
-  if (current_ && (snapshot.version() < current_->version() ||
-                   (snapshot.version() == current_->version() && !out_of_sync_))) {
+  if (current_ && snapshot.version() >= current_->version()) below_count_ = 0;  // the publisher is not below
+  if (current_ && snapshot.version() < current_->version()) note_below(snapshot.version());
+  const bool went_back = current_ && snapshot.version() < current_->version() && publisher_below();
+  if (current_ && !went_back &&
+      (snapshot.version() < current_->version() ||
+       (snapshot.version() == current_->version() && !out_of_sync_))) {
     return updates;
   }
-  const Environment before =
-      current_ && current_->version() < snapshot.version() ? *current_ : Environment(cell_);
-  EnvironmentDelta delta = diff(before, snapshot);
+  below_count_ = 0;
+  EnvironmentDelta delta;
+  if (went_back) {
+    // Every box replaced: the local copy's boxes are not the publisher's.
+    delta = diff(Environment(cell_, 0, 0, current_->boxes()), snapshot);
+    delta.from_version = current_->version();
+    held_.clear();
+    ++stats_.went_back;
+  } else {
+    const Environment before =
+        current_ && current_->version() < snapshot.version() ? *current_ : Environment(cell_);
+    delta = diff(before, snapshot);
+  }
   current_ = snapshot;
   out_of_sync_ = false;
   ++stats_.snapshots_applied;
   updates.push_back({snapshot, std::move(delta), true});
   drain(updates);
   return updates;
+}
+
+void EnvironmentTracker::note_below(std::uint64_t version) {
+  if (below_count_ > 0 && version <= below_version_) return;  // a stale duplicate
+  below_version_ = version;
+  ++below_count_;
 }
 
 std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDelta& delta) {
@@ -52,7 +72,11 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDel
       return updates;
     }
   }
-  if (current_ && delta.to_version <= current_->version()) return updates;
+  if (current_ && delta.to_version <= current_->version()) {
+    if (delta.to_version < current_->version()) note_below(delta.to_version);
+    return updates;
+  }
+  below_count_ = 0;
   if (current_ && delta.from_version != current_->version()) ++stats_.gaps;
   held_[delta.from_version] = delta;
   while (held_.size() > kMaxHeld) held_.erase(held_.begin());
