@@ -156,6 +156,9 @@ VersionStore::VersionStore(fs::path state_dir, std::string cell)
   std::error_code ec;
   fs::create_directories(dir_, ec);
   if (ec) throw Error(dir_.string() + ": cannot create state directory: " + ec.message());
+  // The environment goes encrypted over DDS under Security: no other local user reads it here either.
+  fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::replace, ec);
+  if (ec) throw Error(dir_.string() + ": cannot make the state directory its owner's only: " + ec.message());
   Listing listing = list_directory();
   load_newest_intact(listing);
   remove_superseded(listing);

@@ -66,6 +66,17 @@ TEST(VersionStoreTest, FreshDirectoryStartsAtVersionOne) {
   EXPECT_EQ(store.next_version(), 1u);
 }
 
+TEST(VersionStoreTest, TheStateDirectoryIsItsOwnersOnly) {
+  test::TempDir dir;
+  namespace fs = std::filesystem;
+  (void)VersionStore(dir.path() / "new", "cell-a");
+  EXPECT_EQ(fs::status(dir.path() / "new").permissions(), fs::perms::owner_all);
+  fs::create_directory(dir.path() / "old");
+  fs::permissions(dir.path() / "old", fs::perms::all);  // as a umask of 000 leaves it
+  (void)VersionStore(dir.path() / "old", "cell-a");
+  EXPECT_EQ(fs::status(dir.path() / "old").permissions(), fs::perms::owner_all);
+}
+
 TEST(VersionStoreTest, RoundTripKeepsEveryFieldAndTheBlob) {
   test::TempDir dir;
   {

@@ -50,9 +50,10 @@ struct RecoveredState final {
 /// Not thread-safe; one VersionStore per state directory (no inter-process locking).
 class VersionStore final {
  public:
-  /// Opens `state_dir` (created if missing), removes temporary files of interrupted writes and loads the
-  /// newest intact snapshot (see recovered()).
-  /// @throws Error if the directory cannot be created or listed, or holds a snapshot of another cell.
+  /// Opens `state_dir` (created if missing, and made readable by its owner only: mode 0700), removes
+  /// temporary files of interrupted writes and loads the newest intact snapshot (see recovered()).
+  /// @throws Error if the directory cannot be created, restricted or listed, or holds a snapshot of another
+  /// cell.
   VersionStore(std::filesystem::path state_dir, std::string cell);
 
   /// The cell whose versions `state_dir` holds: the one the newest snapshot that reads back names. Read
