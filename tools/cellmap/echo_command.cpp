@@ -94,7 +94,7 @@ void add_echo_command(CLI::App& app) {
   echo->add_option("--timeout", options->timeout,
                    "Fail after this many seconds without --count messages (0: never)")
       ->check(CLI::NonNegativeNumber);
-  add_security_options(echo, options->security, security::Role::kTool);
+  add_security_options(echo, options->security, security::Role::kPlanner);
   echo->callback([options] { run_echo(*options); });
 }
 

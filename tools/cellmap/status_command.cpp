@@ -136,7 +136,7 @@ void add_status_command(CLI::App& app) {
       ->capture_default_str();
   status->add_flag("--json", options->json,
                    "one JSON document {\"domain\", \"cells\": [...]}, a cell's fields as on cellmap/status");
-  add_security_options(status, options->security, security::Role::kTool);
+  add_security_options(status, options->security, security::Role::kPlanner);
   status->callback([options] { run_status(*options); });
 }
 
