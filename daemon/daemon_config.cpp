@@ -304,7 +304,8 @@ DaemonConfig DaemonConfig::read(const std::string& yaml, const std::string& sour
     if (c.cell.find_first_of("*?\\") != std::string::npos)
       root.fail("cell", "must not hold '*', '?' or '\\' (its DDS partition would be a pattern)");
     if (single_line(c.cell, transport::kMaxNameLength) != c.cell)
-      root.fail("cell", "must be UTF-8 without control characters, at most 128 bytes (subscribers refuse others)");
+      root.fail("cell",
+                "must be UTF-8 without control characters, at most 128 bytes (subscribers refuse others)");
   });
   problems.read([&] { c.domain = static_cast<int>(root.integer("domain", c.domain, 0, 232)); });
   problems.read([&] { c.state_dir = root.get<std::string>("state_dir", c.state_dir.string()); });

@@ -295,7 +295,8 @@ std::string ViewState::state() const {
                      {"timeline", timeline},
                      {"status", cell.status ? status_json(*cell.status, cell.daemon) : json(nullptr)}});
   }
-  return json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}}.dump(-1, ' ', false, kReplaceInvalidUtf8);
+  return json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}}.dump(
+      -1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::vector<std::string> ViewState::layers(transport::Layer layer) const {

@@ -35,12 +35,12 @@ TEST(TextTest, SingleLineKeepsValidTextAndReplacesWhatBreaksALineOrAPage) {
   EXPECT_EQ(single_line("cell-1 Zelle \u00e4 \u4e2d \U0001F916"), "cell-1 Zelle \u00e4 \u4e2d \U0001F916");
   EXPECT_EQ(single_line("a\nb\tc\x7f\r"), "a?b?c??");
   EXPECT_EQ(single_line("c\xffx"), "c?x");                        // not UTF-8
-  EXPECT_EQ(single_line("\xc0\xafx"), "??x");                    // an overlong '/'
-  EXPECT_EQ(single_line("\xed\xa0\x80"), "???");                // a surrogate
-  EXPECT_EQ(single_line("\xf4\x90\x80\x80"), "????");          // past U+10FFFF
-  EXPECT_EQ(single_line("ab\xe4\xb8"), "ab??");                  // cut inside a character
-  EXPECT_EQ(single_line("\xc2\x85x"), "?x");                     // C1 next line
-  EXPECT_EQ(single_line("a\u2028b\u2029c"), "a?b?c");            // line and paragraph separators
+  EXPECT_EQ(single_line("\xc0\xafx"), "??x");                     // an overlong '/'
+  EXPECT_EQ(single_line("\xed\xa0\x80"), "???");                  // a surrogate
+  EXPECT_EQ(single_line("\xf4\x90\x80\x80"), "????");             // past U+10FFFF
+  EXPECT_EQ(single_line("ab\xe4\xb8"), "ab??");                   // cut inside a character
+  EXPECT_EQ(single_line("\xc2\x85x"), "?x");                      // C1 next line
+  EXPECT_EQ(single_line("a\u2028b\u2029c"), "a?b?c");             // line and paragraph separators
   EXPECT_EQ(single_line("x\u202eevil\u2066\u200f"), "x?evil??");  // bidirectional controls
   EXPECT_EQ(single_line(std::string("a\0b", 3)), "a?b");
 }

@@ -102,9 +102,9 @@ TEST_F(SceneEditRulesTest, UnknownKindsAndBadNamesAreRefused) {
 TEST_F(SceneEditRulesTest, ANameWithAControlCharacterIsRefusedOnOneLine) {
   name_ = "c\n2026-12-02T06:00:00.000 info forged";
   msg_.name = name_.data();
-  EXPECT_EQ(
-      refusal(),
-      "cellmap/sim/scene_edits 'c?2026-12-02T06:00:00.000 info forged': name: not UTF-8, or holding a control character");
+  EXPECT_EQ(refusal(),
+            "cellmap/sim/scene_edits 'c?2026-12-02T06:00:00.000 info forged': name: not UTF-8, or holding a "
+            "control character");
   name_ = "tab\there";
   msg_.name = name_.data();
   EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'tab?here': name: not UTF-8, or holding a control character");
@@ -116,20 +116,22 @@ TEST_F(SceneEditRulesTest, ANameThatIsNotUtf8OrReordersTextIsRefused) {
   EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'c?x': name: not UTF-8, or holding a control character");
   name_ = "box\u202e1-xob";  // right-to-left override: shown as "boxbox-1"
   msg_.name = name_.data();
-  EXPECT_EQ(refusal(), "cellmap/sim/scene_edits 'box?1-xob': name: not UTF-8, or holding a control character");
+  EXPECT_EQ(refusal(),
+            "cellmap/sim/scene_edits 'box?1-xob': name: not UTF-8, or holding a control character");
   name_ = "Kiste-\u00e4";
   msg_.name = name_.data();
   EXPECT_EQ(refusal(), "");
 }
 
-// Every text a sample carries reaches logs, JSON writers (cellmap echo, view) and the page: a cell id that is not
-// clean refuses the sample; text only shown (states, sensor names, reasons) is made clean.
+// Every text a sample carries reaches logs, JSON writers (cellmap echo, view) and the page: a cell id that is
+// not clean refuses the sample; text only shown (states, sensor names, reasons) is made clean.
 TEST(NetworkTextTest, AnUncleanCellRefusesTheSampleAndShownTextIsMadeClean) {
   std::string cell = "c\xffx";
   cellmap_msg_Environment environment{};
   environment.cell = cell.data();
-  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(environment); }),
-            "cellmap/environment 'c?x': cell: longer than 128 bytes, not UTF-8, or holding a control character");
+  EXPECT_EQ(
+      test::error_of([&] { (void)wire::from_wire(environment); }),
+      "cellmap/environment 'c?x': cell: longer than 128 bytes, not UTF-8, or holding a control character");
   cell = std::string(129, 'c');
   environment.cell = cell.data();
   EXPECT_NE(test::error_of([&] { (void)wire::from_wire(environment); }).find("longer than 128 bytes"),

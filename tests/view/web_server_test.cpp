@@ -80,8 +80,8 @@ TEST(WebServerTest, OnlyTheViewersOwnPagesAndAllowedOriginsOpenTheLiveConnection
   EXPECT_NE(upgrade_status(options.port, "evil.example.com:8080", "http://evil.example.com:8080"), upgraded);
   EXPECT_NE(upgrade_status(options.port, own, "null"), upgraded) << "a sandboxed or file:// page";
   EXPECT_NE(upgrade_status(options.port, own, "https://" + own), upgraded);
-  EXPECT_EQ(refused, (std::vector<std::string>{"http://evil.example.com", "http://evil.example.com:8080", "null",
-                                                "https://" + own}));
+  EXPECT_EQ(refused, (std::vector<std::string>{"http://evil.example.com", "http://evil.example.com:8080",
+                                               "null", "https://" + own}));
 }
 
 }  // namespace

@@ -71,7 +71,8 @@ void run_echo(const EchoOptions& options) {
     }
     for (const transport::EnvironmentMessage& message :
          monitor.take(std::min(left, std::chrono::nanoseconds(1'000'000'000)))) {
-      std::cout << message_json(message).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;  // one line per message, flushed for pipes
+      std::cout << message_json(message).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+                << std::endl;  // one line per message, flushed for pipes
       if (++printed == options.count) break;
     }
     if (monitor.rejected() > rejected) {
@@ -88,8 +89,9 @@ void add_echo_command(CLI::App& app) {
   CLI::App* echo =
       app.add_subcommand("echo", "Print one JSON line per environment snapshot/delta received over DDS");
   echo->add_option("--domain", options->domain, "DDS domain id")->check(CLI::Range(0, 232));
-  echo->add_option("--cell", options->cell,
-                   "only this cell's partition (default: every cell; with --security, the credentials' cell)");
+  echo->add_option(
+      "--cell", options->cell,
+      "only this cell's partition (default: every cell; with --security, the credentials' cell)");
   echo->add_option("--count", options->count, "Exit after this many messages (0: never)");
   echo->add_option("--timeout", options->timeout,
                    "Fail after this many seconds without --count messages (0: never)")

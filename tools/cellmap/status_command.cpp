@@ -102,7 +102,9 @@ void print_human(const std::map<std::string, transport::CellStatus>& reports) {
 void print_json(const std::map<std::string, transport::CellStatus>& reports, std::uint32_t domain) {
   nlohmann::json cells = nlohmann::json::array();
   for (const auto& entry : reports) cells.push_back(nlohmann::json::parse(view::status_json(entry.second)));
-  std::cout << nlohmann::json({{"domain", domain}, {"cells", cells}}).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  std::cout << nlohmann::json({{"domain", domain}, {"cells", cells}})
+                   .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+            << "\n";
 }
 
 void run_status(const StatusOptions& options) {

@@ -142,9 +142,10 @@ void add_view_command(CLI::App& app) {
   command->add_option("--port", options->server.port, "TCP port (default 8080)")->check(CLI::Range(1, 65535));
   command->add_option("--three", options->server.three_dir,
                       "folder of three.js (default: Debian's libjs-three, /usr/share/javascript/three)");
-  command->add_option("--allow-origin", options->server.allowed_origins,
-                      "an origin whose pages may connect besides the viewer's own, e.g. http://cellpc:8080 when "
-                      "browsers reach it by that name (repeatable)");
+  command->add_option(
+      "--allow-origin", options->server.allowed_origins,
+      "an origin whose pages may connect besides the viewer's own, e.g. http://cellpc:8080 when "
+      "browsers reach it by that name (repeatable)");
   add_security_options(command, options->security, security::Role::kPlanner);
   command->callback([options] { run_view(*options); });
 }

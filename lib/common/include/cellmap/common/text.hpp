@@ -25,8 +25,7 @@ namespace cellmap {
 /// and paragraph separators U+2028/9 and the bidirectional controls (U+061C, U+200E/F, U+202A–E, U+2066–9)
 /// each become '?'; then cut to at most `max_bytes` bytes, never inside a character. The one sanitizer for
 /// text from the network and for messages that quote input.
-[[nodiscard]] std::string single_line(std::string_view text,
-                                      std::size_t max_bytes = std::string_view::npos);
+[[nodiscard]] std::string single_line(std::string_view text, std::size_t max_bytes = std::string_view::npos);
 
 /// The whole of `text` as a finite number. @throws Error "<where>: '<text>' is not a finite number".
 [[nodiscard]] double parse_finite(const std::string& text, const std::string& where);

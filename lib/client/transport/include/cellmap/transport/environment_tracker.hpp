@@ -31,18 +31,19 @@ struct TrackerStats final {
 };
 
 /// How many samples (snapshots or deltas), each newer than the one before yet older than the local copy, make
-/// the copy wait for a snapshot and follow it back: the publisher goes on below what the copy holds (its state
-/// was wiped, or the copy took a forged version far ahead), so the local version is not the publisher's.
+/// the copy wait for a snapshot and follow it back: the publisher goes on below what the copy holds (its
+/// state was wiped, or the copy took a forged version far ahead), so the local version is not the
+/// publisher's.
 inline constexpr int kSamplesBelowToFollow = 3;
 
 /// Keeps a local copy of `cell`. Deltas are applied in version order; a delta that does not start at the
 /// local version is a gap: it is held, and the copy waits for a snapshot at least as new (needs_snapshot()).
 /// A delta from version 0 carries the whole environment (every box added) and counts as a snapshot once a
 /// local copy exists (before, the snapshot itself is awaited, so a late joiner jumps straight to the newest).
-/// Older or duplicate samples are ignored, unless kSamplesBelowToFollow samples in a row go on below the local
-/// version: the copy then needs a snapshot and follows the next one below it (an update from_snapshot whose
-/// delta goes from the local version back to it, replacing every box). Samples of other cells are ignored.
-/// Not thread-safe.
+/// Older or duplicate samples are ignored, unless kSamplesBelowToFollow samples in a row go on below the
+/// local version: the copy then needs a snapshot and follows the next one below it (an update from_snapshot
+/// whose delta goes from the local version back to it, replacing every box). Samples of other cells are
+/// ignored. Not thread-safe.
 class EnvironmentTracker final {
  public:
   explicit EnvironmentTracker(std::string cell);
