@@ -219,8 +219,10 @@ TEST_F(RobotStateRulesTest, ACellNameWithLineBreaksIsQuotedOnOneLine) {
   cell_ = "cell-1\n2026-12-02T06:00:00.000 info forged\r";
   msg_.cell = cell_.data();
   msg_.position[2] = std::nan("");
-  EXPECT_EQ(refusal().substr(0, 69), "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?' at ")
-      << refusal();
+  // Such a cell is refused for what it is, before anything else, on one line.
+  EXPECT_EQ(refusal(),
+            "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?': cell: longer than 128 bytes, not "
+            "UTF-8, or holding a control character");
   msg_.position[2] = 1.5;
   msg_.stamp_ns = kNow - 6'000'000'000;
   EXPECT_EQ(refusal().find_first_of("\n\r"), std::string::npos) << refusal();
