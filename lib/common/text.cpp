@@ -77,15 +77,10 @@ std::string single_line(std::string_view text, std::size_t max_bytes) {
     char32_t code_point = 0;
     const std::size_t length = utf8_sequence(text, code_point);
     const bool safe = length > 0 && !shown_unsafely(code_point);
-    const std::size_t taken = safe ? length : std::max<std::size_t>(length, 1);
-    const std::size_t written = safe ? length : 1;
-    if (out.size() + written > max_bytes) break;
-    if (safe) {
-      out.append(text.substr(0, length));
-    } else {
-      out.push_back('?');
-    }
-    text.remove_prefix(taken);
+    const std::string_view shown = safe ? text.substr(0, length) : "?";
+    if (out.size() + shown.size() > max_bytes) break;
+    out.append(shown);
+    text.remove_prefix(std::max<std::size_t>(length, 1));
   }
   return out;
 }

@@ -10,9 +10,11 @@ namespace {
 
 using nlohmann::json;
 
-// Network text is made valid UTF-8 where it arrives (single_line); this keeps a string that slipped by from
-// making the writer throw.
-constexpr json::error_handler_t kReplaceInvalidUtf8 = json::error_handler_t::replace;
+// The message's text. Network text is made valid UTF-8 where it arrives (single_line); replacing keeps a
+// string that slipped by from making the writer throw.
+std::string text_of(const json& message) {
+  return message.dump(-1, ' ', false, json::error_handler_t::replace);
+}
 
 json vector_json(const Eigen::Vector3d& v) {
   return json::array({v.x(), v.y(), v.z()});
@@ -172,7 +174,7 @@ struct LayerJson {
 }  // namespace
 
 std::string status_json(const transport::CellStatus& status) {
-  return status_object(status).dump(-1, ' ', false, kReplaceInvalidUtf8);
+  return text_of(status_object(status));
 }
 
 const char* layer_name(transport::Layer layer) {
@@ -221,16 +223,15 @@ std::string ViewState::on_version(const Environment& env, const EnvironmentDelta
   };
   json added = json::array();
   for (const Box& box : delta.added) added.push_back(box_json(box, changed_in(box.id)));
-  return json{{"type", "version"},
-              {"cell", env.cell()},
-              {"from_version", delta.from_version},
-              {"to_version", delta.to_version},
-              {"stamp_ns", delta.stamp_ns},
-              {"received_ns", received_ns},
-              {"added", added},
-              {"modified", boxes_json(delta.modified, delta.to_version)},
-              {"removed", delta.removed}}
-      .dump(-1, ' ', false, kReplaceInvalidUtf8);
+  return text_of(json{{"type", "version"},
+                      {"cell", env.cell()},
+                      {"from_version", delta.from_version},
+                      {"to_version", delta.to_version},
+                      {"stamp_ns", delta.stamp_ns},
+                      {"received_ns", received_ns},
+                      {"added", added},
+                      {"modified", boxes_json(delta.modified, delta.to_version)},
+                      {"removed", delta.removed}});
 }
 
 std::string ViewState::on_status(const transport::CellStatus& status) {
@@ -241,7 +242,7 @@ std::string ViewState::on_status(const transport::CellStatus& status) {
   cell.daemon = true;
   json message = status_json(status, true);
   message["type"] = "status";
-  return message.dump(-1, ' ', false, kReplaceInvalidUtf8);
+  return text_of(message);
 }
 
 std::string ViewState::on_daemon_gone(const std::string& cell_name) {
@@ -253,14 +254,14 @@ std::string ViewState::on_daemon_gone(const std::string& cell_name) {
   last.cell = cell_name;
   json message = status_json(last, false);
   message["type"] = "status";
-  return message.dump(-1, ' ', false, kReplaceInvalidUtf8);
+  return text_of(message);
 }
 
 std::string ViewState::on_layer(const transport::LayerMessage& layer) {
   const std::string& cell_name =
       std::visit([](const auto& l) -> const std::string& { return l.cell; }, layer);
   if (!followed(cell_name)) return "";
-  std::string message = std::visit(LayerJson{}, layer).dump(-1, ' ', false, kReplaceInvalidUtf8);
+  std::string message = text_of(std::visit(LayerJson{}, layer));
   const std::lock_guard<std::mutex> lock(mutex_);
   cells_[cell_name].layers[transport::layer_of(layer)] = message;
   return message;
@@ -295,8 +296,8 @@ std::string ViewState::state() const {
                      {"timeline", timeline},
                      {"status", cell.status ? status_json(*cell.status, cell.daemon) : json(nullptr)}});
   }
-  return json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}}.dump(
-      -1, ' ', false, kReplaceInvalidUtf8);
+  return text_of(
+      json{{"type", "state"}, {"domain", domain_}, {"cell_filter", cell_filter_}, {"cells", cells}});
 }
 
 std::vector<std::string> ViewState::layers(transport::Layer layer) const {

@@ -20,12 +20,12 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment
     ++stats_.other_cells;
     return updates;
   }
-  if (current_ && snapshot.version() >= current_->version()) below_count_ = 0;  // the publisher is not below
-  if (current_ && snapshot.version() < current_->version()) note_below(snapshot.version());
-  const bool went_back = current_ && snapshot.version() < current_->version() && publisher_below();
-  if (current_ && !went_back &&
-      (snapshot.version() < current_->version() ||
-       (snapshot.version() == current_->version() && !out_of_sync_))) {
+  const bool went_back = current_ && snapshot.version() < current_->version();
+  if (went_back) {
+    note_below(snapshot.version());
+    if (!publisher_below()) return updates;
+  } else if (current_ && snapshot.version() == current_->version() && !out_of_sync_) {
+    below_count_ = 0;  // the publisher is where the copy is
     return updates;
   }
   below_count_ = 0;

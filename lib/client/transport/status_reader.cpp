@@ -4,8 +4,6 @@
 #include <algorithm>
 
 #include "cellmap/common/error.hpp"
-#include "cellmap/common/text.hpp"
-#include "cellmap/transport/input_limits.hpp"
 #include "cellmap/transport/topics.hpp"
 #include "wire.hpp"
 
@@ -43,10 +41,14 @@ std::vector<CellStatus> StatusReader::take(std::chrono::nanoseconds timeout) {
         }
       },
       [&](const void* key_sample) {
-        const char* cell = static_cast<const cellmap_msg_Status*>(key_sample)->cell;
-        if (cell == nullptr || *cell == '\0' || single_line(cell, kMaxNameLength) != cell) return;
+        std::string cell;
+        try {
+          cell = wire::cell_of(static_cast<const cellmap_msg_Status*>(key_sample)->cell, kStatusTopic);
+        } catch (const Error&) {
+          return;  // as for its reports
+        }
         forget(cell);
-        departed_.emplace_back(cell);
+        departed_.push_back(std::move(cell));
       });
   return reports;
 }
