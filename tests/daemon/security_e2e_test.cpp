@@ -341,6 +341,46 @@ TEST(SecurityE2eTest, AParticipantOfAnotherCaIsRefusedByThePeers) {
       << "only our own planner may have matched";
 }
 
+// Several planners, each with an identity of its own: a stolen one is revoked alone. The revoked host never
+// got the new list (as a thief would not): the daemon's list is what keeps it out.
+TEST(SecurityE2eTest, ARevokedHostIdentityIsRefusedByTheDaemonWhileAnotherPlannerOfTheRoleStaysIn) {
+  test::use_secure_loopback();
+  const test::TestCredentials cell("revoked", test::domain::kRevoked);
+  test::TempDir hosts("cellmap-hosts");
+  const auto issue = [&](const std::string& host) {
+    security::HostIdentity request;
+    request.directory = cell.directory();
+    request.role = Role::kPlanner;
+    request.host = host;
+    request.grants = transport::role_grants("revoked").at(Role::kPlanner);
+    request.valid_from = std::chrono::system_clock::now() - 1h;
+    request.valid_until = request.valid_from + 24h;
+    request.ca = cell.ca();
+    request.out = hosts.path() / host;
+    security::issue_host_identity(request);
+    return request.out;
+  };
+  const std::filesystem::path kept = issue("planner-kept");
+  const std::filesystem::path stolen = issue("planner-stolen");
+  EXPECT_EQ(security::revoke(stolen / "planner" / "identity.pem", cell.ca(), {cell.directory()}),
+            "CN=planner@planner-stolen,OU=revoked,O=cellmap");
+
+  auto daemon =
+      start(probe(test::domain::kRevoked, "revoked", {"serve", "--publish"}, &cell, Role::kDaemon));
+  expect_line(*daemon, "ready");
+  const std::string domain = std::to_string(test::domain::kRevoked);
+  auto thief = start({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "4", "--security",
+                      stolen.string(), "--role", "planner"});
+  const dds::Participant participant(test::domain::kRevoked, security::Setting{kept, Role::kPlanner});
+  transport::EnvironmentSubscriber planner(participant, "revoked");
+  EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the kept planner never matched";
+  int code = 0;
+  EXPECT_EQ(last_line(finish(*thief, &code)), "cellmap: echo: timed out after 4 s with 0 of 1 messages");
+  EXPECT_EQ(code, 1) << "the revoked identity received the environment";
+  const nlohmann::json served = stop(*daemon);
+  EXPECT_EQ(served["subscribers_joined"], 1) << served.dump() << ": only the kept planner may have matched";
+}
+
 TEST(SecurityE2eTest, BadCredentialsStopAProgramAtStartWithOneLine) {
   const test::TestCredentials credentials("refusal", test::domain::kRefusal);
   const test::TempDir state;

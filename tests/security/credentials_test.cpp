@@ -30,9 +30,12 @@ class CredentialsTest : public ::testing::Test {
     setup.domain = kDomain;
     setup.valid_from = std::chrono::system_clock::now() - 1h;
     setup.valid_until = setup.valid_from + 24h * 30;
+    setup.ca_valid_until = setup.valid_until;
     setup.grants = transport::role_grants(setup.cell);
+    setup.ca = ca_of(directory);
     write_cell_credentials(setup);
   }
+  static CaFolder ca_of(const fs::path& directory) { return {directory.string() + "-ca", "a passphrase"}; }
   void SetUp() override { write(cell_); }
 
   [[nodiscard]] std::string refusal(
@@ -134,6 +137,41 @@ TEST_F(CredentialsTest, DocumentsOfAnotherDomainOrRoleAreRefused) {
   EXPECT_EQ(refusal(),
             planner_.permissions.string() +
                 ": made for CN=daemon,OU=cell-7,O=cellmap, not for CN=planner,OU=cell-7,O=cellmap");
+}
+
+TEST_F(CredentialsTest, ACaKeyInTheRuntimeFolderIsRefused) {
+  // The layout of earlier versions: the CA keys in ca/ of the folder every host got a copy of.
+  fs::create_directories(cell_ / "ca");
+  fs::copy_file(ca_of(cell_).directory / "identity_ca_key.pem", cell_ / "ca" / "identity_ca_key.pem");
+  EXPECT_EQ(refusal(), (cell_ / "ca" / "identity_ca_key.pem").string() +
+                           ": a CA private key in the runtime folder: whoever reads this folder can issue "
+                           "credentials for the cell; move it to the CA's own machine (docs/security.md, "
+                           "\"Where keys live\")");
+  fs::remove_all(cell_ / "ca");
+  fs::copy_file(ca_of(cell_).directory / "permissions_ca_key.pem", cell_ / "permissions_ca_key.pem");
+  EXPECT_EQ(refusal().rfind((cell_ / "permissions_ca_key.pem").string() + ": a CA private key", 0), 0u);
+}
+
+TEST_F(CredentialsTest, ARevokedIdentityIsRefusedAndTheOthersPass) {
+  const std::string subject = revoke(planner_.certificate, ca_of(cell_), {cell_});
+  EXPECT_EQ(subject, "CN=planner,OU=cell-7,O=cellmap");
+  const std::string message = refusal();
+  EXPECT_EQ(message.rfind(planner_.certificate.string() + ": revoked on 20", 0), 0u) << message;
+  EXPECT_NE(message.find("(" + planner_.revocations.string() + ")"), std::string::npos) << message;
+  EXPECT_NO_THROW((void)check({cell_, Role::kDaemon}, kDomain));
+  // Revoking twice lists it once, and the list stays the CA's.
+  (void)revoke(planner_.certificate, ca_of(cell_), {cell_});
+  EXPECT_NO_THROW((void)check({cell_, Role::kTool}, kDomain));
+}
+
+TEST_F(CredentialsTest, ARevocationListOfAnotherCaIsRefused) {
+  write(other_);
+  (void)revoke(role_files(other_, Role::kTool).certificate, ca_of(other_), {other_});
+  take_from_other_set("revoked.crl");
+  EXPECT_EQ(refusal(), planner_.revocations.string() + ": not signed by the identity CA " +
+                           planner_.identity_ca.string());
+  std::ofstream(planner_.revocations) << "not a list";
+  EXPECT_EQ(refusal(), planner_.revocations.string() + ": not a PEM certificate revocation list");
 }
 
 TEST(RoleTest, NamesRoundTripAndUnknownOnesAreRefused) {

@@ -106,6 +106,7 @@ inline constexpr int kAttack = 193;
 inline constexpr int kRoles = 194;
 inline constexpr int kOtherCa = 195;
 inline constexpr int kRefusal = 196;
+inline constexpr int kRevoked = 228;
 
 // transport_test: the viewer's layers.
 inline constexpr int kLayers = 222;

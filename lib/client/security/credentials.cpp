@@ -112,6 +112,45 @@ std::string cell_of(const X509* certificate, const fs::path& file) {
   return std::string(cell, static_cast<std::size_t>(n));
 }
 
+// The old layout kept the CA keys in ca/ of the runtime folder; a key copied by hand may sit beside the
+// certificates.
+void require_no_ca_key(const fs::path& directory) {
+  for (const fs::path& folder : {directory / "ca", directory}) {
+    for (const char* name : {"identity_ca_key.pem", "permissions_ca_key.pem"}) {
+      std::error_code ec;
+      if (fs::exists(folder / name, ec)) {
+        throw Error((folder / name).string() +
+                    ": a CA private key in the runtime folder: whoever reads this folder can issue "
+                    "credentials for the cell; move it to the CA's own machine (docs/security.md, \"Where "
+                    "keys live\")");
+      }
+    }
+  }
+}
+
+// Returns when the list must be renewed, or `max` when there is none.
+TimePoint require_not_revoked(X509* certificate, const RoleFiles& files, X509* identity_ca, TimePoint now) {
+  std::error_code ec;
+  if (!fs::exists(files.revocations, ec)) return TimePoint::max();
+  const ossl::CrlPtr crl = ossl::read_crl(read_credential(files.revocations));
+  if (!crl) throw Error(files.revocations.string() + ": not a PEM certificate revocation list");
+  if (X509_CRL_verify(crl.get(), X509_get0_pubkey(identity_ca)) != 1) {
+    ERR_clear_error();
+    throw Error(files.revocations.string() + ": not signed by the identity CA " + files.identity_ca.string());
+  }
+  X509_REVOKED* entry = nullptr;
+  if (X509_CRL_get0_by_serial(crl.get(), &entry, X509_get_serialNumber(certificate)) == 1) {
+    throw Error(files.certificate.string() + ": revoked on " +
+                utc_text(ossl::to_time_point(X509_REVOKED_get0_revocationDate(entry))) + " (" +
+                files.revocations.string() + ")");
+  }
+  const ASN1_TIME* next_update = X509_CRL_get0_nextUpdate(crl.get());
+  if (next_update == nullptr) return TimePoint::max();
+  const TimePoint until = ossl::to_time_point(next_update);
+  if (now >= until) throw Error(files.revocations.string() + ": expired on " + utc_text(until));
+  return until;
+}
+
 }  // namespace
 
 const char* to_string(Role role) {
@@ -133,12 +172,14 @@ const std::vector<Role>& all_roles() {
 RoleFiles role_files(const fs::path& directory, Role role) {
   const fs::path own = directory / to_string(role);
   return {directory / "identity_ca.pem", directory / "permissions_ca.pem", directory / "governance.p7s",
-          own / "identity.pem",          own / "identity_key.pem",         own / "permissions.p7s"};
+          own / "identity.pem",          own / "identity_key.pem",         own / "permissions.p7s",
+          directory / "revoked.crl"};
 }
 
 Credentials check(const Setting& setting, std::uint32_t domain, TimePoint now) {
   Credentials credentials;
   const RoleFiles& files = credentials.files = role_files(fs::absolute(setting.directory), setting.role);
+  require_no_ca_key(fs::absolute(setting.directory));
   const ossl::X509Ptr identity_ca = load_certificate(files.identity_ca);
   TimePoint expires = require_current(identity_ca.get(), files.identity_ca, now);
   const ossl::X509Ptr permissions_ca = load_certificate(files.permissions_ca);
@@ -147,6 +188,7 @@ Credentials check(const Setting& setting, std::uint32_t domain, TimePoint now) {
   expires = std::min(expires, require_current(certificate.get(), files.certificate, now));
   require_issued_by(certificate.get(), files.certificate, identity_ca.get(), files.identity_ca);
   require_private_key_of(certificate.get(), files.private_key, files.certificate);
+  expires = std::min(expires, require_not_revoked(certificate.get(), files, identity_ca.get(), now));
   (void)load_document(files.governance, permissions_ca.get(), files.permissions_ca, domain);
   const std::string permissions =
       load_document(files.permissions, permissions_ca.get(), files.permissions_ca, domain);

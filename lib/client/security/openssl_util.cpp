@@ -4,6 +4,7 @@
 #include <openssl/err.h>
 #include <openssl/pem.h>
 
+#include <algorithm>
 #include <ctime>
 
 #include "cellmap/common/error.hpp"
@@ -52,6 +53,31 @@ KeyPtr read_private_key(const std::string& pem) {
   return key;
 }
 
+CrlPtr read_crl(const std::string& pem) {
+  const BioPtr bio = memory_bio(pem);
+  CrlPtr crl(PEM_read_bio_X509_CRL(bio.get(), nullptr, nullptr, nullptr));
+  ERR_clear_error();
+  return crl;
+}
+
+KeyPtr read_private_key(const std::string& pem, const std::string& passphrase) {
+  const BioPtr bio = memory_bio(pem);
+  // With a callback-less read OpenSSL would take `u` as the passphrase, but a NUL byte would cut it.
+  const auto give = [](char* buffer, int size, int, void* user) {
+    const auto& text = *static_cast<const std::string*>(user);
+    if (text.size() > static_cast<std::size_t>(size)) return 0;
+    std::copy(text.begin(), text.end(), buffer);
+    return static_cast<int>(text.size());
+  };
+  KeyPtr key(PEM_read_bio_PrivateKey(bio.get(), nullptr, give, const_cast<std::string*>(&passphrase)));
+  ERR_clear_error();
+  return key;
+}
+
+bool is_encrypted_key(const std::string& pem) {
+  return pem.find("-----BEGIN ENCRYPTED PRIVATE KEY-----") != std::string::npos;
+}
+
 std::string certificate_pem(X509* certificate) {
   const BioPtr bio = empty_bio();
   if (PEM_write_bio_X509(bio.get(), certificate) != 1) throw Error("OpenSSL: " + last_error());
@@ -62,6 +88,20 @@ std::string private_key_pem(EVP_PKEY* key) {
   const BioPtr bio = empty_bio();
   if (PEM_write_bio_PrivateKey(bio.get(), key, nullptr, nullptr, 0, nullptr, nullptr) != 1)
     throw Error("OpenSSL: " + last_error());
+  return bio_text(bio.get());
+}
+
+std::string crl_pem(X509_CRL* crl) {
+  const BioPtr bio = empty_bio();
+  if (PEM_write_bio_X509_CRL(bio.get(), crl) != 1) throw Error("OpenSSL: " + last_error());
+  return bio_text(bio.get());
+}
+
+std::string encrypted_private_key_pem(EVP_PKEY* key, const std::string& passphrase) {
+  const BioPtr bio = empty_bio();
+  if (PEM_write_bio_PKCS8PrivateKey(bio.get(), key, EVP_aes_256_cbc(), passphrase.data(),
+                                    static_cast<int>(passphrase.size()), nullptr, nullptr) != 1)
+    throw Error("OpenSSL: cannot encrypt a private key: " + last_error());
   return bio_text(bio.get());
 }
 

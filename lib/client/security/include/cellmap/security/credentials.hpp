@@ -9,10 +9,11 @@
 //   DIR/<role>/identity.pem      the role's certificate, signed by the identity CA
 //   DIR/<role>/identity_key.pem  its private key (mode 0600: refused when group or others have access)
 //   DIR/<role>/permissions.p7s   what the role may write and read (S/MIME, signed by the permissions CA)
-//   DIR/ca/                      the two CAs' private keys: needed only to issue credentials, keep offline
+//   DIR/revoked.crl              the identities revoked (signed by the identity CA); only after a revoke
 //
-// A participant needs only its role's files and the three shared ones; ca/ never leaves the machine that
-// issues credentials.
+// A participant needs only its role's files and the shared ones (`cellmap security export` copies exactly
+// those). The CAs' private keys live in a CA folder elsewhere (cell_setup.hpp); a runtime folder that holds
+// one is refused.
 
 #include <chrono>
 #include <cstdint>
@@ -40,6 +41,7 @@ struct RoleFiles final {
   std::filesystem::path certificate;
   std::filesystem::path private_key;
   std::filesystem::path permissions;
+  std::filesystem::path revocations;  ///< may not exist: nothing revoked yet
 };
 [[nodiscard]] RoleFiles role_files(const std::filesystem::path& directory, Role role);
 
@@ -65,6 +67,8 @@ struct Credentials final {
 /// belong to the certificate; the certificates must be within their validity at `now`, the role's signed by
 /// the identity CA; the documents must be signed by the permissions CA, made for `domain`, and the
 /// permissions for this certificate's subject and within their validity. The subject must name a cell (OU).
+/// A revocation list, if present, must be the identity CA's and must not list this certificate. The folder
+/// must hold no CA private key (the old layout's `ca/` included): whoever reads it could issue credentials.
 /// @throws Error "<file>: <reason>" naming the first file found wrong.
 [[nodiscard]] Credentials check(const Setting& setting, std::uint32_t domain,
                                 std::chrono::system_clock::time_point now = std::chrono::system_clock::now());
