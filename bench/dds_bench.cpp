@@ -100,6 +100,8 @@ class BenchCredentials {
     setup.domain = domain;
     setup.valid_from = std::chrono::system_clock::now() - std::chrono::hours(1);
     setup.valid_until = setup.valid_from + std::chrono::hours(24);
+    setup.ca_valid_until = setup.valid_until;
+    setup.ca = {directory.string() + "-ca", "bench passphrase"};
     setup.grants = transport::role_grants(setup.cell);
     setup.data_protection = data;
     security::write_cell_credentials(setup);

@@ -365,12 +365,11 @@ TEST(SecurityE2eTest, ARevokedHostIdentityIsRefusedByTheDaemonWhileAnotherPlanne
   EXPECT_EQ(security::revoke(stolen / "planner" / "identity.pem", cell.ca(), {cell.directory()}),
             "CN=planner@planner-stolen,OU=revoked,O=cellmap");
 
-  auto daemon =
-      start(probe(test::domain::kRevoked, "revoked", {"serve", "--publish"}, &cell, Role::kDaemon));
+  auto daemon = start(probe(test::domain::kRevoked, "revoked", {"serve", "--publish"}, &cell, Role::kDaemon));
   expect_line(*daemon, "ready");
   const std::string domain = std::to_string(test::domain::kRevoked);
-  auto thief = start({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "4", "--security",
-                      stolen.string(), "--role", "planner"});
+  auto thief = start({CELLMAP_TOOL, "echo", "--domain", domain, "--count", "1", "--timeout", "4",
+                      "--security", stolen.string(), "--role", "planner"});
   const dds::Participant participant(test::domain::kRevoked, security::Setting{kept, Role::kPlanner});
   transport::EnvironmentSubscriber planner(participant, "revoked");
   EXPECT_TRUE(planner.wait_for_version(1, test::kDaemonPatience)) << "the kept planner never matched";

@@ -55,7 +55,8 @@ TEST(CellSetupTest, WritesEveryRoleWithPrivateKeysOnlyForTheOwner) {
             std::string::npos);
   for (const auto& entry : fs::recursive_directory_iterator(setup.directory))
     EXPECT_EQ(entry.path().filename().string().find("_ca_key"), std::string::npos) << entry.path();
-  EXPECT_EQ(read_file(setup.directory / "identity_ca.pem"), read_file(setup.ca.directory / "identity_ca.pem"));
+  EXPECT_EQ(read_file(setup.directory / "identity_ca.pem"),
+            read_file(setup.ca.directory / "identity_ca.pem"));
   EXPECT_EQ(mode_of(setup.directory / "identity_ca.pem"), 0644u);
   EXPECT_EQ(mode_of(setup.directory / "governance.p7s"), 0644u);
   for (Role role : all_roles()) {
@@ -95,7 +96,8 @@ TEST(CellSetupTest, DocumentsGrantEachRoleItsTopicsOnly) {
   EXPECT_EQ(robot.find("cellmap/environment"), std::string::npos);
   // Every grant in the cell's partition only.
   for (Role role : all_roles()) {
-    const std::string permissions = read_file(role_files(dir.path(), role).permissions.replace_extension(".xml"));
+    const std::string permissions =
+        read_file(role_files(dir.path(), role).permissions.replace_extension(".xml"));
     EXPECT_NE(permissions.find("<partitions>\n            <partition>cellmap/cell-7</partition>\n"),
               std::string::npos)
         << to_string(role);
@@ -159,7 +161,8 @@ TEST(CellSetupTest, ACellOfAPlantIsIssuedWithAnotherCellsCas) {
   for (Role role : all_roles()) {
     const Credentials credentials = check({second.directory, role}, 7);
     EXPECT_EQ(credentials.cell, "cell-8");
-    EXPECT_NE(read_file(role_files(second.directory, role).permissions).find("cellmap/cell-8"), std::string::npos);
+    EXPECT_NE(read_file(role_files(second.directory, role).permissions).find("cellmap/cell-8"),
+              std::string::npos);
   }
 
   CellSetup wrong_passphrase = setup_in(dir.path() / "cell-9");
@@ -170,7 +173,9 @@ TEST(CellSetupTest, ACellOfAPlantIsIssuedWithAnotherCellsCas) {
   CellSetup orphan = setup_in(dir.path() / "cell-10");
   orphan.ca.directory = second.directory;  // a runtime folder holds no CA keys
   orphan.existing_ca = true;
-  EXPECT_EQ(test::error_of([&] { write_cell_credentials(orphan); }).rfind((second.directory / "identity_ca_key.pem").string(), 0),
+  EXPECT_EQ(test::error_of([&] {
+              write_cell_credentials(orphan);
+            }).rfind((second.directory / "identity_ca_key.pem").string(), 0),
             0u);
 }
 
@@ -208,8 +213,9 @@ TEST(CellSetupTest, AnExportHoldsOneRolesFilesAndNoOtherKey) {
   const Credentials credentials = check({out, Role::kPlanner}, 7);
   EXPECT_EQ(credentials.subject, "CN=planner,OU=cell-7,O=cellmap");
   EXPECT_NE(test::error_of([&] { (void)check({out, Role::kDaemon}, 7); }), "");
-  EXPECT_EQ(test::error_of([&] { export_role(setup.directory, Role::kPlanner, out); }),
-            out.string() + ": not empty; credentials are never overwritten (write a new set into a new directory)");
+  EXPECT_EQ(
+      test::error_of([&] { export_role(setup.directory, Role::kPlanner, out); }),
+      out.string() + ": not empty; credentials are never overwritten (write a new set into a new directory)");
 }
 
 TEST(CellSetupTest, AHostsOwnIdentityIsRevokedAloneAndTheListTravelsWithExports) {
@@ -229,7 +235,8 @@ TEST(CellSetupTest, AHostsOwnIdentityIsRevokedAloneAndTheListTravelsWithExports)
   request.host = "planner-3";
   request.out = dir.path() / "planner-3";
   issue_host_identity(request);
-  EXPECT_EQ(check({dir.path() / "planner-2", Role::kPlanner}, 7).subject, "CN=planner@planner-2,OU=cell-7,O=cellmap");
+  EXPECT_EQ(check({dir.path() / "planner-2", Role::kPlanner}, 7).subject,
+            "CN=planner@planner-2,OU=cell-7,O=cellmap");
   EXPECT_NE(read_file(dir.path() / "planner-2" / "planner" / "permissions.p7s")
                 .find("<subject_name>CN=planner@planner-2,OU=cell-7,O=cellmap</subject_name>"),
             std::string::npos);
@@ -243,13 +250,15 @@ TEST(CellSetupTest, AHostsOwnIdentityIsRevokedAloneAndTheListTravelsWithExports)
   export_role(setup.directory, Role::kPlanner, dir.path() / "planner-1");
   EXPECT_EQ(read_file(dir.path() / "planner-1" / "revoked.crl"), read_file(setup.directory / "revoked.crl"));
   fs::copy_file(setup.directory / "revoked.crl", dir.path() / "planner-2" / "revoked.crl");
-  EXPECT_EQ(test::error_of([&] { (void)check({dir.path() / "planner-2", Role::kPlanner}, 7); })
-                .rfind((dir.path() / "planner-2" / "planner" / "identity.pem").string() + ": revoked on ", 0),
+  EXPECT_EQ(test::error_of([&] {
+              (void)check({dir.path() / "planner-2", Role::kPlanner}, 7);
+            }).rfind((dir.path() / "planner-2" / "planner" / "identity.pem").string() + ": revoked on ", 0),
             0u);
 
   request.host = "bad,host";
   request.out = dir.path() / "bad";
-  EXPECT_EQ(test::error_of([&] { issue_host_identity(request); }), "--host: 'bad,host': use 1-64 of A-Z a-z 0-9 . _ -");
+  EXPECT_EQ(test::error_of([&] { issue_host_identity(request); }),
+            "--host: 'bad,host': use 1-64 of A-Z a-z 0-9 . _ -");
   CellSetup other = setup_in(dir.path() / "other");
   write_cell_credentials(other);
   EXPECT_EQ(test::error_of([&] { (void)revoke(other.directory / "tool" / "identity.pem", setup.ca, {}); }),

@@ -70,7 +70,8 @@ std::string passphrase_from(const PassphraseSource& source, bool new_ca) {
     return text;
   }
   if (::isatty(STDIN_FILENO) == 0) {
-    throw Error("the CA keys are encrypted: give --ca-passphrase-file FILE, or run on a terminal to be asked");
+    throw Error(
+        "the CA keys are encrypted: give --ca-passphrase-file FILE, or run on a terminal to be asked");
   }
   char buffer[1024] = {};
   if (EVP_read_pw_string(buffer, sizeof buffer, "CA passphrase: ", new_ca ? 1 : 0) != 0)
@@ -85,7 +86,9 @@ SystemClock::time_point days_from(SystemClock::time_point start, int days) {
 }
 
 // An hour back: a plant machine whose clock is a little behind still accepts fresh credentials.
-SystemClock::time_point valid_from_now() { return SystemClock::now() - std::chrono::hours(1); }
+SystemClock::time_point valid_from_now() {
+  return SystemClock::now() - std::chrono::hours(1);
+}
 
 // "DIR-ca" beside DIR: never inside it, so copying DIR to a host never copies the CA keys.
 std::string default_ca_folder(const std::string& directory) {
@@ -104,9 +107,9 @@ void init(const InitOptions& options) {
   setup.ca_valid_until = days_from(SystemClock::now(), options.ca_days);
   setup.grants = transport::role_grants(setup.cell);
   setup.existing_ca = !options.plant_ca.empty();
-  setup.ca.directory = setup.existing_ca       ? options.plant_ca
+  setup.ca.directory = setup.existing_ca    ? options.plant_ca
                        : options.ca.empty() ? default_ca_folder(options.directory)
-                                             : options.ca;
+                                            : options.ca;
   setup.ca.passphrase = passphrase_from(options.passphrase, !setup.existing_ca);
   security::write_cell_credentials(setup);
   std::cout << "wrote the DDS Security credentials of cell '" << setup.cell << "' on DDS domain "
@@ -148,8 +151,8 @@ void issue(const IssueOptions& options) {
 
 void revoke(const RevokeOptions& options) {
   const std::vector<fs::path> into(options.into.begin(), options.into.end());
-  const std::string subject = security::revoke(
-      options.certificate, {options.ca, passphrase_from(options.passphrase, false)}, into);
+  const std::string subject =
+      security::revoke(options.certificate, {options.ca, passphrase_from(options.passphrase, false)}, into);
   std::cout << "revoked " << subject << " in " << (fs::path(options.ca) / "revoked.crl").string();
   for (const fs::path& directory : into) std::cout << ", copied into " << directory.string();
   std::cout << "\n  every host must get the new revoked.crl (export again, or copy it beside governance.p7s) "
@@ -157,8 +160,9 @@ void revoke(const RevokeOptions& options) {
 }
 
 void add_passphrase_option(CLI::App* command, PassphraseSource& source) {
-  command->add_option("--ca-passphrase-file", source.file,
-                      "the CA passphrase is this file's first line; default: asked on the terminal")
+  command
+      ->add_option("--ca-passphrase-file", source.file,
+                   "the CA passphrase is this file's first line; default: asked on the terminal")
       ->check(CLI::ExistingFile);
 }
 
@@ -169,8 +173,9 @@ void add_days_option(CLI::App* command, int& days, const char* what) {
 void add_init(CLI::App* security) {
   auto options = std::make_shared<InitOptions>();
   CLI::App* command = security->add_subcommand(
-      "init", "Create a cell's credentials: one identity per role, the governance and permissions documents, "
-              "issued by new CAs (or the plant's)");
+      "init",
+      "Create a cell's credentials: one identity per role, the governance and permissions documents, "
+      "issued by new CAs (or the plant's)");
   command->add_option("directory", options->directory, "new (or empty) runtime folder to write")->required();
   command->add_option("--cell", options->cell, "the cell id")->required();
   command->add_option("--domain", options->domain, "the DDS domain id the credentials allow")
@@ -180,8 +185,9 @@ void add_init(CLI::App* security) {
   command->add_option("--ca-days", options->ca_days, "days new CAs stay valid (at least --days)")
       ->check(CLI::Range(1, kMaxDays))
       ->capture_default_str();
-  CLI::Option* ca = command->add_option(
-      "--ca", options->ca, "new (or empty) folder for the new CAs; default: DIR-ca beside the runtime folder");
+  CLI::Option* ca =
+      command->add_option("--ca", options->ca,
+                          "new (or empty) folder for the new CAs; default: DIR-ca beside the runtime folder");
   command
       ->add_option("--plant-ca", options->plant_ca,
                    "issue with the CAs of this CA folder (another cell's), so that the plant's cells "
@@ -194,8 +200,8 @@ void add_init(CLI::App* security) {
 
 void add_export(CLI::App* security) {
   auto options = std::make_shared<ExportOptions>();
-  CLI::App* command =
-      security->add_subcommand("export", "Copy what one host of a role needs, and nothing else, into a folder");
+  CLI::App* command = security->add_subcommand(
+      "export", "Copy what one host of a role needs, and nothing else, into a folder");
   command->add_option("directory", options->directory, "the cell's runtime folder (security init)")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -207,7 +213,8 @@ void add_export(CLI::App* security) {
 void add_issue(CLI::App* security) {
   auto options = std::make_shared<IssueOptions>();
   CLI::App* command = security->add_subcommand(
-      "issue", "A host's own identity of a role (CN=<role>@<host>), to revoke alone, in a folder for that host");
+      "issue",
+      "A host's own identity of a role (CN=<role>@<host>), to revoke alone, in a folder for that host");
   command->add_option("directory", options->directory, "the cell's runtime folder (security init)")
       ->required()
       ->check(CLI::ExistingDirectory);

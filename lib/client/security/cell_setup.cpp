@@ -168,9 +168,15 @@ ossl::X509Ptr make_certificate(const std::string& name, const std::string& cell,
   return certificate;
 }
 
-fs::path certificate_in(const CaFolder& ca, const std::string& name) { return ca.directory / (name + ".pem"); }
-fs::path key_in(const CaFolder& ca, const std::string& name) { return ca.directory / (name + "_key.pem"); }
-fs::path revocations_in(const fs::path& directory) { return directory / "revoked.crl"; }
+fs::path certificate_in(const CaFolder& ca, const std::string& name) {
+  return ca.directory / (name + ".pem");
+}
+fs::path key_in(const CaFolder& ca, const std::string& name) {
+  return ca.directory / (name + "_key.pem");
+}
+fs::path revocations_in(const fs::path& directory) {
+  return directory / "revoked.crl";
+}
 
 Authority make_authority(const std::string& name, const std::string& cell, Validity validity,
                          const CaFolder& ca) {
@@ -192,8 +198,8 @@ Authority load_authority(const std::string& name, const CaFolder& ca) {
   const std::string key_pem = read_file(key_file);
   authority.key = ossl::read_private_key(key_pem, ca.passphrase);
   if (!authority.key) {
-    throw Error(key_file.string() + (ossl::is_encrypted_key(key_pem) ? ": wrong CA passphrase"
-                                                                      : ": not a PEM private key"));
+    throw Error(key_file.string() +
+                (ossl::is_encrypted_key(key_pem) ? ": wrong CA passphrase" : ": not a PEM private key"));
   }
   if (X509_check_private_key(authority.certificate.get(), authority.key.get()) != 1)
     throw Error(key_file.string() + ": not the key of " + certificate_file.string());
@@ -224,7 +230,8 @@ Authorities authorities_for(const CellSetup& setup, Validity validity) {
     return {make_authority("identity_ca", setup.cell, ca_validity, setup.ca),
             make_authority("permissions_ca", setup.cell, ca_validity, setup.ca)};
   }
-  Authorities authorities{load_authority("identity_ca", setup.ca), load_authority("permissions_ca", setup.ca)};
+  Authorities authorities{load_authority("identity_ca", setup.ca),
+                          load_authority("permissions_ca", setup.ca)};
   require_within_authority(validity, authorities.identity, certificate_in(setup.ca, "identity_ca"));
   require_within_authority(validity, authorities.permissions, certificate_in(setup.ca, "permissions_ca"));
   return authorities;
@@ -275,7 +282,8 @@ void copy_file_as_new(const fs::path& from, const fs::path& to, mode_t mode) {
 
 // The CA certificates a runtime folder holds and the revocation list, if there is one.
 void copy_ca_files(const CaFolder& ca, const fs::path& directory) {
-  for (const char* name : {"identity_ca", "permissions_ca"}) copy_file_as_new(certificate_in(ca, name), directory / (std::string(name) + ".pem"), 0644);
+  for (const char* name : {"identity_ca", "permissions_ca"})
+    copy_file_as_new(certificate_in(ca, name), directory / (std::string(name) + ".pem"), 0644);
   if (fs::exists(revocations_in(ca.directory)))
     copy_file_as_new(revocations_in(ca.directory), revocations_in(directory), 0644);
 }
@@ -322,7 +330,8 @@ void add_revoked(X509_CRL* crl, X509* certificate, const Authority& identity_ca)
     ASN1_TIME* now = ASN1_TIME_set(nullptr, std::time(nullptr));
     const bool ok = entry != nullptr && now != nullptr &&
                     X509_REVOKED_set_serialNumber(entry, X509_get_serialNumber(certificate)) == 1 &&
-                    X509_REVOKED_set_revocationDate(entry, now) == 1 && X509_CRL_add0_revoked(crl, entry) == 1;
+                    X509_REVOKED_set_revocationDate(entry, now) == 1 &&
+                    X509_CRL_add0_revoked(crl, entry) == 1;
     ASN1_TIME_free(now);
     if (!ok) {
       X509_REVOKED_free(entry);

@@ -106,8 +106,8 @@ TimePoint require_permissions_for(const std::string& permissions, const std::str
 // The cell a role's certificate is for: its subject's OU, as `security init` writes it.
 std::string cell_of(const X509* certificate, const fs::path& file) {
   char cell[256] = {};
-  const int n = X509_NAME_get_text_by_NID(X509_get_subject_name(certificate), NID_organizationalUnitName, cell,
-                                          sizeof cell);
+  const int n = X509_NAME_get_text_by_NID(X509_get_subject_name(certificate), NID_organizationalUnitName,
+                                          cell, sizeof cell);
   if (n <= 0) throw Error(file.string() + ": the subject names no cell (OU)");
   return std::string(cell, static_cast<std::size_t>(n));
 }

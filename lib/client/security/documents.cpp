@@ -27,7 +27,8 @@ void topic_list(std::ostringstream& xml, const char* element, const std::vector<
   xml << "          </topics>\n";
   if (!partitions.empty()) {
     xml << "          <partitions>\n";
-    for (const std::string& partition : partitions) xml << "            <partition>" << partition << "</partition>\n";
+    for (const std::string& partition : partitions)
+      xml << "            <partition>" << partition << "</partition>\n";
     xml << "          </partitions>\n";
   }
   xml << "        </" << element << ">\n";

@@ -37,7 +37,8 @@ enum class DataProtection { kSign, kEncrypt };
 ///   CA/identity_ca.pem, CA/permissions_ca.pem          their certificates
 ///   CA/identity_ca_key.pem, CA/permissions_ca_key.pem  their private keys, PKCS#8 encrypted with the
 ///                                                      passphrase (AES-256-CBC, PBKDF2), mode 0600
-///   CA/revoked.crl                                     the identities revoked so far (after the first revoke)
+///   CA/revoked.crl                                     the identities revoked so far (after the first
+///   revoke)
 /// The folder is 0700.
 struct CaFolder final {
   std::filesystem::path directory;
@@ -94,12 +95,12 @@ void export_role(const std::filesystem::path& directory, Role role, const std::f
 struct HostIdentity final {
   std::filesystem::path directory;  ///< the cell's runtime folder (its shared files are copied)
   Role role = Role::kPlanner;
-  std::string host;                 ///< 1-64 characters of [A-Za-z0-9._-]
-  TopicGrants grants;               ///< the role's (transport::role_grants)
+  std::string host;    ///< 1-64 characters of [A-Za-z0-9._-]
+  TopicGrants grants;  ///< the role's (transport::role_grants)
   std::chrono::system_clock::time_point valid_from;
   std::chrono::system_clock::time_point valid_until;  ///< never after the CAs' own end
-  CaFolder ca;                      ///< the CAs that issued the cell
-  std::filesystem::path out;        ///< new or empty: what that host needs, as export_role() writes it
+  CaFolder ca;                                        ///< the CAs that issued the cell
+  std::filesystem::path out;  ///< new or empty: what that host needs, as export_role() writes it
 };
 /// @throws Error as write_cell_credentials() does.
 void issue_host_identity(const HostIdentity& request);

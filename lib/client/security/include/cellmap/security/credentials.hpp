@@ -55,7 +55,7 @@ struct Setting final {
 struct Credentials final {
   RoleFiles files;
   std::string subject;  ///< the certificate's subject, e.g. "CN=planner,OU=cell-1,O=cellmap"
-  std::string cell;     ///< the cell they are for (the subject's OU): their permissions grant its partition only
+  std::string cell;  ///< the cell they are for (the subject's OU): their permissions grant its partition only
   /// The earliest end of validity among the certificates and the permissions: after it the participant
   /// can no longer join (and a running one loses its peers).
   std::chrono::system_clock::time_point expires;
