@@ -44,6 +44,9 @@ NEW_BOX = ['add-box', '--center', '2.12,0.45,0.9', '--half-extents', '0.1,0.1,0.
 NEW_BOX_TOP = (2.12, 0.45, 1.05)
 NEW_BOX_CENTER = (2.12, 0.45, 0.9)
 ARM_BASE = (1.5, -0.45, 0.5)  # where config/scenes/arm_cell.yaml stands the arm's base_link
+# A cell id anyone on the domain could publish (and a config may hold): markup that runs script if the page
+# ever put it into its HTML unescaped.
+HOSTILE_CELL = '<img src=x onerror="window.injected=1">'
 # Unknown space is tracked under the table's front edge only, where no camera of the gantry looks (the table top
 # is between them and it) and the page's camera sees it below the table's edge: one unknown box, clear of every
 # obstacle box.
@@ -241,6 +244,7 @@ class ViewTest(unittest.TestCase):
         self.check_sensors(daemon)
         self.assertEqual(daemon.stop(), 0)
         self.check_robot()
+        self.check_hostile_cell()
         self.assertTrue(self.js('window.notReloaded === true'), 'the page was reloaded')
 
     def round(self, daemon, view, port, round_number):
@@ -480,6 +484,25 @@ class ViewTest(unittest.TestCase):
         wait_for(lambda: 'layer robot: no reader' in daemon.log_text(), 'the daemon to stop publishing')
         self.assertEqual(daemon.stop(), 0)
         self.log('arm cell daemon stopped')
+
+    def check_hostile_cell(self):
+        """A daemon whose cell id is markup: the page lists and shows the id as text, and no element of it
+        appears in the page, nor does its script run."""
+        daemon = self.start_daemon(f"cell: '{HOSTILE_CELL}'\nsweep_period: 0.5\nstatus_period: 0.5\n", 'hostile')
+        options = wait_for(lambda: (lambda o: o if HOSTILE_CELL in o else None)(
+            [o.text for o in self.browser.find_elements(By.CSS_SELECTOR, '#cell-select option')]),
+            'the hostile cell id in the list of cells, as text')
+        option = next(o for o in self.browser.find_elements(By.CSS_SELECTOR, '#cell-select option')
+                      if o.get_attribute('value') == HOSTILE_CELL)
+        option.click()
+        wait_for(lambda: self.js('cellmapView.cell()') == HOSTILE_CELL, 'the page to show the hostile cell')
+        shown = wait_for(lambda: (lambda t: t if HOSTILE_CELL in t else None)(
+            self.browser.find_element(By.TAG_NAME, 'body').text), 'the cell id shown as text')
+        self.assertEqual(self.js('document.querySelectorAll("img").length'), 0, 'markup from the network in the page')
+        self.assertIsNone(self.js('window.injected'), 'script from the network ran')
+        self.log(f'hostile cell id listed among {len(options)} cells and shown as text '
+                 f'({shown.count(HOSTILE_CELL)} times), no element made of it')
+        self.assertEqual(daemon.stop(), 0)
 
     def check_rendered_robot(self, shapes):
         """`cellmap render --domain` draws the arm cell's robot from its layer: every shape, in the robot's
