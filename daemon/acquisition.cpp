@@ -23,6 +23,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
+// Applied scene edits logged per second at most: `cellmap inject` in a loop must not flood the log.
+constexpr std::size_t kEditLinesPerSecond = 10;
+
 Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
@@ -104,7 +107,8 @@ class SimAcquisition final : public Acquisition {
     for (const transport::SceneEdit& edit : edits_.take()) {
       if (!edit.cell.empty() && edit.cell != cell_name_) continue;
       try {
-        spdlog::info("scene edit applied: {}", cell_.apply(edit));
+        const std::string applied = "scene edit applied: " + cell_.apply(edit);
+        if (const auto line = edit_lines_.admit(applied)) spdlog::info("{}", *line);
       } catch (const Error& e) {
         output_.refusals.refuse(e.what());
       }
@@ -114,6 +118,7 @@ class SimAcquisition final : public Acquisition {
   std::string cell_name_;
   SimulatedCell cell_;
   transport::SceneEditReader edits_;
+  LogBudget edit_lines_{kEditLinesPerSecond, std::chrono::seconds(1)};
   AcquisitionOutput output_;
   std::vector<std::string> sensors_;
   std::atomic<double> sweep_period_;

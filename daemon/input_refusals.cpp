@@ -15,4 +15,22 @@ void InputRefusals::refuse(const std::string& reason, Clock::time_point now) {
   log_("refused: " + reason + " (" + std::to_string(total) + " inputs refused so far)");
 }
 
+LogBudget::LogBudget(std::size_t lines, Clock::duration interval) : lines_(lines), interval_(interval) {}
+
+std::optional<std::string> LogBudget::admit(const std::string& line, Clock::time_point now) {
+  if (!window_start_ || now - *window_start_ >= interval_) {
+    window_start_ = now;
+    in_window_ = 0;
+  }
+  if (in_window_ >= lines_) {
+    ++held_back_;
+    return std::nullopt;
+  }
+  ++in_window_;
+  if (held_back_ == 0) return line;
+  const std::string admitted = line + " (" + std::to_string(held_back_) + " more not logged)";
+  held_back_ = 0;
+  return admitted;
+}
+
 }  // namespace cellmap::daemon

@@ -12,6 +12,8 @@ namespace cellmap::ros2 {
 std::vector<double> in_robot_order(const std::vector<std::string>& names,
                                    const std::vector<double>& positions,
                                    const std::vector<std::string>& robot_joints) {
+  if (names.size() > kMaxJointStateNames)
+    throw Error(std::to_string(names.size()) + " names, more than " + std::to_string(kMaxJointStateNames));
   if (names.size() != positions.size()) {
     throw Error(std::to_string(names.size()) + " names but " + std::to_string(positions.size()) +
                 " positions");

@@ -29,5 +29,17 @@ TEST(InputRefusalsTest, CountsEveryRefusalAndLogsAtMostOnceASecond) {
   EXPECT_EQ(refusals.count(), 103u);
 }
 
+TEST(LogBudgetTest, AFloodOfAcceptedInputsLogsAFewLinesASecondAndSaysHowManyMore) {
+  LogBudget budget(3, 1s);
+  const LogBudget::Clock::time_point start{};
+  std::vector<std::string> lines;
+  for (int i = 0; i < 100; ++i) {
+    if (auto line = budget.admit("edit " + std::to_string(i), start + 5ms * i)) lines.push_back(*line);
+  }
+  EXPECT_EQ(lines, (std::vector<std::string>{"edit 0", "edit 1", "edit 2"}));
+  EXPECT_EQ(budget.admit("edit 100", start + 1s).value_or("(held back)"), "edit 100 (97 more not logged)");
+  EXPECT_EQ(budget.admit("edit 101", start + 1s).value_or("(held back)"), "edit 101");
+}
+
 }  // namespace
 }  // namespace cellmap::daemon

@@ -36,6 +36,8 @@ TEST(JointStateTest, IncompleteOrBrokenSamplesAreRefused) {
   EXPECT_EQ(refusal({"joint_1", "joint_2", "joint_3"}, {1.0, std::numeric_limits<double>::quiet_NaN(), 3.0}),
             "joint 'joint_2' position is not finite");
   EXPECT_EQ(refusal({"joint_1", "joint_2", "joint_3\n"}, {1, 2, 3}), "no position for joint 'joint_3'");
+  EXPECT_EQ(refusal(std::vector<std::string>(1025, "joint_1"), std::vector<double>(1025, 0.0)),
+            "1025 names, more than 1024");
 }
 
 }  // namespace

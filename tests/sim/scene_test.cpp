@@ -197,6 +197,16 @@ TEST(SceneEditTest, AddRemoveMoveByName) {
   EXPECT_TRUE(scene.obstacles[1].X_CO.isApprox(before.obstacles[1].X_CO));
 }
 
+TEST(SceneEditTest, AFloodOfAddedBoxesStopsAtTheMostASceneHolds) {
+  Scene scene = parse_scene(kScene, "scene.yaml");
+  const auto crate = transport::SceneEdit::add_box("", {1, 1, 0.85}, {0.01, 0.01, 0.01});
+  while (scene.obstacles.size() < kMaxSceneObstacles) (void)apply(scene, crate);
+  EXPECT_EQ(error_of([&] { (void)apply(scene, crate); }),
+            "scene edit: add: the scene holds 256 obstacles, the most a simulated cell takes");
+  EXPECT_EQ(apply(scene, transport::SceneEdit::remove("added_1")), "added_1");
+  EXPECT_EQ(apply(scene, crate), "added_1");  // room again
+}
+
 }  // namespace
 }  // namespace cellmap::sim
 

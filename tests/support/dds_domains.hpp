@@ -31,6 +31,9 @@ inline constexpr int kPublisherRefuses = 118;
 inline constexpr int kStatusLateReader = 119;
 inline constexpr int kSecuritySetting = 124;
 inline constexpr int kSecuritySettingOther = 126;
+inline constexpr int kSampleSizeCap = 127;
+inline constexpr int kSampleSizeUserCap = 128;
+inline constexpr int kLayerLimits = 129;
 
 // transport_e2e_test: the publisher helper and `cellmap echo` as processes.
 inline constexpr int kLateJoinerProcess = 121;

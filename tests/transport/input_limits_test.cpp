@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "support/test_support.hpp"
 // lib/client/transport's private wire conversion: the samples exactly as DDS delivers them.
@@ -157,6 +158,58 @@ TEST(NetworkTextTest, AnUncleanCellRefusesTheSampleAndShownTextIsMadeClean) {
   EXPECT_EQ(read.sensors.at(0).name, "post?");
   EXPECT_EQ(read.sensors.at(0).state, "run?ning<img src=x>");
   EXPECT_EQ(read.reason, "gone?");
+}
+
+// No writer makes a reader hold or loop over more than a real cell could send.
+TEST(CountLimitsTest, ASampleCarryingMoreThanItsLimitIsRefusedWithTheCount) {
+  std::string cell = "cell-1";
+  std::vector<cellmap_msg_Box> boxes(kMaxBoxes + 1);
+  for (cellmap_msg_Box& box : boxes) box.rotation[0] = 1.0;
+  cellmap_msg_Environment environment{};
+  environment.cell = cell.data();
+  environment.version = 3;
+  environment.boxes._buffer = boxes.data();
+  environment.boxes._length = environment.boxes._maximum = static_cast<std::uint32_t>(boxes.size());
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(environment); }),
+            "cellmap/environment version 3: boxes: 100001 boxes, more than the 100000 a sample may carry");
+  environment.boxes._length = static_cast<std::uint32_t>(kMaxBoxes);
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(environment); }).find("a sample may carry"),
+            std::string::npos);
+
+  std::vector<std::uint64_t> ids(kMaxBoxes + 1);
+  cellmap_msg_EnvironmentDelta delta{};
+  delta.cell = cell.data();
+  delta.from_version = 3;
+  delta.to_version = 4;
+  delta.removed._buffer = ids.data();
+  delta.removed._length = delta.removed._maximum = static_cast<std::uint32_t>(ids.size());
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(delta); }),
+            "cellmap/environment_delta 3 -> 4: removed: 100001 ids, more than the 100000 a sample may carry");
+
+  std::string name = "camera", state = "streaming";
+  std::vector<cellmap_msg_SensorState> sensors(kMaxSensors + 1, cellmap_msg_SensorState{name.data(), state.data()});
+  cellmap_msg_Status status{};
+  status.cell = cell.data();
+  status.sensors._buffer = sensors.data();
+  status.sensors._length = status.sensors._maximum = static_cast<std::uint32_t>(sensors.size());
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(status); }),
+            "cellmap/status 'cell-1': 65 sensors, more than the 64 a sample may carry");
+
+  std::vector<char*> names(kMaxJoints + 1, name.data());
+  std::vector<double> positions(kMaxJoints + 1, 0.0);
+  cellmap_msg_RobotJoints joints{};
+  joints.cell = cell.data();
+  joints.names._buffer = names.data();
+  joints.names._length = joints.names._maximum = static_cast<std::uint32_t>(names.size());
+  joints.positions._buffer = positions.data();
+  joints.positions._length = joints.positions._maximum = static_cast<std::uint32_t>(positions.size());
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(joints); }),
+            "cellmap/robot_joints 'cell-1': 65 names, more than the 64 a sample may carry");
+  std::string long_name(kMaxNameLength + 1, 'j');
+  names.assign(1, long_name.data());
+  joints.names._length = joints.positions._length = 1;
+  EXPECT_EQ(test::error_of([&] { (void)wire::from_wire(joints); }),
+            "cellmap/robot_joints 'cell-1': names[0]: longer than 128 bytes");
 }
 
 class RobotStateRulesTest : public ::testing::Test {

@@ -134,6 +134,25 @@ TEST_F(LayerDdsTest, WriterRefusesAnotherCellsLayer) {
 }
 
 // Every kind of shape, and a payload, comes through as written (mesh vertices as floats).
+TEST_F(LayerDdsTest, ALayerCarryingMoreThanItsLimitIsRefusedAndTheNextOneArrives) {
+  dds::Participant daemon(test::domain::kLayerLimits);
+  dds::Participant viewer(test::domain::kLayerLimits);
+  LayerWriter writer(daemon, "cell-1");
+  LayerReader reader(viewer, Layer::kSensors);
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (writer.readers(Layer::kSensors) == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(5ms);
+  ASSERT_EQ(writer.readers(Layer::kSensors), 1u);
+  writer.write(SensorLayer{"cell-1", 1, 0, std::vector<SensorView>(kMaxSensors + 1, SensorView{"camera"})});
+  EXPECT_TRUE(reader.take(500ms).empty()) << "a layer of 65 views was taken";
+  writer.write(SensorLayer{"cell-1", 2, 0, std::vector<SensorView>(kMaxSensors, SensorView{"camera"})});
+  std::vector<LayerMessage> received;
+  while (received.empty() && std::chrono::steady_clock::now() < deadline) received = reader.take(100ms);
+  ASSERT_EQ(received.size(), 1u);
+  EXPECT_EQ(std::get<SensorLayer>(received[0]).sweep, 2u);
+  EXPECT_EQ(std::get<SensorLayer>(received[0]).views.size(), kMaxSensors);
+}
+
 TEST_F(LayerDdsTest, RobotShapesComeThroughAsWritten) {
   dds::Participant daemon(test::domain::kRobotLayer);
   dds::Participant viewer(test::domain::kRobotLayer);

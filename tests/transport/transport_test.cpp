@@ -8,8 +8,10 @@
 #include <future>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
 
+#include "cellmap/common/atomic_file.hpp"
 #include "cellmap/common/error.hpp"
 #include "cellmap/transport/environment_monitor.hpp"
 #include "cellmap/transport/environment_publisher.hpp"
@@ -356,6 +358,40 @@ TEST_F(TransportTest, AProcessTakesOneSecuritySettingPerDomain) {
   // Once the secured participants are gone the domain takes any setting again.
   const dds::Participant plain(test::domain::kSecuritySetting);
   EXPECT_FALSE(plain.credentials());
+}
+
+// What Cyclone DDS runs a domain with, as its configuration trace says: "config: <setting>: <value> {<source>}".
+std::string traced_config(int domain, const std::string& user_settings, const std::string& setting) {
+  const test::TempDir dir("cellmap-cyclone-trace");
+  const std::string trace = (dir.path() / "trace.log").string();
+  const char* before = std::getenv("CYCLONEDDS_URI");
+  const std::string kept = before ? before : "";
+  ::setenv("CYCLONEDDS_URI",
+           ("<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
+            "</Interfaces></General><Tracing><Category>config</Category><OutputFile>" +
+            trace + "</OutputFile></Tracing>" + user_settings + "</Domain></CycloneDDS>")
+               .c_str(),
+           1);
+  { const dds::Participant participant(static_cast<std::uint32_t>(domain)); }
+  ::setenv("CYCLONEDDS_URI", kept.c_str(), 1);
+  std::istringstream lines(read_file(trace));
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t at = line.find("config: " + setting + ": ");
+    if (at != std::string::npos) return line.substr(at + std::string("config: ").size() + setting.size() + 2);
+  }
+  return "(not traced)";
+}
+
+TEST(DomainTest, EveryDomainCapsTheSampleSizeAndKeepsTheUsersConfiguration) {
+  // Ours is the first configuration source ({0}), the user's CYCLONEDDS_URI the second ({1}).
+  EXPECT_EQ(traced_config(test::domain::kSampleSizeCap, "", "Domain/Internal/MaxSampleSize/#text"),
+            "256 MiB {0}");
+  EXPECT_EQ(traced_config(test::domain::kSampleSizeCap, "", "Domain/General/Interfaces/NetworkInterface[@address]"),
+            "127.0.0.1 {1}");
+  // A user who needs larger samples (a camera of 16 million points of 32 bytes) says so and wins.
+  EXPECT_EQ(traced_config(test::domain::kSampleSizeUserCap, "<Internal><MaxSampleSize>512 MiB</MaxSampleSize></Internal>",
+                          "Domain/Internal/MaxSampleSize/#text"),
+            "512 MiB {0,1}");
 }
 
 }  // namespace

@@ -2,12 +2,14 @@
 #include "cellmap/transport/dds.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <thread>
 #include <utility>
 
 #include "cellmap/common/error.hpp"
+#include "cellmap/transport/input_limits.hpp"
 
 namespace cellmap::dds {
 
@@ -55,6 +57,11 @@ Qos& Qos::autodispose(bool on) {
 
 Qos& Qos::best_effort() {
   dds_qset_reliability(qos_, DDS_RELIABILITY_BEST_EFFORT, 0);
+  return *this;
+}
+
+Qos& Qos::max_samples(std::uint32_t count) {
+  dds_qset_resource_limits(qos_, static_cast<int32_t>(count), DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   return *this;
 }
 
@@ -123,10 +130,16 @@ Qos security_qos(const security::Credentials& credentials) {
   return qos;
 }
 
-// The DDS Security setting of each domain this process is on, with how many live participants hold it.
+// The DDS Security setting of each domain this process is on, with how many live participants hold it and
+// the domain entity made for them.
+struct DomainSetting {
+  std::string security;
+  int participants = 0;
+  dds_entity_t domain = 0;
+};
 struct DomainSettings {
   std::mutex mutex;
-  std::map<std::uint32_t, std::pair<std::string, int>> held;
+  std::map<std::uint32_t, DomainSetting> held;
 };
 DomainSettings& domain_settings() {
   static DomainSettings settings;
@@ -138,25 +151,49 @@ std::string describe(const std::optional<security::Credentials>& credentials) {
   return "as " + credentials->subject + " (" + credentials->files.certificate.parent_path().string() + ")";
 }
 
+// The domain as Cyclone DDS runs it for this process, made before its first participant so that no sample
+// larger than kMaxSampleBytes reaches a reader (Internal/MaxSampleSize). The
+// user's CYCLONEDDS_URI comes after it and wins where it sets the same. A domain that exists already (made
+// by a participant created elsewhere) is left as it is: 0.
+dds_entity_t create_domain(std::uint32_t domain) {
+  std::string config = "<CycloneDDS><Domain Id=\"any\"><Internal><MaxSampleSize>" +
+                       std::to_string(transport::kMaxSampleBytes) + " B</MaxSampleSize></Internal></Domain></CycloneDDS>";
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri != nullptr && *uri != '\0') config += std::string(",") + uri;
+  const dds_entity_t entity = dds_create_domain(domain, config.c_str());
+  if (entity == DDS_RETCODE_PRECONDITION_NOT_MET) return 0;
+  return check(entity, "cannot join DDS domain " + std::to_string(domain) + " (check CYCLONEDDS_URI)");
+}
+
 void claim_setting(std::uint32_t domain, const std::optional<security::Credentials>& credentials) {
   DomainSettings& settings = domain_settings();
   const std::lock_guard<std::mutex> lock(settings.mutex);
-  auto& [setting, count] = settings.held[domain];
+  DomainSetting& setting = settings.held[domain];
   const std::string wanted = describe(credentials);
-  if (count > 0 && setting != wanted) {
+  if (setting.participants > 0 && setting.security != wanted) {
     throw Error("cannot join DDS domain " + std::to_string(domain) + " " + wanted +
-                ": this process is on it " + setting +
+                ": this process is on it " + setting.security +
                 ", and Cyclone DDS takes one security setting per domain and process");
   }
-  setting = wanted;
-  ++count;
+  if (setting.participants == 0) {
+    try {
+      setting.domain = create_domain(domain);
+    } catch (...) {
+      settings.held.erase(domain);
+      throw;
+    }
+  }
+  setting.security = wanted;
+  ++setting.participants;
 }
 
 void release_setting(std::uint32_t domain) {
   DomainSettings& settings = domain_settings();
   const std::lock_guard<std::mutex> lock(settings.mutex);
   const auto it = settings.held.find(domain);
-  if (it != settings.held.end() && --it->second.second == 0) settings.held.erase(it);
+  if (it == settings.held.end() || --it->second.participants > 0) return;
+  if (it->second.domain > 0) (void)dds_delete(it->second.domain);
+  settings.held.erase(it);
 }
 
 dds_entity_t create_participant(std::uint32_t domain,

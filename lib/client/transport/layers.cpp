@@ -236,6 +236,7 @@ VoxelLayer from_wire(const cellmap_msg_VoxelLayer& msg) {
   layer.sweep = msg.sweep;
   layer.stamp_ns = msg.stamp_ns;
   layer.resolution = msg.resolution;
+  require_at_most(msg.runs._length, kMaxVoxelRuns, "runs", kVoxelLayerTopic);
   layer.runs.reserve(msg.runs._length);
   for (uint32_t i = 0; i < msg.runs._length; ++i) {
     const cellmap_msg_VoxelRun& run = msg.runs._buffer[i];
@@ -249,6 +250,7 @@ ChangeRegionLayer from_wire(const cellmap_msg_ChangeRegionLayer& msg) {
   layer.cell = wire::cell_of(msg.cell, kChangeRegionLayerTopic);
   layer.sweep = msg.sweep;
   layer.stamp_ns = msg.stamp_ns;
+  require_at_most(msg.regions._length, kMaxRegions, "regions", kChangeRegionLayerTopic);
   for (uint32_t i = 0; i < msg.regions._length; ++i) {
     const cellmap_msg_ChangeRegionBounds& in = msg.regions._buffer[i];
     ChangeRegionBounds region;
@@ -269,6 +271,7 @@ SensorView from_wire(const cellmap_msg_SensorView& msg, const std::string& where
   view.sensor = msg.sensor != nullptr ? single_line(msg.sensor, kMaxNameLength) : "";
   view.X_CS = pose_of(msg.position, msg.orientation, where);
   if (!std::isfinite(msg.max_range)) throw Error(where + ": not a finite number");
+  require_at_most(msg.outline._length, kMaxOutlineValues, "outline coordinates", where);
   if (msg.outline._length % 3 != 0) throw Error(where + ": outline: not x, y, z triples");
   if (msg.max_range < 0) throw Error(where + ": max_range: must not be negative");
   if (msg.max_range == 0) return view;  // the source did not know its field of view
@@ -287,6 +290,7 @@ SensorLayer from_wire(const cellmap_msg_SensorLayer& msg) {
   layer.cell = wire::cell_of(msg.cell, kSensorLayerTopic);
   layer.sweep = msg.sweep;
   layer.stamp_ns = msg.stamp_ns;
+  require_at_most(msg.views._length, kMaxSensors, "views", kSensorLayerTopic);
   for (std::uint32_t i = 0; i < msg.views._length; ++i) {
     layer.views.push_back(from_wire(msg.views._buffer[i],
                                     std::string(kSensorLayerTopic) + ": views[" + std::to_string(i) + "]"));
@@ -295,6 +299,8 @@ SensorLayer from_wire(const cellmap_msg_SensorLayer& msg) {
 }
 
 std::shared_ptr<const TriangleMesh> mesh_of(const cellmap_msg_RobotShape& msg, const std::string& where) {
+  require_at_most(msg.vertices._length, kMaxMeshValues, "vertex coordinates", where);
+  require_at_most(msg.triangles._length, kMaxMeshValues, "triangle indices", where);
   if (msg.vertices._length % 3 != 0) throw Error(where + ": vertices: not x, y, z triples");
   if (msg.triangles._length % 3 != 0) throw Error(where + ": triangles: not three indices each");
   auto mesh = std::make_shared<TriangleMesh>();
@@ -313,7 +319,7 @@ std::shared_ptr<const TriangleMesh> mesh_of(const cellmap_msg_RobotShape& msg, c
 
 PosedShape from_wire(const cellmap_msg_RobotShape& msg, const std::string& where) {
   PosedShape shape;
-  shape.link = msg.link != nullptr ? msg.link : "";
+  shape.link = msg.link != nullptr ? single_line(msg.link, kMaxNameLength) : "";
   shape.carried = msg.carried;
   shape.X_CG = pose_of(msg.position, msg.orientation, where);
   const double* size = msg.size;
@@ -346,6 +352,7 @@ RobotLayer from_wire(const cellmap_msg_RobotLayer& msg) {
   layer.padding = msg.padding;
   if (!std::isfinite(layer.padding_scale) || !std::isfinite(layer.padding))
     throw Error(std::string(kRobotLayerTopic) + ": padding: not a finite number");
+  require_at_most(msg.shapes._length, kMaxShapes, "shapes", kRobotLayerTopic);
   for (std::uint32_t i = 0; i < msg.shapes._length; ++i) {
     layer.shapes.push_back(from_wire(msg.shapes._buffer[i],
                                      std::string(kRobotLayerTopic) + ": shapes[" + std::to_string(i) + "]"));

@@ -43,7 +43,7 @@ dds::Qos status_qos() {
 }
 
 dds::Qos scene_edit_qos() {
-  return dds::Qos::make(false, 0);
+  return dds::Qos::make(false, 0).max_samples(kMaxQueuedSceneEdits);
 }
 
 dds::Qos robot_state_qos() {

@@ -76,6 +76,7 @@ Box from_msg(const cellmap_msg_Box& msg, const std::string& where) {
 }
 
 std::vector<Box> from_msgs(const dds_sequence_cellmap_msg_Box& seq, const std::string& where) {
+  require_at_most(seq._length, kMaxBoxes, "boxes", where);
   std::vector<Box> boxes;
   boxes.reserve(seq._length);
   for (uint32_t i = 0; i < seq._length; ++i) {
@@ -208,6 +209,7 @@ EnvironmentDelta from_wire(const cellmap_msg_EnvironmentDelta& msg) {
   delta.stamp_ns = msg.stamp_ns;
   delta.added = from_msgs(msg.added, where + ": added");
   delta.modified = from_msgs(msg.modified, where + ": modified");
+  require_at_most(msg.removed._length, kMaxBoxes, "ids", where + ": removed");
   delta.removed.assign(msg.removed._buffer, msg.removed._buffer + msg.removed._length);
   return delta;
 }
@@ -216,6 +218,7 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
   CellStatus status;
   status.cell = cell_of(msg.cell, kStatusTopic);
   status.state = shown(msg.state);
+  require_at_most(msg.sensors._length, kMaxSensors, "sensors", std::string(kStatusTopic) + " " + quote_input(status.cell));
   for (uint32_t i = 0; i < msg.sensors._length; ++i) {
     const cellmap_msg_SensorState& s = msg.sensors._buffer[i];
     status.sensors.push_back({shown(s.name), shown(s.state)});
@@ -329,17 +332,22 @@ RobotJoints from_wire(const cellmap_msg_RobotJoints& msg) {
   RobotJoints joints;
   joints.cell = cell_of(msg.cell, kRobotJointsTopic);
   joints.stamp_ns = msg.stamp_ns;
+  const std::string where = std::string(kRobotJointsTopic) + " " + quote_input(joints.cell);
+  require_at_most(msg.names._length, kMaxJoints, "names", where);
+  require_at_most(msg.positions._length, kMaxJoints, "positions", where);
   for (uint32_t i = 0; i < msg.names._length; ++i) {
     joints.names.emplace_back(msg.names._buffer[i] ? msg.names._buffer[i] : "");
+    if (joints.names.back().size() > kMaxNameLength)
+      throw Error(where + ": names[" + std::to_string(i) + "]: longer than " + std::to_string(kMaxNameLength) +
+                  " bytes");
   }
   joints.positions.assign(msg.positions._buffer, msg.positions._buffer + msg.positions._length);
   if (msg.payload._length == 1) {
     const cellmap_msg_ToolPayload& p = msg.payload._buffer[0];
-    const std::string where = std::string(kRobotJointsTopic) + " " + quote_input(joints.cell) + ": payload";
-    require_finite(p.rotation, 4, where + ".rotation");
+    require_finite(p.rotation, 4, where + ": payload.rotation");
     const Eigen::Quaterniond q(p.rotation[0], p.rotation[1], p.rotation[2], p.rotation[3]);
     if (std::abs(q.norm() - 1.0) > 1e-3)
-      throw Error(where + ".rotation: must be a unit quaternion [w, x, y, z]");
+      throw Error(where + ": payload.rotation: must be a unit quaternion [w, x, y, z]");
     Payload payload;
     payload.X_EB.linear() = q.normalized().toRotationMatrix();
     payload.X_EB.translation() = Eigen::Vector3d(p.center[0], p.center[1], p.center[2]);

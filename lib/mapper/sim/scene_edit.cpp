@@ -21,6 +21,10 @@ Obstacle box_obstacle(const transport::SceneEdit& edit) {
 std::string apply(Scene& scene, const transport::SceneEdit& edit) {
   switch (edit.kind) {
     case transport::SceneEdit::Kind::kAddBox: {
+      if (scene.obstacles.size() >= kMaxSceneObstacles) {
+        throw Error("scene edit: add: the scene holds " + std::to_string(scene.obstacles.size()) +
+                    " obstacles, the most a simulated cell takes");
+      }
       Obstacle obstacle = box_obstacle(edit);
       if (obstacle.name.empty()) {
         for (int k = 1; obstacle.name.empty(); ++k) {

@@ -42,6 +42,9 @@ class Qos final {
   /// BEST_EFFORT instead of RELIABLE: a reader then matches writers of either kind; a sample lost on the way
   /// is not sent again.
   Qos& best_effort();
+  /// RESOURCE_LIMITS max_samples: the most samples an entity holds (a KEEP_ALL reader that holds them makes
+  /// reliable writers wait).
+  Qos& max_samples(std::uint32_t count);
   /// Readers and writers: puts the entity in one DDS partition (instead of the default partition ""). A name
   /// with '*' or '?' is a pattern: it matches every partition it fits (Cyclone matches patterns on either
   /// side, never a pattern with a pattern).

@@ -22,6 +22,27 @@ inline constexpr double kMaxCellCoordinate = 100.0;
 /// The longest obstacle name a scene edit may carry, bytes.
 inline constexpr std::size_t kMaxNameLength = 128;
 
+/// The most any sample on a cellmap topic may carry, checked on receipt by every reader (a sample beyond is
+/// refused with the count in its reason): far above any real cell, low enough that no writer makes a
+/// reader hold or loop over more. A snapshot of 100 000 boxes is 6.4 MB on the wire.
+inline constexpr std::size_t kMaxBoxes = 100'000;  ///< a snapshot's boxes; each list of a delta
+inline constexpr std::size_t kMaxSensors = 64;     ///< a status report's sensors; a sensors layer's views
+inline constexpr std::size_t kMaxJoints = 64;      ///< a joint sample's names and positions
+inline constexpr std::size_t kMaxRegions = 10'000;         ///< a change-region layer's regions
+inline constexpr std::size_t kMaxVoxelRuns = 2'000'000;    ///< a voxel layer's runs (32 MB)
+inline constexpr std::size_t kMaxShapes = 1'024;           ///< a robot layer's shapes
+inline constexpr std::size_t kMaxMeshValues = 3'000'000;   ///< a mesh's vertex coordinates, and its indices
+inline constexpr std::size_t kMaxOutlineValues = 3 * 1'024;  ///< a sensor view's outline coordinates
+/// The largest serialized sample Cyclone DDS forwards in either direction in cellmap's processes
+/// (its Internal/MaxSampleSize, set when a process first joins a domain; a CYCLONEDDS_URI that sets it
+/// wins): room for the largest ROS 2 cloud accepted (ros2::kMaxCloudPoints, 16 million points) at 16 bytes
+/// a point, and far more than any cellmap sample. Larger samples are dropped by Cyclone with a warning
+/// before they are reassembled, so no writer makes a reader allocate more (Cyclone's default is 2 GB).
+inline constexpr std::size_t kMaxSampleBytes = 256u << 20;
+
+/// @throws Error "<where>: <count> <what>, more than the <limit> a sample may carry" when count > limit.
+void require_at_most(std::size_t count, std::size_t limit, const std::string& what, const std::string& where);
+
 struct InputLimits final {
   /// Scene-edit centres and tool positions p_C must lie inside (cell frame, metres); an added box's half
   /// extents must each be at most half the cell's largest side.

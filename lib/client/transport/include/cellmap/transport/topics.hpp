@@ -54,8 +54,11 @@ inline constexpr std::uint32_t kDefaultDeltaDepth = 16;
 [[nodiscard]] dds::Qos environment_delta_qos(std::uint32_t depth);
 /// cellmap/status: RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1 (a late joiner sees the last health report).
 [[nodiscard]] dds::Qos status_qos();
-/// cellmap/sim/scene_edits: RELIABLE, VOLATILE (a restarted daemon must not replay old edits), KEEP_ALL.
+/// cellmap/sim/scene_edits: RELIABLE, VOLATILE (a restarted daemon must not replay old edits), KEEP_ALL of at
+/// most kMaxQueuedSceneEdits samples (ResourceLimits): a reader that holds that many untaken makes the
+/// writers wait, so no writer fills the daemon's memory.
 [[nodiscard]] dds::Qos scene_edit_qos();
+inline constexpr std::uint32_t kMaxQueuedSceneEdits = 1024;
 /// cellmap/robot_state: RELIABLE, VOLATILE (an old pose is no use to a restarted daemon), KEEP_LAST 256 per
 /// cell (a second of a 250 Hz controller: a slow reader loses the oldest poses, the writer never blocks).
 [[nodiscard]] dds::Qos robot_state_qos();
