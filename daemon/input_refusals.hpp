@@ -44,7 +44,8 @@ class LogBudget final {
   using Clock = std::chrono::steady_clock;
   LogBudget(std::size_t lines, Clock::duration interval);
   /// `line`, with " (K more not logged)" when K were held back since the last one, or nullopt: hold it back.
-  [[nodiscard]] std::optional<std::string> admit(const std::string& line, Clock::time_point now = Clock::now());
+  [[nodiscard]] std::optional<std::string> admit(const std::string& line,
+                                                 Clock::time_point now = Clock::now());
 
  private:
   std::size_t lines_;

@@ -39,6 +39,7 @@ inline constexpr int kLayerLimits = 129;
 inline constexpr int kLateJoinerProcess = 121;
 inline constexpr int kKilledPublisher = 122;
 inline constexpr int kFallsBehind = 123;
+inline constexpr int kForgedAhead = 125;
 
 // robot_joints_test, robot_state_test (`cellmap robot-pose` and `inject` as processes).
 inline constexpr int kJointsInOrder = 100;

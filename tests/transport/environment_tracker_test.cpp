@@ -114,12 +114,12 @@ TEST(EnvironmentTrackerTest, ContradictingDeltaWaitsForSnapshot) {
 
 // A snapshot forged far ahead (or a publisher whose state was wiped, starting again at version 1) must not
 // freeze the copy: once the publisher's snapshots go on below the local version, the copy follows them.
+// The daemon's state directory was wiped: it counts from 1 again, below the copy of its earlier life.
 TEST(EnvironmentTrackerTest, ACopyAheadOfThePublisherFollowsItsSnapshotsBack) {
   const History h(6);
   EnvironmentTracker tracker("cell-a");
-  (void)tracker.on_snapshot(h.versions[1]);
-  const Environment forged("cell-a", UINT64_MAX - 1, 0, {});  // no boxes: "the cell is empty"
-  ASSERT_EQ(tracker.on_snapshot(forged).size(), 1u);
+  const Environment earlier_life("cell-a", 5000, 0, {});
+  ASSERT_EQ(tracker.on_snapshot(earlier_life).size(), 1u);
   // In sync, a subscriber reads deltas only: the publisher's next ones arrive below the local version.
   EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty());
   EXPECT_TRUE(tracker.on_delta(h.deltas[1]).empty()) << "a duplicate counts once";
@@ -130,7 +130,7 @@ TEST(EnvironmentTrackerTest, ACopyAheadOfThePublisherFollowsItsSnapshotsBack) {
   const auto updates = tracker.on_snapshot(h.versions[4]);
   ASSERT_EQ(updates.size(), 1u);
   EXPECT_TRUE(updates[0].from_snapshot);
-  EXPECT_EQ(updates[0].delta.from_version, UINT64_MAX - 1);
+  EXPECT_EQ(updates[0].delta.from_version, 5000u);
   EXPECT_EQ(updates[0].delta.to_version, 4u);
   EXPECT_EQ(updates[0].delta.added.size(), h.versions[4].boxes().size());
   EXPECT_EQ(*tracker.environment(), h.versions[4]);
@@ -139,6 +139,39 @@ TEST(EnvironmentTrackerTest, ACopyAheadOfThePublisherFollowsItsSnapshotsBack) {
   ASSERT_EQ(tracker.on_delta(h.deltas[4]).size(), 1u);
   EXPECT_EQ(*tracker.environment(), h.versions[5]);
   EXPECT_FALSE(tracker.needs_snapshot());
+}
+
+TEST(EnvironmentTrackerTest, AVersionFarAheadIsRefusedOnceACopyExists) {
+  const History h(4);
+  EnvironmentTracker tracker("cell-a");
+  (void)tracker.on_snapshot(h.versions[1]);
+  EXPECT_TRUE(tracker.on_snapshot(Environment("cell-a", 1 + kMaxVersionJump + 1, 0, {})).empty());
+  EnvironmentDelta forged_delta{"cell-a", 1, UINT64_MAX, 0, {}, {}, {}};
+  EXPECT_TRUE(tracker.on_delta(forged_delta).empty());
+  EXPECT_EQ(tracker.stats().implausible, 2u);
+  EXPECT_EQ(*tracker.environment(), h.versions[1]);
+  EXPECT_FALSE(tracker.needs_snapshot());
+  ASSERT_EQ(tracker.on_delta(h.deltas[1]).size(), 1u);
+  // A jump of exactly kMaxVersionJump is still taken (a long-running daemon restarted far above).
+  EXPECT_EQ(tracker.on_snapshot(Environment("cell-a", 2 + kMaxVersionJump, 0, {})).size(), 1u);
+}
+
+// A late joiner whose first copy is a forged snapshot far ahead: the daemon's versions go on below it, and
+// the forger's kept snapshot, arriving again while the copy follows the daemon back, does not hold it up
+// there.
+TEST(EnvironmentTrackerTest, AFirstCopyForgedFarAheadFollowsTheDaemonBackPastTheForgersSnapshot) {
+  const History h(6);
+  EnvironmentTracker tracker("cell-a");
+  const Environment forged("cell-a", UINT64_MAX - 8, 0, {});
+  ASSERT_EQ(tracker.on_snapshot(forged).size(), 1u);
+  for (int v : {2, 3, 4}) EXPECT_TRUE(tracker.on_delta(h.deltas[static_cast<std::size_t>(v)]).empty());
+  ASSERT_TRUE(tracker.needs_snapshot());
+  EXPECT_TRUE(tracker.on_snapshot(forged).empty()) << "the forger's snapshot, delivered again";
+  EXPECT_EQ(tracker.on_snapshot(h.versions[5]).size(), 1u);
+  EXPECT_EQ(*tracker.environment(), h.versions[5]);
+  EXPECT_TRUE(tracker.on_snapshot(forged).empty());
+  EXPECT_EQ(tracker.stats().implausible, 1u);
+  EXPECT_EQ(*tracker.environment(), h.versions[5]);
 }
 
 TEST(EnvironmentTrackerTest, OldSnapshotsArrivingLateDoNotTurnTheCopyBack) {

@@ -187,7 +187,8 @@ TEST(CountLimitsTest, ASampleCarryingMoreThanItsLimitIsRefusedWithTheCount) {
             "cellmap/environment_delta 3 -> 4: removed: 100001 ids, more than the 100000 a sample may carry");
 
   std::string name = "camera", state = "streaming";
-  std::vector<cellmap_msg_SensorState> sensors(kMaxSensors + 1, cellmap_msg_SensorState{name.data(), state.data()});
+  std::vector<cellmap_msg_SensorState> sensors(kMaxSensors + 1,
+                                               cellmap_msg_SensorState{name.data(), state.data()});
   cellmap_msg_Status status{};
   status.cell = cell.data();
   status.sensors._buffer = sensors.data();
@@ -273,9 +274,10 @@ TEST_F(RobotStateRulesTest, ACellNameWithLineBreaksIsQuotedOnOneLine) {
   msg_.cell = cell_.data();
   msg_.position[2] = std::nan("");
   // Such a cell is refused for what it is, before anything else, on one line.
-  EXPECT_EQ(refusal(),
-            "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?': cell: longer than 128 bytes, not "
-            "UTF-8, or holding a control character");
+  EXPECT_EQ(
+      refusal(),
+      "cellmap/robot_state 'cell-1?2026-12-02T06:00:00.000 info forged?': cell: longer than 128 bytes, not "
+      "UTF-8, or holding a control character");
   msg_.position[2] = 1.5;
   msg_.stamp_ns = kNow - 6'000'000'000;
   EXPECT_EQ(refusal().find_first_of("\n\r"), std::string::npos) << refusal();

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <future>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 
 #include "cellmap.h"
 #include "cellmap/environment/version_store.hpp"
+#include "cellmap/transport/environment_publisher.hpp"
 #include "cellmap/transport/environment_subscriber.hpp"
 #include "child_process.hpp"
 #include "loopback.hpp"
@@ -125,6 +127,51 @@ TEST_F(TransportE2eTest, SubscriberThatFallsBehindResyncsFromTheSnapshot) {
   EXPECT_EQ(*subscriber.environment(), VersionStore(dir.path(), "cell-e2e").recovered().environment);
   EXPECT_GE(subscriber.stats().gaps, 1u);
   EXPECT_GE(subscriber.stats().snapshots_applied, 2u);
+}
+
+// Without DDS Security anyone on the domain may publish a cell's environment. A forged snapshot far ahead (a
+// version near 2^64) must not freeze a planner: one that follows the cell refuses it (a jump beyond 2^32),
+// and one that joins while the forger's snapshot is the only one on the topic takes it and then follows the
+// daemon back once the daemon's versions go on below it, past the forger's snapshot delivered again.
+TEST_F(TransportE2eTest, AForgedVersionNear2To64FreezesNoPlanner) {
+  test::TempDir dir;
+  const dds::Participant planner(test::domain::kForgedAhead);
+  EnvironmentSubscriber following(planner, "cell-e2e");
+  std::vector<std::uint64_t> published;
+  auto daemon = std::make_unique<test::ChildProcess>(helper(test::domain::kForgedAhead, dir.path(), 3, 0));
+  ASSERT_EQ(read_until(*daemon, "done", published), 3u);
+  ASSERT_TRUE(following.wait_for_version(3, kPatience)) << following.last_error();
+  daemon->signal(SIGTERM);
+  daemon->wait();
+  daemon.reset();
+
+  const dds::Participant attacker(test::domain::kForgedAhead);
+  EnvironmentPublisher forger(attacker, "cell-e2e");
+  constexpr std::uint64_t kForged = std::numeric_limits<std::uint64_t>::max() - 8;
+  forger.publish(Environment("cell-e2e", kForged, 0, {}));
+  EnvironmentSubscriber joining(planner, "cell-e2e");
+  ASSERT_TRUE(joining.wait_for_version(kForged, kPatience))
+      << "the late joiner never got the forged snapshot";
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (following.stats().implausible == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(following.stats().implausible, 1u);
+  EXPECT_EQ(following.environment()->version(), 3u) << "the following planner took the forged version";
+
+  test::ChildProcess resumed(helper(test::domain::kForgedAhead, dir.path(), 5, 50));
+  const std::uint64_t last = read_until(resumed, "done", published);
+  const Environment persisted = VersionStore(dir.path(), "cell-e2e").recovered().environment;
+  ASSERT_EQ(persisted.version(), last);
+  for (const EnvironmentSubscriber* subscriber : {&following, &joining}) {
+    while (subscriber->environment()->version() != last && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(20ms);
+    EXPECT_EQ(*subscriber->environment(), persisted)
+        << "a planner stayed at version " << subscriber->environment()->version();
+  }
+  EXPECT_EQ(following.stats().went_back, 0u);
+  EXPECT_EQ(joining.stats().went_back, 1u);
+  resumed.signal(SIGTERM);
+  EXPECT_EQ(test::exit_code(resumed.wait()), 0);
 }
 
 TEST_F(TransportE2eTest, KilledPublisherResumesWithoutReuseOrRemoval) {

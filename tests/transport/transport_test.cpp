@@ -360,7 +360,8 @@ TEST_F(TransportTest, AProcessTakesOneSecuritySettingPerDomain) {
   EXPECT_FALSE(plain.credentials());
 }
 
-// What Cyclone DDS runs a domain with, as its configuration trace says: "config: <setting>: <value> {<source>}".
+// What Cyclone DDS runs a domain with, as its configuration trace says: "config: <setting>: <value>
+// {<source>}".
 std::string traced_config(int domain, const std::string& user_settings, const std::string& setting) {
   const test::TempDir dir("cellmap-cyclone-trace");
   const std::string trace = (dir.path() / "trace.log").string();
@@ -386,10 +387,12 @@ TEST(DomainTest, EveryDomainCapsTheSampleSizeAndKeepsTheUsersConfiguration) {
   // Ours is the first configuration source ({0}), the user's CYCLONEDDS_URI the second ({1}).
   EXPECT_EQ(traced_config(test::domain::kSampleSizeCap, "", "Domain/Internal/MaxSampleSize/#text"),
             "256 MiB {0}");
-  EXPECT_EQ(traced_config(test::domain::kSampleSizeCap, "", "Domain/General/Interfaces/NetworkInterface[@address]"),
-            "127.0.0.1 {1}");
+  EXPECT_EQ(
+      traced_config(test::domain::kSampleSizeCap, "", "Domain/General/Interfaces/NetworkInterface[@address]"),
+      "127.0.0.1 {1}");
   // A user who needs larger samples (a camera of 16 million points of 32 bytes) says so and wins.
-  EXPECT_EQ(traced_config(test::domain::kSampleSizeUserCap, "<Internal><MaxSampleSize>512 MiB</MaxSampleSize></Internal>",
+  EXPECT_EQ(traced_config(test::domain::kSampleSizeUserCap,
+                          "<Internal><MaxSampleSize>512 MiB</MaxSampleSize></Internal>",
                           "Domain/Internal/MaxSampleSize/#text"),
             "512 MiB {0,1}");
 }

@@ -157,7 +157,8 @@ std::string describe(const std::optional<security::Credentials>& credentials) {
 // by a participant created elsewhere) is left as it is: 0.
 dds_entity_t create_domain(std::uint32_t domain) {
   std::string config = "<CycloneDDS><Domain Id=\"any\"><Internal><MaxSampleSize>" +
-                       std::to_string(transport::kMaxSampleBytes) + " B</MaxSampleSize></Internal></Domain></CycloneDDS>";
+                       std::to_string(transport::kMaxSampleBytes) +
+                       " B</MaxSampleSize></Internal></Domain></CycloneDDS>";
   const char* uri = std::getenv("CYCLONEDDS_URI");
   if (uri != nullptr && *uri != '\0') config += std::string(",") + uri;
   const dds_entity_t entity = dds_create_domain(domain, config.c_str());

@@ -20,10 +20,16 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_snapshot(const Environment
     ++stats_.other_cells;
     return updates;
   }
+  if (implausible(snapshot.version())) {
+    ++stats_.implausible;
+    return updates;
+  }
   const bool went_back = current_ && snapshot.version() < current_->version();
   if (went_back) {
     note_below(snapshot.version());
     if (!publisher_below()) return updates;
+  } else if (publisher_below()) {
+    return updates;  // following the publisher back: only a snapshot below the copy is its
   } else if (current_ && snapshot.version() == current_->version() && !out_of_sync_) {
     below_count_ = 0;  // the publisher is where the copy is
     return updates;
@@ -62,6 +68,10 @@ std::vector<EnvironmentUpdate> EnvironmentTracker::on_delta(const EnvironmentDel
     return updates;
   }
   if (delta.to_version <= delta.from_version) return updates;
+  if (implausible(delta.to_version)) {
+    ++stats_.implausible;
+    return updates;
+  }
   if (delta.from_version == 0 && current_) {
     // From nothing: the whole environment (a restarted publisher's first version). Without a local copy yet
     // it is held like any delta: the snapshot topic brings the current version, not a replay of history.

@@ -37,10 +37,11 @@ void require_stamp_near(std::int64_t stamp_ns, const InputLimits& limits, std::i
 
 }  // namespace
 
-void require_at_most(std::size_t count, std::size_t limit, const std::string& what, const std::string& where) {
+void require_at_most(std::size_t count, std::size_t limit, const std::string& what,
+                     const std::string& where) {
   if (count > limit) {
-    throw Error(where + ": " + std::to_string(count) + " " + what + ", more than the " + std::to_string(limit) +
-                " a sample may carry");
+    throw Error(where + ": " + std::to_string(count) + " " + what + ", more than the " +
+                std::to_string(limit) + " a sample may carry");
   }
 }
 

@@ -59,8 +59,8 @@ std::map<security::Role, security::TopicGrants> role_grants(const std::string& c
   const std::vector<std::string> partition{cell_partition(one_cell(cell, "DDS Security grants"))};
   const std::vector<std::string> environment{kEnvironmentTopic, kEnvironmentDeltaTopic, kStatusTopic};
   std::vector<std::string> environment_and_layers = environment;
-  environment_and_layers.insert(environment_and_layers.end(),
-                                {kVoxelLayerTopic, kChangeRegionLayerTopic, kSensorLayerTopic, kRobotLayerTopic});
+  environment_and_layers.insert(environment_and_layers.end(), {kVoxelLayerTopic, kChangeRegionLayerTopic,
+                                                               kSensorLayerTopic, kRobotLayerTopic});
   return {{Role::kDaemon,
            {environment_and_layers, {kRobotStateTopic, kRobotJointsTopic, kSceneEditTopic}, partition}},
           {Role::kPlanner, {{}, environment_and_layers, partition}},

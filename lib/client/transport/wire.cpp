@@ -218,7 +218,8 @@ CellStatus from_wire(const cellmap_msg_Status& msg) {
   CellStatus status;
   status.cell = cell_of(msg.cell, kStatusTopic);
   status.state = shown(msg.state);
-  require_at_most(msg.sensors._length, kMaxSensors, "sensors", std::string(kStatusTopic) + " " + quote_input(status.cell));
+  require_at_most(msg.sensors._length, kMaxSensors, "sensors",
+                  std::string(kStatusTopic) + " " + quote_input(status.cell));
   for (uint32_t i = 0; i < msg.sensors._length; ++i) {
     const cellmap_msg_SensorState& s = msg.sensors._buffer[i];
     status.sensors.push_back({shown(s.name), shown(s.state)});
@@ -338,8 +339,8 @@ RobotJoints from_wire(const cellmap_msg_RobotJoints& msg) {
   for (uint32_t i = 0; i < msg.names._length; ++i) {
     joints.names.emplace_back(msg.names._buffer[i] ? msg.names._buffer[i] : "");
     if (joints.names.back().size() > kMaxNameLength)
-      throw Error(where + ": names[" + std::to_string(i) + "]: longer than " + std::to_string(kMaxNameLength) +
-                  " bytes");
+      throw Error(where + ": names[" + std::to_string(i) + "]: longer than " +
+                  std::to_string(kMaxNameLength) + " bytes");
   }
   joints.positions.assign(msg.positions._buffer, msg.positions._buffer + msg.positions._length);
   if (msg.payload._length == 1) {

@@ -28,7 +28,14 @@ struct TrackerStats final {
   std::uint64_t rejected = 0;           ///< deltas that did not fit the local copy (apply() threw)
   std::uint64_t other_cells = 0;        ///< snapshots and deltas of other cells, received and ignored
   std::uint64_t went_back = 0;  ///< times the copy followed a publisher going on below the local version
+  std::uint64_t implausible =
+      0;  ///< snapshots and deltas refused for jumping more than kMaxVersionJump ahead
 };
+
+/// The furthest a snapshot or delta may jump ahead of the local copy: a daemon makes one version per change,
+/// so 2³² is more than a cell makes in a century; a version that far ahead is forged (or corrupt), and taking
+/// it would leave the copy above everything the daemon publishes after.
+inline constexpr std::uint64_t kMaxVersionJump = std::uint64_t{1} << 32;
 
 /// How many samples (snapshots or deltas), each newer than the one before yet older than the local copy, make
 /// the copy wait for a snapshot and follow it back: the publisher goes on below what the copy holds (its
@@ -42,8 +49,10 @@ inline constexpr int kSamplesBelowToFollow = 3;
 /// local copy exists (before, the snapshot itself is awaited, so a late joiner jumps straight to the newest).
 /// Older or duplicate samples are ignored, unless kSamplesBelowToFollow samples in a row go on below the
 /// local version: the copy then needs a snapshot and follows the next one below it (an update from_snapshot
-/// whose delta goes from the local version back to it, replacing every box). Samples of other cells are
-/// ignored. Not thread-safe.
+/// whose delta goes from the local version back to it, replacing every box), ignoring meanwhile snapshots at
+/// or above the local version (a forger's kept sample). Samples more than kMaxVersionJump ahead of the local
+/// copy are refused (counted); the first copy takes any version. Samples of other cells are ignored. Not
+/// thread-safe.
 class EnvironmentTracker final {
  public:
   explicit EnvironmentTracker(std::string cell);
@@ -65,6 +74,9 @@ class EnvironmentTracker final {
   void drain(std::vector<EnvironmentUpdate>& updates);
   void note_below(std::uint64_t version);
   [[nodiscard]] bool publisher_below() const { return below_count_ >= kSamplesBelowToFollow; }
+  [[nodiscard]] bool implausible(std::uint64_t version) const {
+    return current_ && version > current_->version() && version - current_->version() > kMaxVersionJump;
+  }
 
   std::string cell_;
   std::optional<Environment> current_;

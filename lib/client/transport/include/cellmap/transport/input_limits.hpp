@@ -25,13 +25,13 @@ inline constexpr std::size_t kMaxNameLength = 128;
 /// The most any sample on a cellmap topic may carry, checked on receipt by every reader (a sample beyond is
 /// refused with the count in its reason): far above any real cell, low enough that no writer makes a
 /// reader hold or loop over more. A snapshot of 100 000 boxes is 6.4 MB on the wire.
-inline constexpr std::size_t kMaxBoxes = 100'000;  ///< a snapshot's boxes; each list of a delta
-inline constexpr std::size_t kMaxSensors = 64;     ///< a status report's sensors; a sensors layer's views
-inline constexpr std::size_t kMaxJoints = 64;      ///< a joint sample's names and positions
-inline constexpr std::size_t kMaxRegions = 10'000;         ///< a change-region layer's regions
-inline constexpr std::size_t kMaxVoxelRuns = 2'000'000;    ///< a voxel layer's runs (32 MB)
-inline constexpr std::size_t kMaxShapes = 1'024;           ///< a robot layer's shapes
-inline constexpr std::size_t kMaxMeshValues = 3'000'000;   ///< a mesh's vertex coordinates, and its indices
+inline constexpr std::size_t kMaxBoxes = 100'000;   ///< a snapshot's boxes; each list of a delta
+inline constexpr std::size_t kMaxSensors = 64;      ///< a status report's sensors; a sensors layer's views
+inline constexpr std::size_t kMaxJoints = 64;       ///< a joint sample's names and positions
+inline constexpr std::size_t kMaxRegions = 10'000;  ///< a change-region layer's regions
+inline constexpr std::size_t kMaxVoxelRuns = 2'000'000;      ///< a voxel layer's runs (32 MB)
+inline constexpr std::size_t kMaxShapes = 1'024;             ///< a robot layer's shapes
+inline constexpr std::size_t kMaxMeshValues = 3'000'000;     ///< a mesh's vertex coordinates, and its indices
 inline constexpr std::size_t kMaxOutlineValues = 3 * 1'024;  ///< a sensor view's outline coordinates
 /// The largest serialized sample Cyclone DDS forwards in either direction in cellmap's processes
 /// (its Internal/MaxSampleSize, set when a process first joins a domain; a CYCLONEDDS_URI that sets it

@@ -19,8 +19,8 @@ inline constexpr std::size_t kMaxSceneObstacles = 256;
 /// box obstacle (centre, half extents, yaw about the cell's z axis; an empty name is replaced by a free one,
 /// "added_1", "added_2", ...), remove drops the named obstacle, move puts its centre at `center`. Returns the
 /// name of the obstacle added, removed or moved. @throws Error if the named obstacle does not exist (remove,
-/// move), the name is taken or the scene holds kMaxSceneObstacles already (add), the added box has a non-positive size or non-finite pose, or the move's
-/// centre is not finite.
+/// move), the name is taken or the scene holds kMaxSceneObstacles already (add), the added box has a
+/// non-positive size or non-finite pose, or the move's centre is not finite.
 std::string apply(Scene& scene, const transport::SceneEdit& edit);
 
 }  // namespace cellmap::sim
