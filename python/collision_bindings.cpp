@@ -92,14 +92,20 @@ py::dict batch_distance(const DoubleArray& robot, const DoubleArray& environment
   double* pb = point_b.mutable_data();
   double* n = normal.mutable_data();
   {
+    // The dense constraints of collision::constraints, in its order, written straight into the arrays.
     py::gil_scoped_release release;
-    const collision::ConstraintSet set = collision::constraints(checkpoints, env);
-    for (std::size_t i = 0; i < set.entries.size(); ++i) {
-      const collision::SignedDistance& r = set.entries[i].result;
-      d[i] = r.distance;
-      std::copy(r.point_a.data(), r.point_a.data() + 3, pa + 3 * i);
-      std::copy(r.point_b.data(), r.point_b.data() + 3, pb + 3 * i);
-      std::copy(r.normal.data(), r.normal.data() + 3, n + 3 * i);
+    std::size_t i = 0;
+    for (const std::vector<collision::Obb>& placed : checkpoints) {
+      for (const collision::Obb& robot_box : placed) {
+        for (const collision::Obb& env_box : env) {
+          const collision::SignedDistance r = collision::signed_distance(robot_box, env_box);
+          d[i] = r.distance;
+          std::copy(r.point_a.data(), r.point_a.data() + 3, pa + 3 * i);
+          std::copy(r.point_b.data(), r.point_b.data() + 3, pb + 3 * i);
+          std::copy(r.normal.data(), r.normal.data() + 3, n + 3 * i);
+          ++i;
+        }
+      }
     }
   }
   py::dict out;
