@@ -3,8 +3,9 @@
 """The Python module's cost against its anchor, the same C++ call, measured in the same run:
 
   ratio python batch distance cost: the batch of 6 checkpoints x 50 robot boxes x 100 environment boxes from
-      Python (NumPy arrays in and out, the boxes checked and converted, four result arrays filled) against the
-      C++ batch alone (collision::constraints on the converted boxes, timed in C++): 1.00x would be free;
+      Python (NumPy arrays in and out, the boxes checked and converted, the four result arrays of the call
+      before filled again, as a planner's loop does) against the C++ batch alone (collision::constraints on
+      the converted boxes, timed in C++): 1.00x would be free; the same with new result arrays each call;
   python single distance: what one cellmap.distance call costs from Python, against one pair of the C++ batch.
 
 Each figure is the best of several rounds (the machine is shared). Run with the module importable:
@@ -42,18 +43,25 @@ def best_seconds(call, rounds, repeats):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('--rounds', type=int, default=7, help='rounds per figure; the best counts (default 7)')
+    parser.add_argument('--rounds', type=int, default=15, help='rounds per figure; the best counts (default 15)')
     args = parser.parse_args()
     rng = np.random.default_rng(1)
     robot = random_boxes(rng, (CHECKPOINTS, ROBOT_BOXES))
     environment = random_boxes(rng, (ENVIRONMENT_BOXES,))
     pairs = CHECKPOINTS * ROBOT_BOXES * ENVIRONMENT_BOXES
 
-    python = best_seconds(lambda: cellmap.batch_distance(robot, environment), args.rounds, 5)
-    cpp = min(cellmap._batch_distance_seconds(robot, environment, 5) for _ in range(args.rounds))
+    out = cellmap.batch_distance(robot, environment)
+    python = fresh = cpp = float('inf')
+    for _ in range(args.rounds):  # side by side, so that the machine's load changes both alike
+        python = min(python, best_seconds(lambda: cellmap.batch_distance(robot, environment, out=out), 1, 5))
+        cpp = min(cpp, cellmap._batch_distance_seconds(robot, environment, 5))
+        fresh = min(fresh, best_seconds(lambda: cellmap.batch_distance(robot, environment), 1, 5))
     print(f'ratio python batch distance cost: {python / cpp:.2f}x (python {python * 1e6:.0f} us vs C++ '
           f'{cpp * 1e6:.0f} us per batch of {CHECKPOINTS} x {ROBOT_BOXES} x {ENVIRONMENT_BOXES} boxes, '
-          f'{python / pairs * 1e9:.0f} vs {cpp / pairs * 1e9:.0f} ns a pair)')
+          f'{python / pairs * 1e9:.0f} vs {cpp / pairs * 1e9:.0f} ns a pair, result arrays reused)')
+    print(f'python batch distance, new result arrays each call: {fresh * 1e6:.0f} us ({fresh / cpp:.2f}x; '
+          f'{sum(a.nbytes for a in out.values()) / 1e6:.1f} MB of results, whose first touch can cost more '
+          f'than the batch when the allocator hands out fresh pages)')
 
     a, b = robot[0, 0], environment[0]
     single = best_seconds(lambda: cellmap.distance(a, b), args.rounds, 2000)

@@ -3,8 +3,10 @@
 // (arrays in and out, the GIL released), the paper's spheres and the path check of a robot from its URDF.
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "bindings.hpp"
 #include "cellmap/collision/batch.hpp"
@@ -76,8 +78,28 @@ std::vector<std::vector<collision::Obb>> robot_at_checkpoints(const DoubleArray&
   return out;
 }
 
-// The dense constraints as arrays: the robot's leading axes, then the environment's boxes.
-py::dict batch_distance(const DoubleArray& robot, const DoubleArray& environment) {
+// `out[key]` if it is a writable C-ordered float64 array of `shape`, else a new one (none given).
+DoubleArray output_array(const std::optional<py::dict>& out, const char* key,
+                         const std::vector<py::ssize_t>& shape) {
+  if (!out) return new_array(shape);
+  if (!out->contains(key)) throw py::value_error(std::string("out: no array '") + key + "'");
+  const py::object given = (*out)[key];
+  if (!py::isinstance<py::array_t<double>>(given))
+    throw py::value_error(std::string("out['") + key + "']: not a float64 array");
+  auto array = py::reinterpret_borrow<py::array_t<double>>(given);
+  const bool fits = array.ndim() == static_cast<py::ssize_t>(shape.size()) &&
+                    std::equal(shape.begin(), shape.end(), array.shape()) &&
+                    (array.flags() & py::array::c_style) != 0 && array.writeable();
+  if (!fits)
+    throw py::value_error(std::string("out['") + key +
+                          "']: not a writable C-ordered array of the result's shape");
+  return array;
+}
+
+// The dense constraints as arrays: the robot's leading axes, then the environment's boxes. Written into `out`
+// when given (a planner's loop reuses its arrays: fresh ones cost their first touch of memory each call).
+py::dict batch_distance(const DoubleArray& robot, const DoubleArray& environment,
+                        std::optional<py::dict> out) {
   const std::vector<std::vector<collision::Obb>> checkpoints = robot_at_checkpoints(robot);
   if (environment.ndim() != 2) throw py::value_error("environment: boxes of shape (E, 10)");
   const std::vector<collision::Obb> env = obbs_of(environment, "environment");
@@ -85,35 +107,22 @@ py::dict batch_distance(const DoubleArray& robot, const DoubleArray& environment
   shape.push_back(static_cast<py::ssize_t>(env.size()));
   std::vector<py::ssize_t> point_shape = shape;
   point_shape.push_back(3);
-  DoubleArray distance = new_array(shape), point_a = new_array(point_shape), point_b = new_array(point_shape),
-              normal = new_array(point_shape);
-  double* d = distance.mutable_data();
-  double* pa = point_a.mutable_data();
-  double* pb = point_b.mutable_data();
-  double* n = normal.mutable_data();
+  DoubleArray distance = output_array(out, "distance", shape),
+              point_a = output_array(out, "point_a", point_shape),
+              point_b = output_array(out, "point_b", point_shape),
+              normal = output_array(out, "normal", point_shape);
+  const collision::ConstraintArrays arrays{distance.mutable_data(), point_a.mutable_data(),
+                                           point_b.mutable_data(), normal.mutable_data()};
   {
-    // The dense constraints of collision::constraints, in its order, written straight into the arrays.
     py::gil_scoped_release release;
-    std::size_t i = 0;
-    for (const std::vector<collision::Obb>& placed : checkpoints) {
-      for (const collision::Obb& robot_box : placed) {
-        for (const collision::Obb& env_box : env) {
-          const collision::SignedDistance r = collision::signed_distance(robot_box, env_box);
-          d[i] = r.distance;
-          std::copy(r.point_a.data(), r.point_a.data() + 3, pa + 3 * i);
-          std::copy(r.point_b.data(), r.point_b.data() + 3, pb + 3 * i);
-          std::copy(r.normal.data(), r.normal.data() + 3, n + 3 * i);
-          ++i;
-        }
-      }
-    }
+    collision::constraints_into(checkpoints, env, arrays);
   }
-  py::dict out;
-  out["distance"] = distance;
-  out["point_a"] = point_a;
-  out["point_b"] = point_b;
-  out["normal"] = normal;
-  return out;
+  py::dict result = out ? *out : py::dict();
+  result["distance"] = distance;
+  result["point_a"] = point_a;
+  result["point_b"] = point_b;
+  result["normal"] = normal;
+  return result;
 }
 
 // The anchor of the Python batch benchmark: the same C++ batch, timed in C++ without any conversion.
@@ -241,9 +250,11 @@ void add_collision(py::module_& module) {
       "normal.");
   module.def(
       "batch_distance", &batch_distance, py::arg("robot"), py::arg("environment"),
+      py::arg("out") = py::none(),
       "Every robot box against every environment box: robot (R, 10) or (K, R, 10) at K checkpoints, "
       "environment (E, 10). Returns {'distance': (..., E), 'point_a', 'point_b', 'normal': (..., E, 3)}, "
-      "the robot box as a; computed without the GIL.");
+      "the robot box as a; computed without the GIL. out: the result of an earlier call of the same shapes, "
+      "filled again and returned (a planner's loop then allocates nothing).");
   module.def("_batch_distance_seconds", &batch_distance_seconds, py::arg("robot"), py::arg("environment"),
              py::arg("repeats"),
              "The C++ batch alone, seconds per call: the anchor of bench/python_bench.py.");

@@ -66,6 +66,30 @@ TEST(BatchTest, DenseVectorHasThePaperCountAndExactEntries) {
   EXPECT_EQ(c.result.distance, signed_distance(robot[2][1], environment[4]).distance);
 }
 
+TEST(BatchTest, ArraysHoldTheDenseEntriesBitForBitAndSkipNullArrays) {
+  std::mt19937 rng(3);
+  const std::vector<Obb> environment = random_boxes(9, 1.0, rng);
+  std::vector<std::vector<Obb>> robot;
+  for (int k = 0; k < 4; ++k) robot.push_back(random_boxes(3, 1.0, rng));
+  const ConstraintSet set = constraints(robot, environment);
+  const std::size_t n = set.n_constr();
+  std::vector<double> distance(n), point_a(3 * n), point_b(3 * n, -7.0), normal(3 * n);
+  constraints_into(robot, environment, {distance.data(), point_a.data(), nullptr, normal.data()});
+  for (std::size_t i = 0; i < n; ++i) {
+    const SignedDistance& want = set.entries[i].result;
+    EXPECT_EQ(distance[i], want.distance) << i;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(point_a[3 * i + c], want.point_a[c]) << i;
+      EXPECT_EQ(normal[3 * i + c], want.normal[c]) << i;
+    }
+  }
+  EXPECT_EQ(point_b, std::vector<double>(3 * n, -7.0)) << "a null array was written";
+  robot.back().pop_back();
+  EXPECT_NE(
+      test::error_of([&] { constraints_into(robot, environment, {distance.data()}); }).find("checkpoint 3"),
+      std::string::npos);
+}
+
 TEST(BatchTest, DenseEntriesEqualSignedDistanceInEveryLane) {
   // The dense batch runs its first projections on several environment boxes at once; every entry must still
   // be exactly signed_distance's answer: separated, overlapping and touching pairs, environment sizes that do

@@ -81,6 +81,11 @@ def test_batch_distance_is_every_pair_of_the_single_distance():
                 assert batch['distance'][k, r, e] == single['distance']
                 assert batch['point_a'][k, r, e].tolist() == single['point_a'].tolist()
     assert cellmap.batch_distance(robot[0], environment)['distance'].shape == (4, 5)
+    # A loop reuses its result: the same arrays, filled again with the same values.
+    again = cellmap.batch_distance(robot, environment, out=batch)
+    assert again is batch and np.array_equal(again['distance'], cellmap.batch_distance(robot, environment)['distance'])
+    with pytest.raises(ValueError, match="out\\['distance'\\]: not a writable C-ordered array of the result's shape"):
+        cellmap.batch_distance(robot[0], environment, out=batch)
 
 
 def test_spheres_cover_the_box_and_bound_its_distance_from_below():

@@ -41,6 +41,32 @@ std::vector<EnvironmentLanes> environment_lanes(const std::vector<Obb>& environm
   return blocks;
 }
 
+// Every pair of the dense batch in order (checkpoint, robot box, environment box): the first projections of
+// signed_distance on kLanes environment boxes at once, the pairs they leave open through signed_distance.
+template <class Emit>
+void for_each_dense(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                    const std::vector<Obb>& environment, const ConstraintSet& shape, Emit&& emit) {
+  const std::vector<EnvironmentLanes> blocks = environment_lanes(environment);
+  for (int k = 0; k < shape.n_checkpoints; ++k) {
+    for (int r = 0; r < shape.n_rob; ++r) {
+      const Obb& robot_box = robot_at_checkpoints[k][r];
+      const EnvironmentLanes robot_lanes = EnvironmentLanes::broadcast(robot_box);
+      for (std::size_t block = 0; block < blocks.size(); ++block) {
+        ProjectionLanes<Double2> projection;
+        project_twice(robot_lanes.view(), blocks[block].view(), &projection);
+        const SeparatedLanes<Double2> separated(robot_lanes.view(), projection.p, projection.gap,
+                                                projection.gap2);
+        const int first = static_cast<int>(block) * kLanes;
+        for (int l = 0; l < kLanes && first + l < shape.n_env; ++l) {
+          const int e = first + l;
+          emit(k, r, e,
+               projection.certified[l] ? separated.lane(l) : signed_distance(robot_box, environment[e]));
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 double ConstraintSet::min_distance() const {
@@ -57,27 +83,26 @@ ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoi
                           const std::vector<Obb>& environment) {
   ConstraintSet set = empty_set(robot_at_checkpoints, environment);
   set.entries.reserve(set.n_constr());
-  const std::vector<EnvironmentLanes> blocks = environment_lanes(environment);
-  for (int k = 0; k < set.n_checkpoints; ++k) {
-    for (int r = 0; r < set.n_rob; ++r) {
-      const Obb& robot_box = robot_at_checkpoints[k][r];
-      const EnvironmentLanes robot_lanes = EnvironmentLanes::broadcast(robot_box);
-      for (std::size_t block = 0; block < blocks.size(); ++block) {
-        ProjectionLanes<Double2> projection;
-        project_twice(robot_lanes.view(), blocks[block].view(), &projection);
-        const SeparatedLanes<Double2> separated(robot_lanes.view(), projection.p, projection.gap,
-                                                projection.gap2);
-        const int first = static_cast<int>(block) * kLanes;
-        for (int l = 0; l < kLanes && first + l < set.n_env; ++l) {
-          const int e = first + l;
-          set.entries.push_back(
-              {k, r, e,
-               projection.certified[l] ? separated.lane(l) : signed_distance(robot_box, environment[e])});
-        }
-      }
-    }
-  }
+  for_each_dense(robot_at_checkpoints, environment, set, [&](int k, int r, int e, const SignedDistance& d) {
+    set.entries.push_back({k, r, e, d});
+  });
   return set;
+}
+
+void constraints_into(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                      const std::vector<Obb>& environment, const ConstraintArrays& out) {
+  const ConstraintSet shape = empty_set(robot_at_checkpoints, environment);
+  std::size_t i = 0;
+  const auto put = [](double* array, std::size_t i, const Eigen::Vector3d& v) {
+    if (array != nullptr) std::copy(v.data(), v.data() + 3, array + 3 * i);
+  };
+  for_each_dense(robot_at_checkpoints, environment, shape, [&](int, int, int, const SignedDistance& d) {
+    if (out.distance != nullptr) out.distance[i] = d.distance;
+    put(out.point_a, i, d.point_a);
+    put(out.point_b, i, d.point_b);
+    put(out.normal, i, d.normal);
+    ++i;
+  });
 }
 
 ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,

@@ -50,6 +50,21 @@ struct ConstraintSet final {
 [[nodiscard]] ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
                                         const std::vector<Obb>& environment);
 
+/// Where constraints_into() writes: `distance` n_constr values, point_a, point_b and normal 3 · n_constr each
+/// (x, y, z per entry), all in constraints()'s order (checkpoint, robot box, environment box); a null array
+/// is skipped. The caller owns them.
+struct ConstraintArrays final {
+  double* distance = nullptr;
+  double* point_a = nullptr;
+  double* point_b = nullptr;
+  double* normal = nullptr;
+};
+/// The dense constraints written into arrays instead of a ConstraintSet (for array consumers such as the
+/// Python module: no entry list is built). Values equal constraints()'s bit for bit. Thread-safe (pure).
+/// @throws Error as constraints().
+void constraints_into(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
+                      const std::vector<Obb>& environment, const ConstraintArrays& out);
+
 /// As above with a broad phase: `tree` must be built over `environment`; only pairs whose bounds come closer
 /// than `cutoff` (> 0, metres, e.g. the safety margin plus the planner's influence distance) are computed.
 [[nodiscard]] ConstraintSet constraints(const std::vector<std::vector<Obb>>& robot_at_checkpoints,
