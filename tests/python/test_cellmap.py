@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Python module `cellmap` against the real parts: cellmapd and `cellmap echo`/`inject`/`distance` as
-processes on loopback DDS (domain 213), the IRB 2400 URDF of the shared data. Run by ctest (python_module)
+"""The Python module `cellmap` against the real parts: cellmapd and `cellmap echo`/`inject`/`distance`/
+`security` as processes on loopback DDS (domains 213, and 215 with DDS Security), the IRB 2400 URDF of the
+shared data. Run by ctest (python_module)
 with PYTHONPATH at the built module and CELLMAPD, CELLMAP_TOOL and CELLMAP_SHARED_DATA set.
 """
 import json
@@ -223,3 +224,34 @@ def test_the_subscriber_receives_the_versions_and_boxes_echo_receives(daemon):
         assert planner.last_error() == ''
     with pytest.raises(ValueError, match='closed'):
         planner.environment()
+
+
+SECURE_DOMAIN = 215
+SECURE_LOOPBACK = LOOPBACK.replace('<LeaseDuration>1 s</LeaseDuration>', '')  # DDS Security: Cyclone's 10 s
+
+
+def test_a_secured_subscriber_joins_with_an_exported_planner_folder(tmp_path):
+    os.environ['CYCLONEDDS_URI'] = SECURE_LOOPBACK
+    passphrase = tmp_path / 'passphrase'
+    passphrase.write_text('a passphrase for the test\n')
+    keys, planner = tmp_path / 'keys', tmp_path / 'planner-host'
+    run_tool('security', 'init', str(keys), '--cell', CELL, '--domain', str(SECURE_DOMAIN), '--days', '1',
+             '--ca-passphrase-file', str(passphrase))
+    run_tool('security', 'export', str(keys), '--role', 'planner', '-o', str(planner))
+    config = tmp_path / 'cellmapd.yaml'
+    config.write_text(f'cell: {CELL}\nsweep_period: 0.2\nstatus_period: 0.5\nsource: {{noise: false}}\n'
+                      'change: {settle_sweeps: 4}\n')
+    with open(tmp_path / 'cellmapd.log', 'w') as log:
+        daemon = subprocess.Popen([os.environ['CELLMAPD'], '--config', str(config), '--domain', str(SECURE_DOMAIN),
+                                   '--state-dir', str(tmp_path / 'state'), '--security', str(keys)],
+                                  stdout=log, stderr=log)
+        try:
+            with cellmap.EnvironmentSubscriber(domain=SECURE_DOMAIN, cell=CELL, security=str(planner)) as secured:
+                environment = secured.wait(timeout=PATIENCE)
+                assert environment is not None and len(environment) > 0
+                # Cyclone DDS takes one security setting per domain and process: a plain one is refused here.
+                with pytest.raises(cellmap.Error, match='one security setting per domain and process'):
+                    cellmap.EnvironmentSubscriber(domain=SECURE_DOMAIN, cell=CELL)
+        finally:
+            daemon.terminate()
+            assert daemon.wait(timeout=PATIENCE) == 0

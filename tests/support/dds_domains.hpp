@@ -4,7 +4,7 @@
 // loopback talk to whatever joins the same domain, so each test that starts participants has ids of its own.
 // A new test takes a free id here. Ids used elsewhere: benchmarks 140-143 (bench/dds_bench.cpp), 144
 // (bench/daemon_bench.cpp) and 145 (bench/ros2_bench.cpp), the browser test 220-221
-// (tests/view/view_browser_test.py), the Python module's test 213 (tests/python), scripts/soak 179, the install tests 172 and 198
+// (tests/view/view_browser_test.py), the Python module's tests 213 and 215 (tests/python), scripts/soak 179, the install tests 172 and 198
 // (tests/install).
 // Credentials tests name domains 7, 197 and 233 without joining them. Ids above 232 cannot be joined:
 // Cyclone's ports for domain d start at 7400 + 250 · d, beyond 65535 there.
