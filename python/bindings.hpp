@@ -29,6 +29,9 @@ void add_collision(py::module_& module);
 /// extent, a quaternion whose norm differs from 1 by more than 1e-6.
 [[nodiscard]] std::vector<collision::Obb> obbs_of(const DoubleArray& array, const std::string& name);
 
+/// The boxes as one (N, 10) array, in their order.
+[[nodiscard]] DoubleArray boxes_array(const std::vector<Box>& boxes);
+
 /// A new float64 array of `shape`, C order.
 [[nodiscard]] DoubleArray new_array(const std::vector<py::ssize_t>& shape);
 

@@ -176,18 +176,9 @@ class PathChecker final {
   [[nodiscard]] int boxes() const { return robot_.size(); }
 
   DoubleArray place(const DoubleArray& q) const {
-    const std::vector<collision::Obb> placed = robot_.place(joints_of(q));
-    DoubleArray out = new_array({static_cast<py::ssize_t>(placed.size()), 10});
-    double* v = out.mutable_data();
-    for (const collision::Obb& obb : placed) {
-      const Box box = collision::to_box(obb);
-      const double values[10] = {box.center.x(),       box.center.y(),       box.center.z(),
-                                 box.half_extents.x(), box.half_extents.y(), box.half_extents.z(),
-                                 box.rotation.w(),     box.rotation.x(),     box.rotation.y(),
-                                 box.rotation.z()};
-      v = std::copy(values, values + 10, v);
-    }
-    return out;
+    std::vector<Box> boxes;
+    for (const collision::Obb& obb : robot_.place(joints_of(q))) boxes.push_back(collision::to_box(obb));
+    return boxes_array(boxes);
   }
 
   std::optional<py::dict> blocked(const DoubleArray& control_points, const Environment& environment,

@@ -45,20 +45,6 @@ DoubleArray column_array(const std::vector<Box>& boxes, Field field) {
   return out;
 }
 
-// The boxes as the (N, 10) array every collision function takes.
-DoubleArray boxes_array(const std::vector<Box>& boxes) {
-  DoubleArray out = new_array({static_cast<py::ssize_t>(boxes.size()), 10});
-  auto view = out.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const Box& b = boxes[i];
-    const double values[10] = {b.center.x(),       b.center.y(),       b.center.z(),   b.half_extents.x(),
-                               b.half_extents.y(), b.half_extents.z(), b.rotation.w(), b.rotation.x(),
-                               b.rotation.y(),     b.rotation.z()};
-    for (int c = 0; c < 10; ++c) view(static_cast<py::ssize_t>(i), c) = values[c];
-  }
-  return out;
-}
-
 void add_box_arrays(py::class_<Environment>& environment) {
   environment
       .def_property_readonly(
@@ -211,6 +197,18 @@ Environment environment_from(const std::string& cell, std::uint64_t version, std
 }
 
 }  // namespace
+
+DoubleArray boxes_array(const std::vector<Box>& boxes) {
+  DoubleArray out = new_array({static_cast<py::ssize_t>(boxes.size()), 10});
+  double* v = out.mutable_data();
+  for (const Box& b : boxes) {
+    const double values[10] = {b.center.x(),       b.center.y(),       b.center.z(),   b.half_extents.x(),
+                               b.half_extents.y(), b.half_extents.z(), b.rotation.w(), b.rotation.x(),
+                               b.rotation.y(),     b.rotation.z()};
+    v = std::copy(values, values + 10, v);
+  }
+  return out;
+}
 
 void add_environment(py::module_& module) {
   py::class_<Environment> environment(module, "Environment",

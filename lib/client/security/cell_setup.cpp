@@ -223,6 +223,14 @@ struct Authorities {
   Authority permissions;
 };
 
+// The CAs of an existing CA folder, when they outlive `validity`.
+Authorities existing_authorities(const CaFolder& ca, Validity validity) {
+  Authorities authorities{load_authority("identity_ca", ca), load_authority("permissions_ca", ca)};
+  require_within_authority(validity, authorities.identity, certificate_in(ca, "identity_ca"));
+  require_within_authority(validity, authorities.permissions, certificate_in(ca, "permissions_ca"));
+  return authorities;
+}
+
 Authorities authorities_for(const CellSetup& setup, Validity validity) {
   if (!setup.existing_ca) {
     make_private_directory(setup.ca.directory);
@@ -230,11 +238,7 @@ Authorities authorities_for(const CellSetup& setup, Validity validity) {
     return {make_authority("identity_ca", setup.cell, ca_validity, setup.ca),
             make_authority("permissions_ca", setup.cell, ca_validity, setup.ca)};
   }
-  Authorities authorities{load_authority("identity_ca", setup.ca),
-                          load_authority("permissions_ca", setup.ca)};
-  require_within_authority(validity, authorities.identity, certificate_in(setup.ca, "identity_ca"));
-  require_within_authority(validity, authorities.permissions, certificate_in(setup.ca, "permissions_ca"));
-  return authorities;
+  return existing_authorities(setup.ca, validity);
 }
 
 // A document beside its signed form: DDS reads the .p7s, people the .xml.
@@ -396,11 +400,8 @@ void issue_host_identity(const HostIdentity& request) {
   require_empty_or_new(request.out, "credentials");
   const CellOfFolder cell = read_cell_of(request.directory);
   const Validity validity{request.valid_from, request.valid_until};
-  const Authorities authorities{load_authority("identity_ca", request.ca),
-                                load_authority("permissions_ca", request.ca)};
+  const Authorities authorities = existing_authorities(request.ca, validity);
   require_same_ca(request.directory, authorities.identity, request.ca);
-  require_within_authority(validity, authorities.identity, certificate_in(request.ca, "identity_ca"));
-  require_within_authority(validity, authorities.permissions, certificate_in(request.ca, "permissions_ca"));
   make_private_directory(request.out);
   copy_shared_files(request.directory, request.out);
   write_identity({std::string(to_string(request.role)) + "@" + request.host, cell.cell, cell.domain, validity,
