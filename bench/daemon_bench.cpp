@@ -66,12 +66,15 @@ struct Options {
   double pass_seconds = 2.0;     // the gantry's time from one end of the table to the other
   int stops = 20;                // distinct gantry positions rendered per pass (a frame shows the nearest)
   int phase = 0;                 // frames of the gantry's back and forth gone by at the first frame
+  std::vector<int> phases;       // --offline: one run per phase, scored each and together
+  std::vector<std::string> settings;  // --set SECTION.KEY=VALUE: cellmapd config keys for the run
   double no_return_range = 4.5;  // the Kinect's (time-of-flight)
   int settle_sweeps = 15;        // change.settle_sweeps (cellmapd's default)
   int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
   int domain = 144;
   int anchor_frames = 6;  // frames per camera fused by the anchor
   bool offline = false;   // the recordings through the cell pipeline alone, boxes scored (run_offline)
+  bool explain = false;   // --offline: the first version's boxes one by one, with the free space each blocks
 };
 
 using bench::Arrival;
@@ -168,9 +171,14 @@ class Recording {
     if (t < options_.warmup) return false;
     return static_cast<long>((t - options_.warmup) / options_.change_every) % 2 == 0;
   }
-  [[nodiscard]] std::size_t changes() const {
+  [[nodiscard]] std::size_t changes() const { return changes_between(0.0, stamp_of(frames_ - 1)); }
+  // Changes of the crate in the frames stamped in (from, to].
+  [[nodiscard]] std::size_t changes_between(double from, double to) const {
     std::size_t n = 0;
-    for (std::size_t i = 1; i < frames_; ++i) n += crate_at(stamp_of(i)) != crate_at(stamp_of(i - 1));
+    for (std::size_t i = 1; i < frames_; ++i) {
+      const double t = stamp_of(i);
+      if (t > from && t <= to) n += crate_at(t) != crate_at(stamp_of(i - 1));
+    }
     return n;
   }
   [[nodiscard]] std::size_t frames() const { return frames_; }
@@ -470,12 +478,29 @@ void write_recordings(const Options& options, const Recording& recording, std::v
       std::chrono::duration<double>(Clock::now() - render_start).count());
 }
 
+// The --set values as the config's sections: SECTION -> "KEY: VALUE, ..." (a flow map's inside).
+std::map<std::string, std::string> config_sections(const std::vector<std::string>& settings) {
+  std::map<std::string, std::string> sections;
+  for (const std::string& setting : settings) {
+    const std::size_t dot = setting.find('.'), equals = setting.find('=');
+    if (dot == 0 || dot == std::string::npos || equals == std::string::npos || equals < dot + 2)
+      throw Error("--set wants SECTION.KEY=VALUE, got '" + setting + "'");
+    std::string& keys = sections[setting.substr(0, dot)];
+    keys += (keys.empty() ? "" : ", ") + setting.substr(dot + 1, equals - dot - 1) + ": " +
+            setting.substr(equals + 1);
+  }
+  return sections;
+}
+
 daemon::DaemonConfig daemon_config(const Options& options, const std::vector<Camera>& cameras,
                                    const fs::path& dir) {
+  std::map<std::string, std::string> sections = config_sections(options.settings);
+  std::string& change = sections["change"];
+  change = "settle_sweeps: " + std::to_string(options.settle_sweeps) + (change.empty() ? "" : ", ") + change;
   std::string yaml = "cell: " + std::string(kCell) + "\ndomain: " + std::to_string(options.domain) +
-                     "\nstate_dir: " + (dir / "state").string() +
-                     "\nlog_level: warn\nchange: {settle_sweeps: " + std::to_string(options.settle_sweeps) +
-                     "}\nsources:\n";
+                     "\nstate_dir: " + (dir / "state").string() + "\nlog_level: warn\n";
+  for (const auto& [section, keys] : sections) yaml += section + ": {" + keys + "}\n";
+  yaml += "sources:\n";
   for (const Camera& camera : cameras) yaml += source_yaml(camera, dir, options.sweep_frames);
   return daemon::DaemonConfig::parse(yaml, "bench", dir);
 }
@@ -658,6 +683,30 @@ Standing standing(const std::vector<Box>& boxes, bool crate_there) {
   return out;
 }
 
+// Each box of the cell without the crate: centre, size, voxels, the free space it blocks alone (m³ and
+// over the obstacles' volume) and the objects it matches best, largest blocked first: where the blocked free
+// space of a version is.
+void explain(const std::vector<Box>& boxes) {
+  const sim::Scene scene = sim::default_scene();
+  const sim::BoxScore all = sim::score_boxes(scene.obstacles, boxes, Cloud(), scene.cell, 0.02);
+  std::vector<std::pair<double, const Box*>> blocked;
+  for (const Box& b : boxes) {
+    const sim::BoxScore alone = sim::score_boxes(scene.obstacles, {b}, Cloud(), scene.cell, 0.02);
+    blocked.emplace_back(alone.blocked_free_space * alone.true_volume, &b);
+  }
+  std::sort(blocked.begin(), blocked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [m3, b] : blocked) {
+    std::string objects;
+    for (const sim::ObjectScore& o : all.objects)
+      if (o.box == b->id) objects += " " + o.name + " (IoU " + std::to_string(o.iou).substr(0, 4) + ")";
+    std::printf("    box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels: blocks %.4f m3 (%.1f %%);%s\n",
+                static_cast<unsigned long long>(b->id), b->center.x(), b->center.y(), b->center.z(),
+                2 * b->half_extents.x(), 2 * b->half_extents.y(), 2 * b->half_extents.z(),
+                static_cast<unsigned long long>(b->points), m3, 100 * m3 / all.true_volume,
+                objects.empty() ? " no object's best box" : objects.c_str());
+  }
+}
+
 // The cameras' replays as cellmapd opens them (their directories, poses and intrinsics).
 std::vector<std::unique_ptr<ReplaySource>> open_replays(const std::vector<Camera>& cameras,
                                                         const fs::path& dir) {
@@ -687,11 +736,63 @@ std::vector<Camera> native_cameras(const Options& options) {
           {"realsense", d435_848x480(), 0.0}};
 }
 
+// The versions after the first, by the box ids each added, modified or removed, so that versions made only
+// of boxes that came and went (added and removed within kTransientSeconds with no change of the crate in
+// between: smear, or part of a change boxed on its own and taken back) can be counted.
+class VersionLog {
+ public:
+  static constexpr double kTransientSeconds = 5.0;
+
+  void add(double stamp, const Reconciled& change) {
+    Version version{stamp, {}};
+    for (const Box& b : change.added) {
+      added_[b.id] = stamp;
+      version.ids.push_back(b.id);
+    }
+    for (const Box& b : change.modified) version.ids.push_back(b.id);
+    for (const std::uint64_t id : change.removed) {
+      removed_[id] = stamp;
+      version.ids.push_back(id);
+    }
+    versions_.push_back(std::move(version));
+  }
+  [[nodiscard]] std::size_t versions() const { return versions_.size(); }
+  [[nodiscard]] std::size_t transient_only(const Recording& recording) const {
+    return static_cast<std::size_t>(std::count_if(versions_.begin(), versions_.end(), [&](const Version& v) {
+      return std::all_of(v.ids.begin(), v.ids.end(), [&](std::uint64_t id) { return transient(id, recording); });
+    }));
+  }
+
+ private:
+  struct Version {
+    double stamp;
+    std::vector<std::uint64_t> ids;
+  };
+  [[nodiscard]] bool transient(std::uint64_t id, const Recording& recording) const {
+    const auto added = added_.find(id), removed = removed_.find(id);
+    if (added == added_.end() || removed == removed_.end()) return false;
+    return removed->second - added->second <= kTransientSeconds &&
+           recording.changes_between(added->second, removed->second) == 0;
+  }
+  std::vector<Version> versions_;
+  std::map<std::uint64_t, double> added_, removed_;
+};
+
+// One phase's offline run against the criteria: versions per change of the crate after the first version,
+// versions made only of boxes that came and went, how the first version stands, and the crate just before
+// each of its changes (and at the end).
+struct OfflineScore {
+  int phase = 0;
+  std::size_t changes = 0, versions = 0, transient_versions = 0;
+  std::optional<Standing> first;
+  std::size_t there = 0, boxed = 0, away = 0, freed = 0;
+};
+
 // Plays the recordings through CellPipeline on this thread, frame by frame in stamp order, grouped into
 // sweeps by cellmapd's FrameGrouper: the daemon's versions without its threads, DDS or timing, so a run is
-// the same every time. Prints each version, how the boxes stand before each change of the crate and at the
-// end, and how often the crate was boxed on its own.
-int run_offline(const Options& options) {
+// the same every time. Prints each version and how the boxes stand before each change of the crate and at
+// the end.
+OfflineScore play_offline(const Options& options) {
   const ScratchDir dir;
   const Recording recording(options, dir.path);
   std::vector<Camera> cameras = native_cameras(options);
@@ -701,7 +802,11 @@ int run_offline(const Options& options) {
   CellPipeline pipeline(config.pipeline);
   FrameGrouper grouper(config.sources.front().grouping);
   FrameSweep open;
-  std::size_t versions = 0;
+  OfflineScore score;
+  score.phase = options.phase;
+  score.changes = recording.changes();
+  VersionLog log;
+  std::size_t version = 0;
   const auto close = [&] {
     if (open.frames.empty()) return;
     const double stamp = open.stamp;
@@ -709,11 +814,13 @@ int run_offline(const Options& options) {
     open = {};
     if (!report.change) return;
     std::printf("version %zu at %5.2f s: +%zu ~%zu -%zu, %zu boxes; %zu voxels re-segmented in %.1f ms\n",
-                ++versions, stamp, report.change->added.size(), report.change->modified.size(),
+                ++version, stamp, report.change->added.size(), report.change->modified.size(),
                 report.change->removed.size(), report.boxes, report.evidence, 1e3 * report.t_segment);
-    if (versions == 1) print_standing(stamp, standing(pipeline.boxes(), false));
+    if (version > 1) return log.add(stamp, *report.change);
+    score.first = standing(pipeline.boxes(), false);
+    print_standing(stamp, *score.first);
+    if (options.explain) explain(pipeline.boxes());
   };
-  std::size_t there = 0, boxed = 0, away = 0, freed = 0;
   for (std::size_t i = 0; i < recording.frames(); ++i) {
     for (std::size_t c = 0; c < cameras.size(); ++c) {
       Frame frame = replays[c]->load(i);
@@ -731,19 +838,69 @@ int run_offline(const Options& options) {
       continue;
     const Standing now = standing(pipeline.boxes(), recording.crate_at(t));
     print_standing(t, now);
-    if (now.crate_there) {
-      ++there;
-      boxed += now.crate_boxed ? 1 : 0;
-    } else {
-      ++away;
-      freed += now.place_free ? 1 : 0;
-    }
+    (now.crate_there ? score.there : score.away) += 1;
+    score.boxed += now.crate_there && now.crate_boxed;
+    score.freed += !now.crate_there && now.place_free;
   }
   close();
+  score.versions = log.versions();
+  score.transient_versions = log.transient_only(recording);
+  return score;
+}
+
+double per_change(std::size_t versions, std::size_t changes) {
+  return changes ? static_cast<double>(versions) / static_cast<double>(changes) : NAN;
+}
+
+void print_score(const OfflineScore& s) {
+  char first[96] = "never made";
+  if (s.first)
+    std::snprintf(first, sizeof first, "%zu boxes blocking %.1f %%", s.first->boxes, 100 * s.first->blocked);
   std::printf(
-      "versions: %zu for %zu changes of the crate; the crate boxed on its own %zu of %zu times, its place "
-      "free %zu of %zu times (just before each change, and at the end)\n",
-      versions, recording.changes(), boxed, there, freed, away);
+      "phase %d: %zu versions after the first for %zu changes of the crate (%.2f a change), %zu of them only "
+      "boxes that came and went within %.0f s; the first version %s; the crate boxed on its own %zu of %zu "
+      "times, its place free %zu of %zu times (just before each change, and at the end)\n",
+      s.phase, s.versions, s.changes, per_change(s.versions, s.changes), s.transient_versions,
+      VersionLog::kTransientSeconds, first, s.boxed, s.there, s.freed, s.away);
+}
+
+// The criteria over every phase: versions per change, versions only of boxes that came and went, the first
+// version's blocked free space (mean and worst), the crate boxed at every presence and its place free at
+// every absence.
+void print_overall(const std::vector<OfflineScore>& scores) {
+  std::size_t changes = 0, versions = 0, transient = 0, there = 0, boxed = 0, away = 0, freed = 0, firsts = 0;
+  double blocked_sum = 0.0, blocked_worst = 0.0;
+  for (const OfflineScore& s : scores) {
+    changes += s.changes;
+    versions += s.versions;
+    transient += s.transient_versions;
+    there += s.there, boxed += s.boxed, away += s.away, freed += s.freed;
+    if (!s.first) continue;
+    ++firsts;
+    blocked_sum += s.first->blocked;
+    blocked_worst = std::max(blocked_worst, s.first->blocked);
+  }
+  std::printf(
+      "over %zu phases: %.2f versions a change of the crate (goal <= 1.1), %zu versions only of boxes that "
+      "came and went (goal 0), the first version blocking %.1f %% of the obstacles' volume in free space on "
+      "average and %.1f %% at worst (goal <= 25 %%, first versions made: %zu), the crate boxed on its own %zu "
+      "of %zu times and its place free %zu of %zu times (goal: every time)\n",
+      scores.size(), per_change(versions, changes), transient,
+      firsts ? 100 * blocked_sum / static_cast<double>(firsts) : NAN, 100 * blocked_worst, firsts, boxed,
+      there, freed, away);
+}
+
+// One offline run per phase (--phases, else --phase), each scored, then all of them together.
+int run_offline(const Options& options) {
+  std::vector<OfflineScore> scores;
+  for (const int phase : options.phases.empty() ? std::vector<int>{options.phase} : options.phases) {
+    Options at = options;
+    at.phase = phase;
+    scores.push_back(play_offline(at));
+    print_score(scores.back());
+  }
+  for (const OfflineScore& s : scores) print_score(s);
+  print_overall(scores);
   return 0;
 }
 
@@ -801,11 +958,25 @@ int main(int argc, char** argv) {
          "frames of the gantry's back and forth gone by at the first frame: where the sweeps (grouped "
          "from the first frame's stamp) fall in its passes")
       ->check(CLI::Range(0, 100000));
+  app.add_option("--phases", options.phases,
+                 "--offline: one run per phase (comma-separated), each scored, then all together")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 100000));
+  app.add_flag("--explain", options.explain,
+               "--offline: print the first version's boxes, each with the free space it blocks");
+  app.add_option("--set", options.settings,
+                 "a cellmapd config key for the run, SECTION.KEY=VALUE (e.g. change.gather_sweeps=2); "
+                 "repeatable")
+      ->type_name("SECTION.KEY=VALUE");
   app.add_option("--domain", options.domain, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_flag("--offline", options.offline,
                "play the recordings through the cell pipeline alone, as fast as it goes, and score the boxes "
                "before each change of the crate (no daemon, no DDS, no timing: the same every run)");
   CLI11_PARSE(app, argc, argv);
+  if (!options.phases.empty() && !options.offline) {
+    std::fprintf(stderr, "bench daemon: --phases needs --offline\n");
+    return 2;
+  }
   try {
     return options.offline ? run_offline(options) : run(options);
   } catch (const std::exception& e) {
