@@ -707,6 +707,18 @@ void explain(const std::vector<Box>& boxes) {
   }
 }
 
+void print_box(const Box& b, const char* what) {
+  std::printf("    %s box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels\n", what,
+              static_cast<unsigned long long>(b.id), b.center.x(), b.center.y(), b.center.z(),
+              2 * b.half_extents.x(), 2 * b.half_extents.y(), 2 * b.half_extents.z(),
+              static_cast<unsigned long long>(b.points));
+}
+
+void print_added(const Reconciled& change) {
+  for (const Box& b : change.added) print_box(b, "added");
+  for (const Box& b : change.modified) print_box(b, "modified");
+}
+
 // The cameras' replays as cellmapd opens them (their directories, poses and intrinsics).
 std::vector<std::unique_ptr<ReplaySource>> open_replays(const std::vector<Camera>& cameras,
                                                         const fs::path& dir) {
@@ -816,7 +828,10 @@ OfflineScore play_offline(const Options& options) {
     std::printf("version %zu at %5.2f s: +%zu ~%zu -%zu, %zu boxes; %zu voxels re-segmented in %.1f ms\n",
                 ++version, stamp, report.change->added.size(), report.change->modified.size(),
                 report.change->removed.size(), report.boxes, report.evidence, 1e3 * report.t_segment);
-    if (version > 1) return log.add(stamp, *report.change);
+    if (version > 1) {
+      if (options.explain) print_added(*report.change);
+      return log.add(stamp, *report.change);
+    }
     score.first = standing(pipeline.boxes(), false);
     print_standing(stamp, *score.first);
     if (options.explain) explain(pipeline.boxes());
@@ -963,7 +978,8 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::Range(0, 100000));
   app.add_flag("--explain", options.explain,
-               "--offline: print the first version's boxes, each with the free space it blocks");
+               "--offline: print the first version's boxes, each with the free space it blocks, and the "
+               "boxes each later version adds or modifies");
   app.add_option("--set", options.settings,
                  "a cellmapd config key for the run, SECTION.KEY=VALUE (e.g. change.gather_sweeps=2); "
                  "repeatable")

@@ -150,9 +150,10 @@ TEST(CellPipelineFramesTest, ScannerBeamsWithoutAReturnClearUpToTheNearerOfTheir
 // A panel appears in two halves three sweeps apart (the left half confirmed when the right one gets its first
 // hit): with gather_sweeps 0 each half is a version (the right half touches the left, whose voxels are new,
 // so it is a change of its own); with 3, one version holds both.
-std::vector<std::vector<Box>> versions_of_a_panel_in_two_halves(int gather_sweeps) {
+std::vector<std::vector<Box>> versions_of_a_panel_in_two_halves(int gather_sweeps, bool gather_removals = true) {
   CellPipelineConfig c = config();
   c.gather_sweeps = gather_sweeps;
+  c.gather_removals = gather_removals;
   CellPipeline pipeline(c);
   const Scene wall = wall_and_panel([](int, int) { return false; });
   const Scene left = wall_and_panel([](int u, int v) { return panel_centre(u, v) && u < 40; });
@@ -179,6 +180,31 @@ TEST(CellPipelineFramesTest, GatherSweepsPublishesAChangeConfirmedInTwoPartsAsOn
     for (const Box& b : gathered.back()) held += b.contains(p) ? 1 : 0;
     EXPECT_GE(held, 1u) << "the gathered version leaves out the panel at " << p.transpose();
   }
+}
+
+// The sweep, counted from the panel's going, whose version takes it away: the panel stood whole for 12
+// sweeps in front of the wall.
+int version_after_the_panel_goes(int gather_sweeps, bool gather_removals) {
+  CellPipelineConfig c = config();
+  c.gather_sweeps = gather_sweeps;
+  c.gather_removals = gather_removals;
+  CellPipeline pipeline(c);
+  const Scene wall = wall_and_panel([](int, int) { return false; });
+  const Scene panel = wall_and_panel(panel_centre);
+  for (int i = 0; i < 6; ++i) (void)pipeline.process(sweep_of(wall));
+  for (int i = 0; i < 12; ++i) (void)pipeline.process(sweep_of(panel));
+  for (int sweep = 1; sweep <= 40; ++sweep) {
+    if (pipeline.process(sweep_of(wall)).change) return sweep;
+  }
+  return -1;
+}
+
+TEST(CellPipelineFramesTest, GatherRemovalsFalsePublishesARemovalAtOnceAndStillGathersAnArrival) {
+  const int at_once = version_after_the_panel_goes(0, true);
+  ASSERT_GT(at_once, 0) << "the panel's going made no version";
+  EXPECT_EQ(version_after_the_panel_goes(3, true), at_once + 3);
+  EXPECT_EQ(version_after_the_panel_goes(3, false), at_once);
+  EXPECT_EQ(versions_of_a_panel_in_two_halves(3, false).size(), 2u) << "the wall, then the whole panel";
 }
 
 TEST(CellPipelineFramesTest, GatherSweepsOutOfRangeIsRefused) {

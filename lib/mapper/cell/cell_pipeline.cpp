@@ -91,6 +91,12 @@ double free_volume_of_parts(const Cloud& centres, const std::vector<Box>& parts,
   return free;
 }
 
+// Whether something appeared in `changes` (else they only remove).
+bool appears(const ChangeSet& changes) {
+  return std::any_of(changes.regions.begin(), changes.regions.end(),
+                     [](const ChangeRegion& region) { return !region.appeared.empty(); });
+}
+
 }  // namespace
 
 CellPipeline::CellPipeline(const CellPipelineConfig& config, std::vector<Box> boxes,
@@ -349,7 +355,7 @@ void CellPipeline::update_viewpoint(const Sweep& sweep) {
 bool CellPipeline::resegmentation_due(ChangeSet& changes) {
   if (settling_) return ++settled_sweeps_ >= config_.settle_sweeps;
   if (!changes.empty()) {
-    if (gathered_.empty()) gather_wait_ = config_.gather_sweeps;
+    if (gathered_.empty()) gather_wait_ = config_.gather_removals || appears(changes) ? config_.gather_sweeps : 0;
     for (ChangeRegion& region : changes.regions) gathered_.regions.push_back(std::move(region));
   }
   if (gathered_.empty() || gather_wait_-- > 0) return false;

@@ -49,6 +49,12 @@ struct CellPipelineConfig final {
   /// its top; the part of an object's old place that the robot hid while it carried the object away clears
   /// once the robot moved on. Each part would otherwise be a version of its own.
   int gather_sweeps = 0;
+  /// Whether a change in which nothing appeared (removals only) waits `gather_sweeps` too
+  /// (`change.gather_removals`; default true). A place that clears is mostly confirmed in one go once the
+  /// cameras see through it, while a new object's sides come in after its top; false publishes removals at
+  /// once and keeps the wait for arrivals. Keep it true where a robot hides part of an object's old place
+  /// while it carries the object away.
+  bool gather_removals = true;
   /// Every version holds every obstacle voxel of the map whole (`reconcile.cover_every_version`; default
   /// true). Obstacle voxels are those of 26-connected occupied groups of at least `change.min_voxels`; a
   /// smaller group touching nothing else is noise and never fitted. The first version holds every obstacle
