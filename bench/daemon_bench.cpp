@@ -67,10 +67,11 @@ struct Options {
   int stops = 20;                // distinct gantry positions rendered per pass (a frame shows the nearest)
   int phase = 0;                 // frames of the gantry's back and forth gone by at the first frame
   std::vector<int> phases;       // --offline: one run per phase, scored each and together
-  std::vector<std::string> settings;  // --set SECTION.KEY=VALUE: cellmapd config keys for the run
   double no_return_range = 4.5;  // the Kinect's (time-of-flight)
   int settle_sweeps = 15;        // change.settle_sweeps (cellmapd's default)
   int sweep_frames = 0;          // the sources' sweep_frames (cellmapd's default: only sweep_period groups)
+  // --set SECTION.KEY=VALUE: cellmapd config keys for the run
+  std::vector<std::string> settings;
   int domain = 144;
   int anchor_frames = 6;  // frames per camera fused by the anchor
   bool offline = false;   // the recordings through the cell pipeline alone, boxes scored (run_offline)
@@ -697,13 +698,19 @@ void explain(const std::vector<Box>& boxes) {
   std::sort(blocked.begin(), blocked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [m3, b] : blocked) {
     std::string objects;
-    for (const sim::ObjectScore& o : all.objects)
-      if (o.box == b->id) objects += " " + o.name + " (IoU " + std::to_string(o.iou).substr(0, 4) + ")";
-    std::printf("    box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels: blocks %.4f m3 (%.1f %%);%s\n",
-                static_cast<unsigned long long>(b->id), b->center.x(), b->center.y(), b->center.z(),
-                2 * b->half_extents.x(), 2 * b->half_extents.y(), 2 * b->half_extents.z(),
-                static_cast<unsigned long long>(b->points), m3, 100 * m3 / all.true_volume,
-                objects.empty() ? " no object's best box" : objects.c_str());
+    for (const sim::ObjectScore& o : all.objects) {
+      if (o.box != b->id) continue;
+      char iou[32];
+      std::snprintf(iou, sizeof iou, " (IoU %.2f)", o.iou);
+      objects += " " + o.name + iou;
+    }
+    std::printf(
+        "    box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels: blocks %.4f m3 (%.1f "
+        "%%);%s\n",
+        static_cast<unsigned long long>(b->id), b->center.x(), b->center.y(), b->center.z(),
+        2 * b->half_extents.x(), 2 * b->half_extents.y(), 2 * b->half_extents.z(),
+        static_cast<unsigned long long>(b->points), m3, 100 * m3 / all.true_volume,
+        objects.empty() ? " no object's best box" : objects.c_str());
   }
 }
 
@@ -771,7 +778,8 @@ class VersionLog {
   [[nodiscard]] std::size_t versions() const { return versions_.size(); }
   [[nodiscard]] std::size_t transient_only(const Recording& recording) const {
     return static_cast<std::size_t>(std::count_if(versions_.begin(), versions_.end(), [&](const Version& v) {
-      return std::all_of(v.ids.begin(), v.ids.end(), [&](std::uint64_t id) { return transient(id, recording); });
+      return std::all_of(v.ids.begin(), v.ids.end(),
+                         [&](std::uint64_t id) { return transient(id, recording); });
     }));
   }
 
@@ -898,7 +906,8 @@ void print_overall(const std::vector<OfflineScore>& scores) {
   std::printf(
       "over %zu phases: %.2f versions a change of the crate (goal <= 1.1), %zu versions only of boxes that "
       "came and went (goal 0), the first version blocking %.1f %% of the obstacles' volume in free space on "
-      "average and %.1f %% at worst (goal <= 25 %%, first versions made: %zu), the crate boxed on its own %zu "
+      "average and %.1f %% at worst (goal <= 25 %%, first versions made: %zu), the crate boxed on its "
+      "own %zu "
       "of %zu times and its place free %zu of %zu times (goal: every time)\n",
       scores.size(), per_change(versions, changes), transient,
       firsts ? 100 * blocked_sum / static_cast<double>(firsts) : NAN, 100 * blocked_worst, firsts, boxed,

@@ -43,8 +43,8 @@ TEST(DaemonBenchTest, OfflineScoresTheCrateBeforeEachOfItsChangesPerPhaseAndOver
   // pipeline alone boxes it on its own while it stands and, at phase 0, frees its place once it is gone; the
   // overall line adds the phases up. The map settles for 3 sweeps only, so versions are many: the criteria
   // are the long run's (docs/tuning.md). No DDS here, so no domain.
-  const BenchRun run = run_bench(
-      "--offline --rate 5 --seconds 14 --settle-sweeps 3 --warmup 6 --change-every 4 --phases 0,3");
+  const BenchRun run =
+      run_bench("--offline --rate 5 --seconds 14 --settle-sweeps 3 --warmup 6 --change-every 4 --phases 0,3");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string phase0 = run.output.substr(run.output.rfind("phase 0: "));
   EXPECT_NE(phase0.find("the crate boxed on its own 1 of 1 times, its place free 1 of 1 times"),

@@ -150,7 +150,8 @@ TEST(CellPipelineFramesTest, ScannerBeamsWithoutAReturnClearUpToTheNearerOfTheir
 // A panel appears in two halves three sweeps apart (the left half confirmed when the right one gets its first
 // hit): with gather_sweeps 0 each half is a version (the right half touches the left, whose voxels are new,
 // so it is a change of its own); with 3, one version holds both.
-std::vector<std::vector<Box>> versions_of_a_panel_in_two_halves(int gather_sweeps, bool gather_removals = true) {
+std::vector<std::vector<Box>> versions_of_a_panel_in_two_halves(int gather_sweeps,
+                                                                bool gather_removals = true) {
   CellPipelineConfig c = config();
   c.gather_sweeps = gather_sweeps;
   c.gather_removals = gather_removals;

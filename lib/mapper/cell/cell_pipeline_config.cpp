@@ -27,8 +27,9 @@ CellPipelineConfig CellPipelineConfig::from_yaml(YamlMap& root) {
   YamlMap unknown = root.child("unknown");
   CellPipelineConfig c;
   c.occupancy = OccupancyConfig::from_yaml(occupancy);
-  // settle_sweeps, gather_sweeps and gather_removals sit in the `change` section (where operators look for them) but are the
-  // pipeline's policies: read them here, the rest of the section by the change detector's reader.
+  // settle_sweeps, gather_sweeps and gather_removals sit in the `change` section (where operators look for
+  // them) but are the pipeline's policies: read them here, the rest of the section by the change detector's
+  // reader.
   c.settle_sweeps = static_cast<int>(change.integer("settle_sweeps", c.settle_sweeps, 0, 100000));
   c.gather_sweeps = static_cast<int>(change.integer("gather_sweeps", c.gather_sweeps, 0, 1000));
   c.gather_removals = change.get<bool>("gather_removals", c.gather_removals);
