@@ -355,7 +355,8 @@ void CellPipeline::update_viewpoint(const Sweep& sweep) {
 bool CellPipeline::resegmentation_due(ChangeSet& changes) {
   if (settling_) return ++settled_sweeps_ >= config_.settle_sweeps;
   if (!changes.empty()) {
-    if (gathered_.empty()) gather_wait_ = config_.gather_removals || appears(changes) ? config_.gather_sweeps : 0;
+    if (gathered_.empty())
+      gather_wait_ = (config_.gather_removals || appears(changes)) ? config_.gather_sweeps : 0;
     for (ChangeRegion& region : changes.regions) gathered_.regions.push_back(std::move(region));
   }
   if (gathered_.empty() || gather_wait_-- > 0) return false;
