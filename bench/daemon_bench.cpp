@@ -684,6 +684,16 @@ Standing standing(const std::vector<Box>& boxes, bool crate_there) {
   return out;
 }
 
+// "box ID at (x, y, z), X x Y x Z m, N voxels": where a box is, its size along its own axes, what it holds.
+std::string box_text(const Box& b) {
+  char text[160];
+  std::snprintf(text, sizeof text, "box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels",
+                static_cast<unsigned long long>(b.id), b.center.x(), b.center.y(), b.center.z(),
+                2 * b.half_extents.x(), 2 * b.half_extents.y(), 2 * b.half_extents.z(),
+                static_cast<unsigned long long>(b.points));
+  return text;
+}
+
 // Each box of the cell without the crate: centre, size, voxels, the free space it blocks alone (m³ and
 // over the obstacles' volume) and the objects it matches best, largest blocked first: where the blocked free
 // space of a version is.
@@ -704,26 +714,14 @@ void explain(const std::vector<Box>& boxes) {
       std::snprintf(iou, sizeof iou, " (IoU %.2f)", o.iou);
       objects += " " + o.name + iou;
     }
-    std::printf(
-        "    box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels: blocks %.4f m3 (%.1f "
-        "%%);%s\n",
-        static_cast<unsigned long long>(b->id), b->center.x(), b->center.y(), b->center.z(),
-        2 * b->half_extents.x(), 2 * b->half_extents.y(), 2 * b->half_extents.z(),
-        static_cast<unsigned long long>(b->points), m3, 100 * m3 / all.true_volume,
-        objects.empty() ? " no object's best box" : objects.c_str());
+    std::printf("    %s: blocks %.4f m3 (%.1f %%);%s\n", box_text(*b).c_str(), m3, 100 * m3 / all.true_volume,
+                objects.empty() ? " no object's best box" : objects.c_str());
   }
 }
 
-void print_box(const Box& b, const char* what) {
-  std::printf("    %s box %llu at (%.2f, %.2f, %.2f), %.2f x %.2f x %.2f m, %llu voxels\n", what,
-              static_cast<unsigned long long>(b.id), b.center.x(), b.center.y(), b.center.z(),
-              2 * b.half_extents.x(), 2 * b.half_extents.y(), 2 * b.half_extents.z(),
-              static_cast<unsigned long long>(b.points));
-}
-
 void print_added(const Reconciled& change) {
-  for (const Box& b : change.added) print_box(b, "added");
-  for (const Box& b : change.modified) print_box(b, "modified");
+  for (const Box& b : change.added) std::printf("    added %s\n", box_text(b).c_str());
+  for (const Box& b : change.modified) std::printf("    modified %s\n", box_text(b).c_str());
 }
 
 // The cameras' replays as cellmapd opens them (their directories, poses and intrinsics).
@@ -763,38 +761,33 @@ class VersionLog {
   static constexpr double kTransientSeconds = 5.0;
 
   void add(double stamp, const Reconciled& change) {
-    Version version{stamp, {}};
+    std::vector<std::uint64_t> ids;
     for (const Box& b : change.added) {
       added_[b.id] = stamp;
-      version.ids.push_back(b.id);
+      ids.push_back(b.id);
     }
-    for (const Box& b : change.modified) version.ids.push_back(b.id);
+    for (const Box& b : change.modified) ids.push_back(b.id);
     for (const std::uint64_t id : change.removed) {
       removed_[id] = stamp;
-      version.ids.push_back(id);
+      ids.push_back(id);
     }
-    versions_.push_back(std::move(version));
+    versions_.push_back(std::move(ids));
   }
   [[nodiscard]] std::size_t versions() const { return versions_.size(); }
   [[nodiscard]] std::size_t transient_only(const Recording& recording) const {
-    return static_cast<std::size_t>(std::count_if(versions_.begin(), versions_.end(), [&](const Version& v) {
-      return std::all_of(v.ids.begin(), v.ids.end(),
-                         [&](std::uint64_t id) { return transient(id, recording); });
+    return static_cast<std::size_t>(std::count_if(versions_.begin(), versions_.end(), [&](const auto& ids) {
+      return std::all_of(ids.begin(), ids.end(), [&](std::uint64_t id) { return transient(id, recording); });
     }));
   }
 
  private:
-  struct Version {
-    double stamp;
-    std::vector<std::uint64_t> ids;
-  };
   [[nodiscard]] bool transient(std::uint64_t id, const Recording& recording) const {
     const auto added = added_.find(id), removed = removed_.find(id);
     if (added == added_.end() || removed == removed_.end()) return false;
     return removed->second - added->second <= kTransientSeconds &&
            recording.changes_between(added->second, removed->second) == 0;
   }
-  std::vector<Version> versions_;
+  std::vector<std::vector<std::uint64_t>> versions_;  // per version: the ids it added, modified or removed
   std::map<std::uint64_t, double> added_, removed_;
 };
 
@@ -907,8 +900,7 @@ void print_overall(const std::vector<OfflineScore>& scores) {
       "over %zu phases: %.2f versions a change of the crate (goal <= 1.1), %zu versions only of boxes that "
       "came and went (goal 0), the first version blocking %.1f %% of the obstacles' volume in free space on "
       "average and %.1f %% at worst (goal <= 25 %%, first versions made: %zu), the crate boxed on its "
-      "own %zu "
-      "of %zu times and its place free %zu of %zu times (goal: every time)\n",
+      "own %zu of %zu times and its place free %zu of %zu times (goal: every time)\n",
       scores.size(), per_change(versions, changes), transient,
       firsts ? 100 * blocked_sum / static_cast<double>(firsts) : NAN, 100 * blocked_worst, firsts, boxed,
       there, freed, away);
@@ -998,8 +990,8 @@ int main(int argc, char** argv) {
                "play the recordings through the cell pipeline alone, as fast as it goes, and score the boxes "
                "before each change of the crate (no daemon, no DDS, no timing: the same every run)");
   CLI11_PARSE(app, argc, argv);
-  if (!options.phases.empty() && !options.offline) {
-    std::fprintf(stderr, "bench daemon: --phases needs --offline\n");
+  if ((!options.phases.empty() || options.explain) && !options.offline) {
+    std::fprintf(stderr, "bench daemon: --phases and --explain need --offline\n");
     return 2;
   }
   try {
